@@ -1,0 +1,157 @@
+#include "pipeline/commands.h"
+
+#include "core/log.h"
+#include "pipeline/frame_range.h"
+#include "pipeline/progress.h"
+#include "pipeline/schema.h"
+
+#include <tbb/global_control.h>
+
+#include <chrono>
+#include <iostream>
+
+namespace hp {
+
+const std::vector<CommandSpec>& commands() {
+    static const std::vector<CommandSpec> list = {
+        runCommandSpec(),
+        validateCommandSpec(),
+        infoCommandSpec(),
+        helpCommandSpec(),
+    };
+    return list;
+}
+
+namespace {
+
+std::string sceneArgument(const CommandLine& cl) {
+    if (cl.positional.empty()) throw UsageError("hairpipe " + cl.command + ": no scene file given (see --help)");
+    if (cl.positional.size() > 1)
+        throw UsageError("hairpipe " + cl.command + ": unexpected argument '" + cl.positional[1] + "'");
+    return cl.positional[0];
+}
+
+long positiveInteger(const CommandLine& cl, const std::string& option, long max) {
+    const std::string text = cl.value(option);
+    char* end = nullptr;
+    const long n = std::strtol(text.c_str(), &end, 10);
+    if (text.empty() || *end != '\0' || n < 1 || n > max)
+        throw UsageError(cat("option ", option, " expects an integer in [1, ", max, "], got '", text, "'"));
+    return n;
+}
+
+}  // namespace
+
+CommandContext::CommandContext(const CommandLine& cl) {
+    std::vector<std::string> sets;
+    if (cl.has("--set")) sets = cl.values.at("--set");
+    if (cl.has("--seed")) {
+        const std::string seed = cl.value("--seed");
+        char* end = nullptr;
+        std::strtoll(seed.c_str(), &end, 10);
+        if (seed.empty() || *end != '\0') throw UsageError("option --seed expects an integer, got '" + seed + "'");
+        sets.push_back("seed=" + seed);
+    }
+    if (cl.has("--threads")) {
+        const long n = positiveInteger(cl, "--threads", 1024);
+        threads_ = std::make_shared<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(n));
+    }
+    scene = Scene::load(sceneArgument(cl), sets);
+    if (cl.has("--frames")) options.frames = parseFrameRange(cl.value("--frames"));
+    if (cl.has("--out")) options.outputDir = cl.value("--out");
+    options.force = cl.has("--force");
+}
+
+CommandContext::~CommandContext() = default;
+
+int runShotCommand(const CommandContext& ctx, const std::set<std::string>& only) {
+    const auto start = std::chrono::steady_clock::now();
+    const ShotSettings shot = resolveShot(ctx.scene, ctx.options);
+    std::vector<StagePtr> stages = makeStages(ctx.scene, shot, only);
+    std::string names;
+    for (const StagePtr& s : stages) names += (names.empty() ? "" : ", ") + s->name();
+    logInfo("hairpipe: ", ctx.scene.name(), ": frames ", formatFrameRange(shot.frames), " -> ",
+            shot.outputDir.string(), " (stages: ", names.empty() ? "none" : names, ")");
+    std::unique_ptr<FrameSource> source = makeFrameSource(ctx.scene, shot);
+    const RunReport report = runFrames(*source, stages, shot);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    logInfo("hairpipe: ", report.framesDone, " frames in ", formatDuration(seconds), ", ", report.outputsSkipped,
+            " stage outputs already present (skipped)", report.failures.empty() ? "" : ", FAILURES:");
+    for (const std::string& f : report.failures) logError(f);
+    return report.failures.empty() ? kExitOk : kExitFrameFailed;
+}
+
+CommandSpec runCommandSpec() {
+    CommandSpec c;
+    c.name = "run";
+    c.usage = "[options] scene.yaml";
+    c.summary = "run every stage the scene enables, frame by frame";
+    c.details =
+        "Frames whose outputs all exist are skipped (use --force to redo them), so an\n"
+        "interrupted batch resumes where it stopped. Each file is written under a\n"
+        "temporary name and renamed when complete.";
+    c.run = [](const CommandLine& cl) {
+        CommandContext ctx(cl);
+        return runShotCommand(ctx, {});
+    };
+    return c;
+}
+
+CommandSpec validateCommandSpec() {
+    CommandSpec c;
+    c.name = "validate";
+    c.usage = "[options] scene.yaml";
+    c.summary = "check a scene file (types, ranges, files) without running it";
+    c.run = [](const CommandLine& cl) {
+        CommandContext ctx(cl);
+        resolveShot(ctx.scene, ctx.options);
+        std::cout << ctx.scene.name() << ": ok\n";
+        return int(kExitOk);
+    };
+    return c;
+}
+
+CommandSpec infoCommandSpec() {
+    CommandSpec c;
+    c.name = "info";
+    c.usage = "[options] scene.yaml";
+    c.summary = "print what a scene resolves to (frames, assets, strand counts, every key)";
+    c.run = [](const CommandLine& cl) {
+        CommandContext ctx(cl);
+        const ShotSettings shot = resolveShot(ctx.scene, ctx.options);
+        std::cout << "scene:   " << ctx.scene.name() << "\n"
+                  << "frames:  " << formatFrameRange(shot.frames) << " (" << shot.frames.size() << " frames at "
+                  << shot.fps << " fps)\n"
+                  << "output:  " << shot.outputDir.string() << "\n"
+                  << "seed:    " << shot.seed << "\n\nresolved keys:\n"
+                  << ctx.scene.dump();
+        return int(kExitOk);
+    };
+    return c;
+}
+
+CommandSpec helpCommandSpec() {
+    CommandSpec c;
+    c.name = "help";
+    c.usage = "[command | scene]";
+    c.summary = "show help for a command, or 'help scene' for the scene file reference";
+    c.sceneOptions = false;
+    c.run = [](const CommandLine& cl) {
+        if (cl.positional.empty()) {
+            std::cout << generalHelp();
+        } else if (cl.positional[0] == "scene") {
+            std::cout << Schema::scene().markdown();
+        } else {
+            for (const CommandSpec& cmd : commands())
+                if (cmd.name == cl.positional[0]) {
+                    std::cout << commandHelp(cmd);
+                    return int(kExitOk);
+                }
+            throw UsageError("hairpipe help: unknown command '" + cl.positional[0] + "'");
+        }
+        return int(kExitOk);
+    };
+    return c;
+}
+
+}  // namespace hp

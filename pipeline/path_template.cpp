@@ -1,0 +1,61 @@
+#include "pipeline/path_template.h"
+
+#include "core/errors.h"
+
+#include <cctype>
+#include <cstdio>
+
+namespace hp {
+
+namespace {
+
+struct Token {
+    size_t pos = std::string::npos;
+    size_t length = 0;
+    int padding = 0;
+};
+
+/// Finds frame tokens; returns how many there are and the first one.
+int findTokens(const std::string& p, Token* first) {
+    int count = 0;
+    for (size_t i = 0; i < p.size();) {
+        Token t;
+        if (p[i] == '#') {
+            size_t j = i;
+            while (j < p.size() && p[j] == '#') ++j;
+            t = {i, j - i, int(j - i)};
+        } else if (p[i] == '%') {
+            // %d, %4d, %04d
+            size_t j = i + 1;
+            while (j < p.size() && std::isdigit(static_cast<unsigned char>(p[j]))) ++j;
+            if (j < p.size() && p[j] == 'd') {
+                const std::string digits = p.substr(i + 1, j - i - 1);
+                t = {i, j - i + 1, digits.empty() ? 0 : std::stoi(digits)};
+            }
+        }
+        if (t.pos != std::string::npos) {
+            if (count++ == 0 && first) *first = t;
+            i = t.pos + t.length;
+        } else {
+            ++i;
+        }
+    }
+    return count;
+}
+
+}  // namespace
+
+bool hasFrameToken(const std::string& pattern) { return findTokens(pattern, nullptr) > 0; }
+
+std::string expandFrame(const std::string& pattern, int frame) {
+    Token t;
+    const int n = findTokens(pattern, &t);
+    if (n == 0) throw UsageError("path template '" + pattern + "' has no frame number (use #### or %04d)");
+    if (n > 1) throw UsageError("path template '" + pattern + "' has more than one frame number");
+    if (t.padding > 32) throw UsageError("path template '" + pattern + "' pads to more than 32 digits");
+    char digits[48];
+    std::snprintf(digits, sizeof digits, "%0*d", t.padding + (frame < 0 ? 1 : 0), frame);
+    return pattern.substr(0, t.pos) + digits + pattern.substr(t.pos + t.length);
+}
+
+}  // namespace hp

@@ -1,0 +1,14 @@
+// Registration of the scene schema, one function per section, each in its own
+// pipeline/scene_keys_<section>.cpp. addSceneKeys (schema.cpp) calls them all.
+#pragma once
+
+#include "pipeline/schema.h"
+
+namespace hp {
+
+void addSceneKeys(SchemaBuilder& b);
+
+void addShotKeys(SchemaBuilder& b);    // top level: name, frames, fps, seed
+void addOutputKeys(SchemaBuilder& b);  // output: directory, templates
+
+}  // namespace hp

@@ -1,0 +1,80 @@
+#include "pipeline/shot.h"
+
+#include "core/log.h"
+#include "pipeline/progress.h"
+#include "pipeline/output.h"
+#include "pipeline/stages.h"
+
+#include <algorithm>
+
+namespace fs = std::filesystem;
+
+namespace hp {
+
+ShotSettings resolveShot(const Scene& scene, const RunOptions& options) {
+    ShotSettings shot;
+    shot.fps = scene.number("fps");
+    shot.seed = scene.integer("seed");
+    shot.force = options.force;
+    shot.frames = options.frames ? *options.frames : scene.frames("frames");
+    fs::path out = options.outputDir;
+    if (out.empty()) {
+        const std::string& configured = scene.text("output.directory");
+        out = configured.empty() ? fs::path("out") / fs::path(scene.name()).stem() : fs::path(configured);
+        // A directory named in the scene is relative to the scene's folder.
+        if (!configured.empty() && out.is_relative()) out = scene.directory() / out;
+    }
+    shot.outputDir = fs::absolute(out).lexically_normal();
+    return shot;
+}
+
+RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const ShotSettings& shot) {
+    RunReport report;
+    if (stages.empty()) {
+        logWarning("nothing to do: the scene enables no output stage");
+        return report;
+    }
+    Progress progress("frames", shot.frames.size());
+    for (int frame : shot.frames) {
+        // Decide first which stages still have work, so a fully written frame
+        // costs no simulation or head evaluation when the source allows it.
+        std::vector<FrameStage*> todo;
+        for (StagePtr& stage : stages) {
+            if (!shot.force && allExist(stage->outputs(frame))) {
+                ++report.outputsSkipped;
+                logVerbose("frame ", frame, " ", stage->name(), ": outputs exist, skipped");
+            } else {
+                todo.push_back(stage.get());
+            }
+        }
+        const bool needsData = std::any_of(todo.begin(), todo.end(), [](FrameStage* s) { return s->needsFrameData(); });
+        FrameData data;
+        data.frame = frame;
+        data.time = frame / shot.fps;
+        bool sourceFailed = false;
+        if (needsData) {
+            try {
+                data = source.get(frame);
+            } catch (const Error& e) {
+                // Without the frame's data no data stage can run; later frames may still work.
+                report.failures.push_back(cat("frame ", frame, ": ", e.what()));
+                logError("frame ", frame, ": ", e.what());
+                sourceFailed = true;
+            }
+        }
+        for (FrameStage* stage : todo) {
+            if (sourceFailed && stage->needsFrameData()) continue;
+            try {
+                stage->run(data);
+            } catch (const Error& e) {
+                report.failures.push_back(cat("frame ", frame, " ", stage->name(), ": ", e.what()));
+                logError("frame ", frame, " ", stage->name(), ": ", e.what());
+            }
+        }
+        ++report.framesDone;
+        progress.advance(cat("frame ", frame));
+    }
+    return report;
+}
+
+}  // namespace hp

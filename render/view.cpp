@@ -1,0 +1,81 @@
+#include "render/view.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hp {
+
+Mat4f Camera::view() const {
+    const Vec3f f = (target - position).normalized();
+    const Vec3f s = f.cross(up).normalized();
+    const Vec3f u = s.cross(f);
+    Mat4f m = Mat4f::Identity();
+    m.block<1, 3>(0, 0) = s.transpose();
+    m.block<1, 3>(1, 0) = u.transpose();
+    m.block<1, 3>(2, 0) = -f.transpose();
+    m(0, 3) = -s.dot(position);
+    m(1, 3) = -u.dot(position);
+    m(2, 3) = f.dot(position);
+    return m;
+}
+
+Mat4f Camera::projection() const {
+    const float t = 1.f / std::tan(0.5f * fovY * float(M_PI) / 180.f);
+    Mat4f m = Mat4f::Zero();
+    m(0, 0) = t / aspect();
+    m(1, 1) = t;
+    m(2, 2) = (farClip + nearClip) / (nearClip - farClip);
+    m(2, 3) = 2.f * farClip * nearClip / (nearClip - farClip);
+    m(3, 2) = -1.f;
+    return m;
+}
+
+Vec3f Camera::rayDirection(float x, float y) const {
+    const Vec3f f = (target - position).normalized();
+    const Vec3f s = f.cross(up).normalized();
+    const Vec3f u = s.cross(f);
+    const float tanHalf = std::tan(0.5f * fovY * float(M_PI) / 180.f);
+    const float ndcX = (2.f * x / width - 1.f) * tanHalf * aspect();
+    const float ndcY = (1.f - 2.f * y / height) * tanHalf;
+    return (f + ndcX * s + ndcY * u).normalized();
+}
+
+Vec3f Light::toLight(const Vec3f& p, Vec3f* radiance, float* distance) const {
+    if (type == LightType::Directional) {
+        if (radiance) *radiance = color * intensity;
+        if (distance) *distance = std::numeric_limits<float>::infinity();
+        return -direction.normalized();
+    }
+    const Vec3f d = position - p;
+    const float r2 = std::max(d.squaredNorm(), 1e-8f);
+    if (radiance) *radiance = color * (intensity / r2);
+    if (distance) *distance = std::sqrt(r2);
+    return d / std::sqrt(r2);
+}
+
+namespace {
+float sinBetween(const Vec3f& a, const Vec3f& b) {
+    const float c = std::clamp(a.dot(b), -1.f, 1.f);
+    return std::sqrt(std::max(0.f, 1.f - c * c));
+}
+Vec3f shifted(const Vec3f& t, const Vec3f& n, float shift) {
+    if (shift == 0.f) return t;
+    return (t + shift * n).normalized();
+}
+}  // namespace
+
+Vec3f kajiyaKay(const HairMaterial& m, const Vec3f& t, const Vec3f& n, const Vec3f& l, const Vec3f& v,
+                Vec3f* diffuseOut, Vec3f* specularOut) {
+    const Vec3f h = (l + v).normalized();
+    const Vec3f diffuse = m.kd * sinBetween(t, l) * m.color;
+    Vec3f specular = m.ks * std::pow(sinBetween(shifted(t, n, m.primaryShift), h), m.shininess) * m.specularColor;
+    if (m.twoLobes) {
+        specular += m.secondaryKs * std::pow(sinBetween(shifted(t, n, m.secondaryShift), h), m.secondaryShininess) *
+                    m.secondaryColor;
+    }
+    if (diffuseOut) *diffuseOut = diffuse;
+    if (specularOut) *specularOut = specular;
+    return diffuse + specular;
+}
+
+}  // namespace hp

@@ -1,0 +1,88 @@
+// Camera, lights and hair material shared by the GL preview and the Embree
+// reference, so both render the same shot with the same parameters.
+#pragma once
+
+#include "sim/strand.h"
+
+#include <Eigen/Geometry>
+
+#include <string>
+#include <vector>
+
+namespace hp {
+
+using Vec4f = Eigen::Vector4f;
+using Mat4f = Eigen::Matrix4f;
+
+/// A pinhole perspective camera. Right-handed, Y up, looking down -Z in view space.
+struct Camera {
+    Vec3f position{0.f, 0.05f, 0.9f};
+    Vec3f target{0.f, 0.f, 0.f};
+    Vec3f up{0.f, 1.f, 0.f};
+    float fovY = 40.f;  ///< vertical field of view, degrees
+    int width = 1920;
+    int height = 1080;
+    float nearClip = 0.01f;
+    float farClip = 100.f;
+
+    float aspect() const { return float(width) / float(height); }
+    /// World-to-view matrix (OpenGL convention).
+    Mat4f view() const;
+    /// View-to-clip matrix (OpenGL convention, depth in [-1, 1]).
+    Mat4f projection() const;
+    /// Unit direction of the ray through image position (x, y) in pixels,
+    /// (0, 0) the top-left corner of the top-left pixel, y pointing down.
+    Vec3f rayDirection(float x, float y) const;
+};
+
+enum class LightType { Directional, Point };
+
+struct Light {
+    LightType type = LightType::Directional;
+    Vec3f direction{-1.f, -1.f, -1.f};  ///< directional: the way the light travels (normalised on use)
+    Vec3f position{0.f, 1.f, 1.f};      ///< point lights
+    Vec3f color{1.f, 1.f, 1.f};
+    float intensity = 3.f;              ///< radiance scale (directional) or power/(4π) (point)
+
+    /// Unit vector from `p` toward the light, and the light's radiance at `p`.
+    Vec3f toLight(const Vec3f& p, Vec3f* radiance, float* distance) const;
+};
+
+/// Kajiya-Kay hair material. The preview's GLSL (shaders/) mirrors kajiyaKay().
+struct HairMaterial {
+    Vec3f color{0.35f, 0.22f, 0.12f};          ///< diffuse albedo (linear)
+    Vec3f specularColor{1.f, 1.f, 1.f};
+    float kd = 0.6f;                            ///< diffuse weight
+    float ks = 0.3f;                            ///< specular weight
+    float shininess = 80.f;                     ///< specular exponent alpha
+    bool twoLobes = false;                      ///< Scheuermann's shifted-tangent two-lobe variant
+    float primaryShift = 0.f;                   ///< tangent shift along the normal, lobe 1
+    float secondaryShift = -0.1f;               ///< lobe 2
+    float secondaryKs = 0.15f;
+    float secondaryShininess = 20.f;
+    Vec3f secondaryColor{0.6f, 0.45f, 0.3f};
+};
+
+/// Opaque head material (simple Lambert + ambient).
+struct SurfaceMaterial {
+    Vec3f color{0.75f, 0.6f, 0.5f};
+    float ambient = 0.05f;
+};
+
+/// Everything a renderer needs about the shot besides geometry.
+struct View {
+    Camera camera;
+    std::vector<Light> lights{Light{}};
+    Vec3f environment{0.f, 0.f, 0.f};  ///< constant environment radiance (black by default)
+    HairMaterial hair;
+    SurfaceMaterial head;
+};
+
+/// Reflected radiance factor of Kajiya-Kay for tangent `t`, normal `n` (the
+/// shading normal used only to shift tangents), unit direction to the light
+/// `l` and to the viewer `v`: kd * color * sin(t,l) + ks * spec * sin(t,h)^alpha
+/// (seed 004), with h = normalize(l + v). Multiply by the light's radiance.
+Vec3f kajiyaKay(const HairMaterial& m, const Vec3f& t, const Vec3f& n, const Vec3f& l, const Vec3f& v,
+                Vec3f* diffuseOut = nullptr, Vec3f* specularOut = nullptr);
+
+}  // namespace hp

@@ -1,0 +1,69 @@
+#include "core/errors.h"
+#include "render/image_io.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+using namespace hp;
+
+namespace {
+Image gradient() {
+    Image img(16, 8, {"R", "G", "B", "A", "Z"});
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            img.at(x, y, 0) = x / 15.f;
+            img.at(x, y, 1) = y / 7.f;
+            img.at(x, y, 2) = 0.25f;
+            img.at(x, y, 3) = (x + y) % 2 ? 1.f : 0.5f;
+            img.at(x, y, 4) = 1.2345678f + x * 0.001f;
+        }
+    return img;
+}
+}  // namespace
+
+TEST(ImageIo, ExrRoundTripKeepsChannelsAndFullPrecisionDepth) {
+    test::TempDir dir;
+    const Image in = gradient();
+    writeImage((dir / "a.exr").string(), in);
+    const Image out = readImage((dir / "a.exr").string());
+    ASSERT_EQ(out.width, 16);
+    ASSERT_EQ(out.height, 8);
+    ASSERT_EQ(out.channels, in.channels);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 16; ++x) {
+            for (int c = 0; c < 4; ++c) EXPECT_NEAR(out.at(x, y, c), in.at(x, y, c), 1e-3f);  // half
+            EXPECT_EQ(out.at(x, y, 4), in.at(x, y, 4)) << "depth is stored as 32-bit float";
+        }
+}
+
+TEST(ImageIo, PngIsSrgbEncodedRgba) {
+    test::TempDir dir;
+    Image in(4, 1, {"R", "G", "B", "A", "Z"});
+    for (int x = 0; x < 4; ++x) {
+        in.at(x, 0, 0) = in.at(x, 0, 1) = in.at(x, 0, 2) = 0.2f;  // linear 0.2 -> sRGB ~0.484
+        in.at(x, 0, 3) = 1.f;
+    }
+    writeImage((dir / "a.png").string(), in);
+    const Image raw = readImage((dir / "a.png").string());
+    ASSERT_EQ(raw.channelCount(), 4) << "PNG keeps R, G, B, A only";
+    EXPECT_NEAR(raw.at(0, 0, 0), 0.484f, 0.01f);
+    EXPECT_NEAR(raw.at(0, 0, 3), 1.f, 1e-6f) << "alpha is not colour-converted";
+    const Image lin = readImage((dir / "a.png").string(), true);
+    EXPECT_NEAR(lin.at(0, 0, 0), 0.2f, 0.01f);
+}
+
+TEST(ImageIo, MissingOrBrokenFileNamesTheFile) {
+    test::TempDir dir;
+    try {
+        readImage((dir / "none.exr").string());
+        FAIL();
+    } catch (const AssetError& e) {
+        EXPECT_NE(std::string(e.what()).find("none.exr"), std::string::npos);
+    }
+    test::writeFile(dir / "bad.exr", "not an exr");
+    EXPECT_THROW(readImage((dir / "bad.exr").string()), AssetError);
+}
+
+TEST(ImageIo, UnwritablePathIsAnIoError) {
+    EXPECT_THROW(writeImage("/nonexistent-dir/x.exr", gradient()), IoError);
+}

@@ -1,0 +1,160 @@
+#include "pipeline/scene.h"
+#include "pipeline/schema.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+using namespace hp;
+
+namespace {
+
+/// Parses `yaml` expecting a SceneError; returns it.
+SceneError parseError(const std::string& yaml, const std::vector<std::string>& sets = {}) {
+    try {
+        Scene::parse(yaml, "shot.yaml", ".", sets);
+    } catch (const SceneError& e) {
+        return e;
+    }
+    ADD_FAILURE() << "no error for:\n" << yaml;
+    return SceneError({}, "", "");
+}
+
+}  // namespace
+
+TEST(Scene, DefaultsFillAbsentKeys) {
+    const Scene s = Scene::parse("fps: 30\n", "shot.yaml", ".");
+    EXPECT_EQ(s.number("fps"), 30.0);
+    EXPECT_TRUE(s.given("fps"));
+    EXPECT_EQ(s.integer("seed"), 1);
+    EXPECT_FALSE(s.given("seed"));
+    EXPECT_EQ(s.frames("frames").front(), 1);
+}
+
+TEST(Scene, WrongTypeNamesLineColumnAndKey) {
+    const SceneError e = parseError("frames: 1-10\nfps: fast\n");
+    EXPECT_EQ(e.where().file, "shot.yaml");
+    EXPECT_EQ(e.where().line, 2);
+    EXPECT_EQ(e.where().column, 6);
+    EXPECT_EQ(e.key(), "fps");
+    EXPECT_NE(std::string(e.what()).find("shot.yaml:2:6: 'fps': expected a number"), std::string::npos) << e.what();
+}
+
+TEST(Scene, OutOfRangeIsRejected) {
+    const SceneError e = parseError("fps: 0\n");
+    EXPECT_EQ(e.key(), "fps");
+    EXPECT_NE(e.detail().find("must be in [1, 1000]"), std::string::npos) << e.what();
+}
+
+TEST(Scene, IntegerRejectsFraction) {
+    const SceneError e = parseError("seed: 1.5\n");
+    EXPECT_NE(e.detail().find("expected an integer"), std::string::npos) << e.what();
+}
+
+TEST(Scene, NonFiniteNumbersAreRejected) {
+    for (const char* v : {"nan", "inf", "-inf", "1e999"}) {
+        const SceneError e = parseError(std::string("fps: ") + v + "\n");
+        EXPECT_NE(e.detail().find("finite"), std::string::npos) << v << ": " << e.what();
+    }
+}
+
+TEST(Scene, UnknownKeySuggestsTheClosest) {
+    const SceneError e = parseError("fps: 24\nframse: 1-3\n");
+    EXPECT_EQ(e.where().line, 2);
+    EXPECT_EQ(e.where().column, 1);
+    EXPECT_EQ(e.key(), "framse");
+    EXPECT_NE(std::string(e.what()).find("did you mean 'frames'"), std::string::npos) << e.what();
+}
+
+TEST(Scene, UnknownNestedKey) {
+    const SceneError e = parseError("output:\n  directroy: x\n");
+    EXPECT_EQ(e.key(), "output.directroy");
+    EXPECT_EQ(e.where().line, 2);
+    EXPECT_NE(std::string(e.what()).find("did you mean 'directory'"), std::string::npos) << e.what();
+}
+
+TEST(Scene, SectionMustBeAMap) {
+    const SceneError e = parseError("output: 3\n");
+    EXPECT_EQ(e.key(), "output");
+    EXPECT_NE(e.detail().find("section"), std::string::npos);
+}
+
+TEST(Scene, DuplicateKey) {
+    const SceneError e = parseError("fps: 24\nfps: 25\n");
+    EXPECT_EQ(e.where().line, 2);
+    EXPECT_NE(e.detail().find("duplicate"), std::string::npos);
+}
+
+TEST(Scene, YamlSyntaxErrorHasLocation) {
+    const SceneError e = parseError("fps: 24\nframes: [1, 2\n");
+    EXPECT_GE(e.where().line, 2);
+    EXPECT_NE(e.detail().find("YAML syntax error"), std::string::npos) << e.what();
+}
+
+TEST(Scene, BadFrameRangeInFile) {
+    const SceneError e = parseError("frames: 10-1\n");
+    EXPECT_EQ(e.key(), "frames");
+    EXPECT_EQ(e.where().line, 1);
+    EXPECT_NE(e.detail().find("ends before it starts"), std::string::npos) << e.what();
+}
+
+TEST(Scene, SetOverridesAreTypedAndValidated) {
+    const Scene s = Scene::parse("fps: 24\n", "shot.yaml", ".", {"fps=48", "seed=7", "frames=3-5"});
+    EXPECT_EQ(s.number("fps"), 48.0);
+    EXPECT_EQ(s.integer("seed"), 7);
+    EXPECT_EQ(s.frames("frames"), (std::vector<int>{3, 4, 5}));
+    EXPECT_EQ(s.where("fps").file, "--set fps=48");
+
+    const SceneError bad = parseError("", {"seed=abc"});
+    EXPECT_EQ(bad.key(), "seed");
+    EXPECT_NE(std::string(bad.what()).find("--set seed=abc"), std::string::npos) << bad.what();
+    EXPECT_NE(bad.detail().find("expected an integer"), std::string::npos);
+
+    const SceneError unknown = parseError("", {"fsp=3"});
+    EXPECT_NE(std::string(unknown.what()).find("did you mean 'fps'"), std::string::npos) << unknown.what();
+
+    const SceneError malformed = parseError("", {"fps"});
+    EXPECT_NE(malformed.detail().find("key.path=value"), std::string::npos);
+}
+
+TEST(Scene, FileKeysMustExist) {
+    test::TempDir dir;
+    test::writeFile(dir / "scene.yaml", "output:\n  directory: out\n");
+    const Scene s = Scene::load(dir / "scene.yaml");
+    EXPECT_EQ(s.text("output.directory"), "out");
+    EXPECT_THROW(Scene::load(dir / "missing.yaml"), AssetError);
+}
+
+TEST(Scene, CurveParsesScalarsAndKeys) {
+    Curve c;
+    c.keys = {{1, 0.0}, {11, 1.0}};
+    EXPECT_DOUBLE_EQ(c.eval(0), 0.0);
+    EXPECT_DOUBLE_EQ(c.eval(6), 0.5);
+    EXPECT_DOUBLE_EQ(c.eval(20), 1.0);
+}
+
+TEST(Scene, DumpMarksDefaults) {
+    const Scene s = Scene::parse("fps: 30\n", "shot.yaml", ".");
+    const std::string d = s.dump();
+    EXPECT_NE(d.find("fps: 30\n"), std::string::npos) << d;
+    EXPECT_NE(d.find("seed: 1    # default"), std::string::npos) << d;
+}
+
+TEST(Schema, EveryKeyIsDocumented) {
+    for (const KeySpec& k : Schema::scene().keys()) {
+        EXPECT_FALSE(k.doc.empty()) << k.path;
+        if (k.type == KeyType::Enum) {
+            EXPECT_FALSE(k.choices.empty()) << k.path;
+        }
+    }
+}
+
+TEST(Schema, DefaultsAreValid) {
+    // Every default must pass its own validation (an empty scene uses them all).
+    EXPECT_NO_THROW(Scene::parse("", "empty.yaml", "."));
+}
+
+TEST(Schema, ReferencePageIsUpToDate) {
+    const std::string committed = test::readFile(test::sourcePath("docs/scene-reference.md"));
+    EXPECT_EQ(committed, Schema::scene().markdown())
+        << "docs/scene-reference.md is stale: regenerate it with 'hairpipe help scene > docs/scene-reference.md'";
+}

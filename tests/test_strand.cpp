@@ -1,0 +1,80 @@
+#include "core/errors.h"
+#include "sim/head.h"
+#include "sim/strand.h"
+
+#include <gtest/gtest.h>
+
+using namespace hp;
+
+TEST(StrandFrame, AddStrandKeepsArraysConsistent) {
+    StrandFrame f;
+    const Vec3f p[3] = {{0, 0, 0}, {0, 1, 0}, {0, 2, 0}};
+    const float r[3] = {1, 0.5f, 0.1f};
+    f.addStrand(7, p, r, 3);
+    f.addStrand(8, p, r, 2);
+    EXPECT_EQ(f.strandCount(), 2u);
+    EXPECT_EQ(f.vertexCount(), 5u);
+    EXPECT_EQ(f.first(1), 3u);
+    EXPECT_EQ(f.vertexCount(1), 2u);
+    EXPECT_TRUE(f.velocities.empty());
+    EXPECT_NO_THROW(f.validate());
+    const Vec3f v[3] = {{1, 0, 0}, {1, 0, 0}, {1, 0, 0}};
+    f.addStrand(9, p, r, 3, v);
+    EXPECT_EQ(f.velocities.size(), f.positions.size()) << "earlier strands get zero velocity";
+    EXPECT_EQ(f.velocities[0], Vec3f::Zero());
+    EXPECT_EQ(f.velocities[5], Vec3f(1, 0, 0));
+}
+
+TEST(StrandFrame, ValidateCatchesNaNAndMismatch) {
+    StrandFrame f;
+    const Vec3f p[2] = {{0, 0, 0}, {0, NAN, 0}};
+    const float r[2] = {1, 1};
+    f.addStrand(0, p, r, 2);
+    EXPECT_THROW(f.validate(), Error);
+    f.positions[1].y() = 0;
+    EXPECT_NO_THROW(f.validate());
+    f.radii.pop_back();
+    EXPECT_THROW(f.validate(), Error);
+}
+
+TEST(Head, SphereMeshFacesPointOutward) {
+    const TriangleMesh m = makeSphereMesh(Vec3f(1, 2, 3), 0.5f, 12, 24);
+    int outward = 0;
+    for (const Tri& t : m.triangles) {
+        const Vec3f n = (m.positions[t[1]] - m.positions[t[0]]).cross(m.positions[t[2]] - m.positions[t[0]]);
+        const Vec3f c = (m.positions[t[0]] + m.positions[t[1]] + m.positions[t[2]]) / 3.f - Vec3f(1, 2, 3);
+        outward += n.dot(c) > 0;
+    }
+    EXPECT_EQ(outward, int(m.triangles.size()));
+    for (const Vec3f& p : m.positions) EXPECT_NEAR((p - Vec3f(1, 2, 3)).norm(), 0.5f, 1e-5f);
+}
+
+TEST(Head, SurfacePointFollowsDeformation) {
+    TriangleMesh m;
+    m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 0, -1}};
+    m.triangles = {{0, 1, 2}};
+    m.computeNormals();
+    const SurfacePoint sp{0, 0.25f, 0.25f};
+    SurfaceFrame f = evaluate(m, sp);
+    EXPECT_TRUE(f.position.isApprox(Vec3f(0.25f, 0, -0.25f)));
+    EXPECT_TRUE(f.normal.isApprox(Vec3f(0, 1, 0)));
+    EXPECT_TRUE(f.tangent.isApprox(Vec3f(1, 0, 0)));
+    // Rotate the triangle 90 degrees about X: the frame rotates with it.
+    const Eigen::AngleAxisf rot(float(M_PI / 2), Vec3f::UnitX());
+    for (Vec3f& p : m.positions) p = rot * p;
+    m.computeNormals();
+    f = evaluate(m, sp);
+    EXPECT_TRUE(f.normal.isApprox(rot * Vec3f(0, 1, 0), 1e-5f));
+    EXPECT_TRUE(f.tangent.isApprox(rot * Vec3f(1, 0, 0), 1e-5f));
+}
+
+TEST(Head, SpinningSphereTurnsAtItsRate) {
+    const SpinningSphere head(0.1f, 90.f);
+    const HeadPose p0 = head.sample(0.0), p1 = head.sample(1.0);
+    const Vec3f x = p1.transform * Vec3f(1, 0, 0);
+    EXPECT_NEAR(x.z(), -1.f, 1e-5f) << "90 degrees about +Y takes +X to -Z";
+    Vec3f n;
+    EXPECT_NEAR(p0.collider->signedDistance(Vec3f(0, 0.2f, 0), &n), 0.1f, 1e-6f);
+    EXPECT_TRUE(n.isApprox(Vec3f::UnitY()));
+    EXPECT_LT(p0.collider->signedDistance(Vec3f(0, 0.05f, 0)), 0.f);
+}
