@@ -78,3 +78,36 @@ TEST(Head, SpinningSphereTurnsAtItsRate) {
     EXPECT_TRUE(n.isApprox(Vec3f::UnitY()));
     EXPECT_LT(p0.collider->signedDistance(Vec3f(0, 0.05f, 0)), 0.f);
 }
+
+#include "sim/fibonacci.h"
+
+TEST(Fibonacci, CapHoldsExactlyCountPointsInside) {
+    for (size_t n : {1u, 94u, 845u, 10000u}) {
+        const auto pts = fibonacciCap(n);
+        ASSERT_EQ(pts.size(), n);
+        for (const Vec3f& p : pts) {
+            EXPECT_NEAR(p.norm(), 1.f, 1e-5f);
+            EXPECT_GE(p.y(), 0.f);
+        }
+    }
+}
+
+TEST(Fibonacci, LatticeIsEven) {
+    // Nearest-neighbour distances of a good lattice vary little.
+    const auto pts = fibonacciCap(500);
+    float lo = 1e9f, hi = 0.f;
+    for (size_t i = 0; i < pts.size(); ++i) {
+        float best = 1e9f;
+        for (size_t j = 0; j < pts.size(); ++j)
+            if (i != j) best = std::min(best, (pts[i] - pts[j]).norm());
+        lo = std::min(lo, best);
+        hi = std::max(hi, best);
+    }
+    EXPECT_GT(lo, 0.5f * hi) << "min/max nearest-neighbour spacing " << lo << " / " << hi;
+}
+
+TEST(Fibonacci, CapAroundAnotherAxis) {
+    const auto pts = fibonacciCap(100, Vec3f(0, 0, 1), 0.5f);
+    ASSERT_EQ(pts.size(), 100u);
+    for (const Vec3f& p : pts) EXPECT_GE(p.z(), 0.5f - 1e-5f);
+}
