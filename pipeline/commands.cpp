@@ -4,6 +4,7 @@
 #include "pipeline/frame_range.h"
 #include "pipeline/progress.h"
 #include "pipeline/schema.h"
+#include "pipeline/view_settings.h"
 
 #include <tbb/global_control.h>
 
@@ -15,6 +16,7 @@ namespace hp {
 const std::vector<CommandSpec>& commands() {
     static const std::vector<CommandSpec> list = {
         runCommandSpec(),
+        renderCommandSpec(),
         validateCommandSpec(),
         infoCommandSpec(),
         helpCommandSpec(),
@@ -97,6 +99,24 @@ CommandSpec runCommandSpec() {
     return c;
 }
 
+CommandSpec renderCommandSpec() {
+    CommandSpec c;
+    c.name = "render";
+    c.usage = "[--preview] [--reference] [options] scene.yaml";
+    c.summary = "render preview (GL) and/or reference (Embree) frames";
+    c.details = "Without --preview or --reference, renders whichever of the two the scene enables.";
+    c.options = {{"--preview", "", "render the GL preview"}, {"--reference", "", "render the Embree reference"}};
+    c.run = [](const CommandLine& cl) {
+        CommandContext ctx(cl);
+        std::set<std::string> only;
+        if (cl.has("--preview")) only.insert("preview");
+        if (cl.has("--reference")) only.insert("reference");
+        if (only.empty()) only = {"preview", "reference"};
+        return runShotCommand(ctx, only);
+    };
+    return c;
+}
+
 CommandSpec validateCommandSpec() {
     CommandSpec c;
     c.name = "validate";
@@ -105,6 +125,7 @@ CommandSpec validateCommandSpec() {
     c.run = [](const CommandLine& cl) {
         CommandContext ctx(cl);
         resolveShot(ctx.scene, ctx.options);
+        makeView(ctx.scene);  // checks across render keys
         std::cout << ctx.scene.name() << ": ok\n";
         return int(kExitOk);
     };

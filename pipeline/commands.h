@@ -10,6 +10,7 @@
 namespace hp {
 
 CommandSpec runCommandSpec();
+CommandSpec renderCommandSpec();
 CommandSpec validateCommandSpec();
 CommandSpec infoCommandSpec();
 CommandSpec helpCommandSpec();

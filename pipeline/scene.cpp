@@ -121,12 +121,17 @@ class SceneLoader {
         walkKey(key, YAML::Node(), value, origin);
     }
 
-    /// Fills defaults for absent keys (lists first, so their items get defaults too).
-    void fillDefaults() {
+    /// Default lists for absent list keys (before overrides, which may index them).
+    void fillListDefaults() {
         const Origin origin{"default", false, false};
         for (const KeySpec& spec : schema_.keys())
             if (spec.type == KeyType::List && !spec.defaultYaml.empty() && !scene_.values_.count(spec.path))
                 walkList(spec.path, spec, YAML::Load(spec.defaultYaml), origin);
+    }
+
+    /// Defaults for absent keys, including the keys of every list item.
+    void fillDefaults() {
+        const Origin origin{"default", false, false};
         for (const KeySpec& spec : schema_.keys()) {
             if (spec.type == KeyType::List) continue;
             const size_t item = spec.path.find("[].");
@@ -300,6 +305,7 @@ Scene Scene::parse(const std::string& yaml, const std::string& displayName, cons
         }
         loader.walkMap(root, "", {displayName, true, true});
     }
+    loader.fillListDefaults();
     for (const std::string& o : overrides) loader.applyOverride(o);
     loader.fillDefaults();
     return scene;

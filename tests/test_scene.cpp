@@ -158,3 +158,64 @@ TEST(Schema, ReferencePageIsUpToDate) {
     EXPECT_EQ(committed, Schema::scene().markdown())
         << "docs/scene-reference.md is stale: regenerate it with 'hairpipe help scene > docs/scene-reference.md'";
 }
+
+#include "pipeline/view_settings.h"
+
+TEST(SceneLists, DefaultListAndItemDefaults) {
+    const Scene s = Scene::parse("", "shot.yaml", ".");
+    ASSERT_EQ(s.count("render.lights"), 1u);
+    EXPECT_EQ(s.text("render.lights[0].type"), "directional");
+    EXPECT_EQ(s.number("render.lights[0].intensity"), 3.0);
+}
+
+TEST(SceneLists, ItemsFromFileGetDefaultsAndLocations) {
+    const Scene s = Scene::parse("render:\n  lights:\n    - type: point\n      position: [0, 2, 0]\n    - intensity: 7\n",
+                                 "shot.yaml", ".");
+    ASSERT_EQ(s.count("render.lights"), 2u);
+    EXPECT_EQ(s.text("render.lights[0].type"), "point");
+    EXPECT_EQ(s.text("render.lights[1].type"), "directional") << "item keys take their defaults";
+    EXPECT_EQ(s.number("render.lights[1].intensity"), 7.0);
+    EXPECT_EQ(s.where("render.lights[1].intensity").line, 5);
+}
+
+TEST(SceneLists, ItemErrorsNameTheIndex) {
+    const SceneError e = parseError("render:\n  lights:\n    - type: spot\n");
+    EXPECT_EQ(e.key(), "render.lights[0].type");
+    EXPECT_EQ(e.where().line, 3);
+    EXPECT_NE(e.detail().find("expected one of directional, point"), std::string::npos) << e.what();
+    const SceneError notMap = parseError("render:\n  lights: [3]\n");
+    EXPECT_EQ(notMap.key(), "render.lights[0]");
+}
+
+TEST(SceneLists, SetOverridesItemsAndWholeLists) {
+    const Scene a = Scene::parse("", "shot.yaml", ".", {"render.lights[0].intensity=5"});
+    EXPECT_EQ(a.number("render.lights[0].intensity"), 5.0);
+    const Scene b = Scene::parse("", "shot.yaml", ".", {"render.lights=[{type: point}, {type: point}]"});
+    EXPECT_EQ(b.count("render.lights"), 2u);
+    EXPECT_EQ(b.text("render.lights[1].type"), "point");
+    const SceneError e = parseError("", {"render.lights[3].intensity=1"});
+    EXPECT_NE(e.detail().find("has only 1 items"), std::string::npos) << e.what();
+}
+
+TEST(SceneLists, TooManyItems) {
+    std::string yaml = "render:\n  lights:\n";
+    for (int i = 0; i < 17; ++i) yaml += "    - {type: point}\n";
+    const SceneError e = parseError(yaml);
+    EXPECT_NE(e.detail().find("at most 16"), std::string::npos) << e.what();
+}
+
+TEST(ViewSettings, MapsKeysAndChecksAcrossThem) {
+    const Scene s = Scene::parse("render:\n  camera: {width: 320, height: 240, fov: 30}\n", "shot.yaml", ".");
+    const View v = makeView(s);
+    EXPECT_EQ(v.camera.width, 320);
+    EXPECT_EQ(v.camera.fovY, 30.f);
+    ASSERT_EQ(v.lights.size(), 1u);
+    EXPECT_TRUE(v.lights[0].direction.isApprox(Vec3f(-1, -1, -1)));
+    const Scene bad = Scene::parse("render:\n  camera: {position: [0, 0, 0]}\n", "shot.yaml", ".");
+    try {
+        makeView(bad);
+        FAIL();
+    } catch (const SceneError& e) {
+        EXPECT_EQ(e.key(), "render.camera.target");
+    }
+}

@@ -1,0 +1,45 @@
+// render.*: camera, lights and materials shared by the preview (GL) and the
+// reference (Embree), so both render the same shot (see render/view.h).
+#include "pipeline/scene_keys.h"
+
+namespace hp {
+
+void addRenderKeys(SchemaBuilder& b) {
+    b.section("render", "The shot's look, shared by the preview and the reference renderer.");
+    b.section("render.camera", "A perspective camera (right-handed, Y up).")
+        .vec3("render.camera.position", 0, 0.05, 0.9, "m", "Camera position.")
+        .vec3("render.camera.target", 0, 0, 0, "m", "Point the camera looks at.")
+        .vec3("render.camera.up", 0, 1, 0, "", "Up direction.")
+        .number("render.camera.fov", 40, 1, 170, "deg", "Vertical field of view.")
+        .integer("render.camera.width", 1920, 16, 16384, "px", "Image width.")
+        .integer("render.camera.height", 1080, 16, 16384, "px", "Image height.")
+        .number("render.camera.near", 0.01, 1e-5, 1e3, "m", "Near clipping distance (preview depth range).")
+        .number("render.camera.far", 100, 1e-3, 1e6, "m", "Far clipping distance (preview depth range).");
+    b.section("render.lights", "Lights, a list of maps; the default is the benchmark's single directional light.")
+        .list("render.lights", "[{type: directional, direction: [-1, -1, -1], intensity: 3}]", 16,
+              "Lights of the shot.")
+        .choice("render.lights[].type", "directional", {"directional", "point"}, "Kind of light.")
+        .vec3("render.lights[].direction", -1, -1, -1, "", "Directional: the way the light travels.")
+        .vec3("render.lights[].position", 0, 1, 1, "m", "Point: position.")
+        .vec3("render.lights[].color", 1, 1, 1, "", "Linear RGB colour.")
+        .number("render.lights[].intensity", 3, 0, 1e6, "",
+                "Directional: radiance scale; point: intensity (falls off with distance squared).");
+    b.vec3("render.environment", 0, 0, 0, "", "Constant environment radiance (linear RGB); black by default.");
+    b.section("render.hair", "Kajiya-Kay hair material (seed 004): diffuse kd·sin(t,l), specular ks·sin(t,h)^shininess.")
+        .vec3("render.hair.color", 0.35, 0.22, 0.12, "", "Diffuse albedo (linear RGB).")
+        .vec3("render.hair.specular_color", 1, 1, 1, "", "Specular colour (linear RGB).")
+        .number("render.hair.kd", 0.6, 0, 10, "", "Diffuse weight.")
+        .number("render.hair.ks", 0.3, 0, 10, "", "Specular weight.")
+        .number("render.hair.shininess", 80, 1, 10000, "", "Specular exponent.")
+        .flag("render.hair.two_lobes", false, "Add a second, shifted-tangent specular lobe (Scheuermann 2004).")
+        .number("render.hair.primary_shift", 0, -1, 1, "", "Tangent shift of the first lobe along the normal.")
+        .number("render.hair.secondary_shift", -0.1, -1, 1, "", "Tangent shift of the second lobe.")
+        .number("render.hair.secondary_ks", 0.15, 0, 10, "", "Weight of the second lobe.")
+        .number("render.hair.secondary_shininess", 20, 1, 10000, "", "Exponent of the second lobe.")
+        .vec3("render.hair.secondary_color", 0.6, 0.45, 0.3, "", "Colour of the second lobe.");
+    b.section("render.head", "The opaque head's simple lit material.")
+        .vec3("render.head.color", 0.75, 0.6, 0.5, "", "Diffuse albedo (linear RGB).")
+        .number("render.head.ambient", 0.05, 0, 1, "", "Ambient term.");
+}
+
+}  // namespace hp

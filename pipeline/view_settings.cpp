@@ -1,0 +1,54 @@
+#include "pipeline/view_settings.h"
+
+namespace hp {
+
+View makeView(const Scene& s) {
+    View v;
+    Camera& c = v.camera;
+    c.position = s.vec3f("render.camera.position");
+    c.target = s.vec3f("render.camera.target");
+    c.up = s.vec3f("render.camera.up");
+    c.fovY = float(s.number("render.camera.fov"));
+    c.width = int(s.integer("render.camera.width"));
+    c.height = int(s.integer("render.camera.height"));
+    c.nearClip = float(s.number("render.camera.near"));
+    c.farClip = float(s.number("render.camera.far"));
+    if ((c.target - c.position).norm() < 1e-6f) s.fail("render.camera.target", "must differ from the camera position");
+    if ((c.target - c.position).normalized().cross(c.up).norm() < 1e-4f)
+        s.fail("render.camera.up", "must not be parallel to the viewing direction");
+    if (c.farClip <= c.nearClip) s.fail("render.camera.far", "must be greater than render.camera.near");
+
+    v.lights.clear();
+    for (size_t i = 0; i < s.count("render.lights"); ++i) {
+        const std::string k = cat("render.lights[", i, "].");
+        Light l;
+        l.type = s.text(k + "type") == "point" ? LightType::Point : LightType::Directional;
+        l.direction = s.vec3f(k + "direction");
+        l.position = s.vec3f(k + "position");
+        l.color = s.vec3f(k + "color");
+        l.intensity = float(s.number(k + "intensity"));
+        if (l.type == LightType::Directional && l.direction.norm() < 1e-6f)
+            s.fail(k + "direction", "a directional light needs a non-zero direction");
+        v.lights.push_back(l);
+    }
+    v.environment = s.vec3f("render.environment");
+
+    HairMaterial& h = v.hair;
+    h.color = s.vec3f("render.hair.color");
+    h.specularColor = s.vec3f("render.hair.specular_color");
+    h.kd = float(s.number("render.hair.kd"));
+    h.ks = float(s.number("render.hair.ks"));
+    h.shininess = float(s.number("render.hair.shininess"));
+    h.twoLobes = s.flag("render.hair.two_lobes");
+    h.primaryShift = float(s.number("render.hair.primary_shift"));
+    h.secondaryShift = float(s.number("render.hair.secondary_shift"));
+    h.secondaryKs = float(s.number("render.hair.secondary_ks"));
+    h.secondaryShininess = float(s.number("render.hair.secondary_shininess"));
+    h.secondaryColor = s.vec3f("render.hair.secondary_color");
+
+    v.head.color = s.vec3f("render.head.color");
+    v.head.ambient = float(s.number("render.head.ambient"));
+    return v;
+}
+
+}  // namespace hp
