@@ -111,3 +111,24 @@ TEST(Fibonacci, CapAroundAnotherAxis) {
     ASSERT_EQ(pts.size(), 100u);
     for (const Vec3f& p : pts) EXPECT_GE(p.z(), 0.5f - 1e-5f);
 }
+
+#include "sim/synthetic.h"
+
+TEST(SyntheticHair, StrandsHaveTheRequestedShape) {
+    SyntheticHairSettings s;
+    s.strands = 200;
+    const StrandFrame f = makeSyntheticHair(s);
+    ASSERT_EQ(f.strandCount(), 200u);
+    EXPECT_NO_THROW(f.validate());
+    for (size_t i = 0; i < f.strandCount(); ++i) {
+        float length = 0.f;
+        for (uint32_t v = f.first(i) + 1; v < f.first(i) + f.vertexCount(i); ++v) {
+            length += (f.positions[v] - f.positions[v - 1]).norm();
+            EXPECT_GE(f.positions[v].norm(), s.headRadius) << "outside the head";
+        }
+        EXPECT_NEAR(length, s.length, 0.02f * s.length);
+        EXPECT_NEAR(f.positions[f.first(i)].norm(), s.headRadius, 1e-6f);
+        EXPECT_FLOAT_EQ(f.radii[f.first(i)], s.rootRadius);
+        EXPECT_FLOAT_EQ(f.radii[f.first(i) + f.vertexCount(i) - 1], s.tipRadius);
+    }
+}
