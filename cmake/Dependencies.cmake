@@ -2,6 +2,7 @@
 # "Dependencies"); nothing is vendored or downloaded. Facts behind the
 # workarounds below are in ../shared/STACK.md of the development workspace.
 find_package(PkgConfig REQUIRED)
+find_package(ZLIB REQUIRED)
 
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(TBB REQUIRED)
