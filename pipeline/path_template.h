@@ -15,3 +15,12 @@ bool hasFrameToken(const std::string& pattern);
 std::string expandFrame(const std::string& pattern, int frame);
 
 }  // namespace hp
+
+namespace hp {
+
+/// If `fileName` is `pattern` with its frame token replaced by a frame number
+/// (any number of digits, at least the padding, optionally negative), stores
+/// the frame and returns true. Compares names only, not folders.
+bool matchFrame(const std::string& pattern, const std::string& fileName, int* frame);
+
+}  // namespace hp

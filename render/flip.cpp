@@ -1,0 +1,231 @@
+#include "render/flip.h"
+
+#include "core/errors.h"
+
+#include <Eigen/Dense>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace hp {
+
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+// Constants of the paper (section 4): colour and feature exponents, the
+// error redistribution breakpoints, and the feature detector's width.
+constexpr double kQc = 0.7;
+constexpr double kPc = 0.4;
+constexpr double kPt = 0.95;
+constexpr double kQf = 0.5;
+constexpr double kFeatureWidthDegrees = 0.082;
+constexpr double kPi = 3.14159265358979323846;
+
+/// Linear sRGB (D65) ↔ CIE XYZ, and the reference white: XYZ of RGB (1, 1, 1),
+/// so that white maps to Y' = 100, Cx = Cz = 0 and L* = 100, a* = b* = 0.
+struct ColourSpace {
+    Matrix3d rgbToXyz;
+    Matrix3d xyzToRgb;
+    Vector3d white;
+    ColourSpace() {
+        rgbToXyz << 0.4124564, 0.3575761, 0.1804375,  //
+            0.2126729, 0.7151522, 0.0721750,          //
+            0.0193339, 0.1191920, 0.9503041;
+        xyzToRgb = rgbToXyz.inverse();
+        white = rgbToXyz * Vector3d::Ones();
+    }
+};
+
+const ColourSpace& space() {
+    static const ColourSpace s;
+    return s;
+}
+
+Vector3d rgbToYcxcz(const Vector3d& rgb) {
+    const Vector3d n = (space().rgbToXyz * rgb).cwiseQuotient(space().white);
+    return {116.0 * n.y() - 16.0, 500.0 * (n.x() - n.y()), 200.0 * (n.y() - n.z())};
+}
+
+Vector3d ycxczToRgb(const Vector3d& v) {
+    const double ny = (v[0] + 16.0) / 116.0;
+    const Vector3d n(ny + v[1] / 500.0, ny, ny - v[2] / 200.0);
+    return space().xyzToRgb * n.cwiseProduct(space().white);
+}
+
+/// CIELAB of a linear RGB colour with the Hunt adjustment (a, b scaled by 0.01·L).
+Vector3d rgbToHuntLab(const Vector3d& rgb) {
+    const Vector3d n = (space().rgbToXyz * rgb).cwiseQuotient(space().white);
+    constexpr double d = 6.0 / 29.0;
+    auto f = [](double t) { return t > d * d * d ? std::cbrt(t) : t / (3.0 * d * d) + 4.0 / 29.0; };
+    const double fx = f(n.x()), fy = f(n.y()), fz = f(n.z());
+    const double L = 116.0 * fy - 16.0;
+    return {L, 0.01 * L * 500.0 * (fx - fy), 0.01 * L * 200.0 * (fy - fz)};
+}
+
+double hyab(const Vector3d& p, const Vector3d& q) {
+    return std::abs(p[0] - q[0]) + std::hypot(p[1] - q[1], p[2] - q[2]);
+}
+
+/// Maps the exponentiated HyAB distance to [0, 1] (paper eq. 5).
+double redistribute(double e, double cmax) {
+    const double knee = kPc * cmax;
+    return e < knee ? kPt / knee * e : kPt + (e - knee) / (cmax - knee) * (1.0 - kPt);
+}
+
+/// One Gaussian term a·sqrt(π/b)·exp(−π²r²/b) of a contrast sensitivity function.
+struct CsfTerm {
+    double a, b;
+};
+
+/// A 2-D filter that is a weighted sum of separable Gaussians.
+struct GaussianSum {
+    std::vector<std::pair<float, Kernel>> terms;  ///< (weight, normalised 1-D kernel)
+
+    Plane apply(const Plane& in) const {
+        Plane out(in.width, in.height);
+        for (const auto& [weight, k] : terms) {
+            const Plane part = convolveSeparable(in, k, k);
+            for (size_t i = 0; i < out.size(); ++i) out.data[i] += weight * part.data[i];
+        }
+        return out;
+    }
+};
+
+/// The sampled CSF filter of one channel, normalised to sum 1. Each 2-D
+/// Gaussian factorises into 1-D ones, so the filter is a weighted sum of
+/// separable passes; the weights are the terms' sampled 2-D sums.
+GaussianSum csfFilter(std::initializer_list<CsfTerm> terms, double ppd, int radius) {
+    const double dx = 1.0 / ppd;  // degrees per pixel
+    GaussianSum filter;
+    std::vector<double> mass;
+    for (const CsfTerm& t : terms) {
+        Kernel k(size_t(2 * radius + 1));
+        double sum = 0;
+        for (int i = -radius; i <= radius; ++i) sum += std::exp(-kPi * kPi * (i * dx) * (i * dx) / t.b);
+        for (int i = -radius; i <= radius; ++i)
+            k[size_t(i + radius)] = float(std::exp(-kPi * kPi * (i * dx) * (i * dx) / t.b) / sum);
+        mass.push_back(t.a * std::sqrt(kPi / t.b) * sum * sum);
+        filter.terms.emplace_back(0.f, std::move(k));
+    }
+    double total = 0;
+    for (double m : mass) total += m;
+    for (size_t i = 0; i < mass.size(); ++i) filter.terms[i].first = float(mass[i] / total);
+    return filter;
+}
+
+/// 1-D Gaussian derivative kernels of the feature detector: derivative of
+/// order 1 (edges) or 2 (points), positive weights summing to 1 and negative
+/// ones to −1, so a unit step gives a peak response of 1.
+Kernel featureKernel(double sigma, int radius, int order) {
+    Kernel k(size_t(2 * radius + 1));
+    double pos = 0, neg = 0;
+    for (int i = -radius; i <= radius; ++i) {
+        const double g = std::exp(-0.5 * i * i / (sigma * sigma));
+        const double v = order == 1 ? -i * g : (i * i / (sigma * sigma) - 1.0) * g;
+        k[size_t(i + radius)] = float(v);
+        (v > 0 ? pos : neg) += v;
+    }
+    for (float& v : k) v = float(v > 0 ? v / pos : v / -neg);
+    return k;
+}
+
+/// Edge and point strength (gradient magnitudes of the 1st and 2nd derivative filters).
+struct Features {
+    Plane edges, points;
+};
+
+Features detectFeatures(const Plane& lum, double ppd) {
+    const double sigma = 0.5 * kFeatureWidthDegrees * ppd;
+    const int radius = int(std::ceil(3.0 * sigma));
+    const Kernel g = gaussianKernel(sigma, radius);
+    const Kernel d1 = featureKernel(sigma, radius, 1);
+    const Kernel d2 = featureKernel(sigma, radius, 2);
+    // 2-D kernels d(x)·g(y) and g(x)·d(y): three horizontal passes shared by four vertical ones.
+    const Plane rowG = convolveRows(lum, g);
+    const Plane ex = convolveColumns(convolveRows(lum, d1), g);
+    const Plane ey = convolveColumns(rowG, d1);
+    const Plane px = convolveColumns(convolveRows(lum, d2), g);
+    const Plane py = convolveColumns(rowG, d2);
+    Features f{Plane(lum.width, lum.height), Plane(lum.width, lum.height)};
+    tbb::parallel_for(size_t(0), lum.size(), [&](size_t i) {
+        f.edges.data[i] = std::hypot(ex.data[i], ey.data[i]);
+        f.points.data[i] = std::hypot(px.data[i], py.data[i]);
+    });
+    return f;
+}
+
+/// Hunt-adjusted CIELAB planes of the CSF-filtered image, and its unfiltered luminance Y/Yn.
+struct Prepared {
+    Plane L, A, B, lum;
+};
+
+Prepared prepare(const RgbPlanes& img, double ppd) {
+    const int w = img.width(), h = img.height();
+    const size_t n = size_t(w) * size_t(h);
+    Plane y(w, h), cx(w, h), cz(w, h);
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+        const Vector3d v = rgbToYcxcz({img.r.data[i], img.g.data[i], img.b.data[i]});
+        y.data[i] = float(v[0]);
+        cx.data[i] = float(v[1]);
+        cz.data[i] = float(v[2]);
+    });
+    // One radius for all three filters, from the widest Gaussian (b = 0.04).
+    const int radius = int(std::ceil(3.0 * std::sqrt(0.04 / (2.0 * kPi * kPi)) * ppd));
+    const Plane yf = csfFilter({{1.0, 0.0047}}, ppd, radius).apply(y);
+    const Plane cxf = csfFilter({{1.0, 0.0053}}, ppd, radius).apply(cx);
+    const Plane czf = csfFilter({{34.1, 0.04}, {13.5, 0.025}}, ppd, radius).apply(cz);
+    Prepared p{Plane(w, h), Plane(w, h), Plane(w, h), Plane(w, h)};
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+        const Vector3d rgb = ycxczToRgb({yf.data[i], cxf.data[i], czf.data[i]}).cwiseMax(0.0).cwiseMin(1.0);
+        const Vector3d lab = rgbToHuntLab(rgb);
+        p.L.data[i] = float(lab[0]);
+        p.A.data[i] = float(lab[1]);
+        p.B.data[i] = float(lab[2]);
+        p.lum.data[i] = (y.data[i] + 16.f) / 116.f;
+    });
+    return p;
+}
+
+void checkSame(const Plane& a, const Plane& b, const char* what) {
+    if (a.width != b.width || a.height != b.height || a.size() != b.size())
+        throw Error(cat("flip: ", what, " sizes differ (", a.width, "x", a.height, " vs ", b.width, "x", b.height, ")"));
+}
+
+}  // namespace
+
+double pixelsPerDegree(double distanceMetres, double widthMetres, int pixelsX) {
+    return distanceMetres * (pixelsX / widthMetres) * kPi / 180.0;
+}
+
+Plane flipErrorMap(const RgbPlanes& reference, const RgbPlanes& test, const FlipSettings& settings) {
+    const double ppd = settings.pixelsPerDegree;
+    if (!(ppd > 0) || !std::isfinite(ppd)) throw Error(cat("flip: pixels per degree must be positive, got ", ppd));
+    for (const RgbPlanes* img : {&reference, &test}) {
+        checkSame(img->r, img->g, "channel");
+        checkSame(img->r, img->b, "channel");
+    }
+    checkSame(reference.r, test.r, "image");
+    const Prepared ref = prepare(reference, ppd);
+    const Prepared tst = prepare(test, ppd);
+    const Features fr = detectFeatures(ref.lum, ppd);
+    const Features ft = detectFeatures(tst.lum, ppd);
+
+    const double cmax = std::pow(hyab(rgbToHuntLab({0, 1, 0}), rgbToHuntLab({0, 0, 1})), kQc);
+    Plane out(reference.width(), reference.height());
+    tbb::parallel_for(size_t(0), out.size(), [&](size_t i) {
+        const double dc = hyab({ref.L.data[i], ref.A.data[i], ref.B.data[i]},
+                               {tst.L.data[i], tst.A.data[i], tst.B.data[i]});
+        const double ec = redistribute(std::pow(dc, kQc), cmax);
+        const double df = std::max(std::abs(fr.edges.data[i] - ft.edges.data[i]),
+                                   std::abs(fr.points.data[i] - ft.points.data[i]));
+        const double ef = std::min(1.0, std::pow(df / std::sqrt(2.0), kQf));
+        out.data[i] = float(std::pow(ec, 1.0 - ef));
+    });
+    return out;
+}
+
+}  // namespace hp
