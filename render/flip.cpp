@@ -7,36 +7,42 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <utility>
 
 namespace hp {
 
 namespace {
 
-using Eigen::Matrix3d;
-using Eigen::Vector3d;
+using Eigen::Matrix3f;
+using Eigen::Vector3f;
 
 // Constants of the paper (section 4): colour and feature exponents, the
 // error redistribution breakpoints, and the feature detector's width.
-constexpr double kQc = 0.7;
-constexpr double kPc = 0.4;
-constexpr double kPt = 0.95;
-constexpr double kQf = 0.5;
+constexpr float kQc = 0.7f;
+constexpr float kPc = 0.4f;
+constexpr float kPt = 0.95f;
+constexpr float kQf = 0.5f;
 constexpr double kFeatureWidthDegrees = 0.082;
 constexpr double kPi = 3.14159265358979323846;
 
 /// Linear sRGB (D65) ↔ CIE XYZ, and the reference white: XYZ of RGB (1, 1, 1),
 /// so that white maps to Y' = 100, Cx = Cz = 0 and L* = 100, a* = b* = 0.
 struct ColourSpace {
-    Matrix3d rgbToXyz;
-    Matrix3d xyzToRgb;
-    Vector3d white;
+    Matrix3f rgbToXyz;
+    Matrix3f xyzToRgb;
+    Vector3f white;
+    Vector3f invWhite;
     ColourSpace() {
-        rgbToXyz << 0.4124564, 0.3575761, 0.1804375,  //
-            0.2126729, 0.7151522, 0.0721750,          //
+        Eigen::Matrix3d m;
+        m << 0.4124564, 0.3575761, 0.1804375,  //
+            0.2126729, 0.7151522, 0.0721750,   //
             0.0193339, 0.1191920, 0.9503041;
-        xyzToRgb = rgbToXyz.inverse();
-        white = rgbToXyz * Vector3d::Ones();
+        rgbToXyz = m.cast<float>();
+        xyzToRgb = m.inverse().cast<float>();
+        white = (m * Eigen::Vector3d::Ones()).cast<float>();
+        invWhite = white.cwiseInverse();
     }
 };
 
@@ -45,35 +51,53 @@ const ColourSpace& space() {
     return s;
 }
 
-Vector3d rgbToYcxcz(const Vector3d& rgb) {
-    const Vector3d n = (space().rgbToXyz * rgb).cwiseQuotient(space().white);
-    return {116.0 * n.y() - 16.0, 500.0 * (n.x() - n.y()), 200.0 * (n.y() - n.z())};
+Vector3f rgbToYcxcz(const Vector3f& rgb) {
+    const Vector3f n = (space().rgbToXyz * rgb).cwiseProduct(space().invWhite);
+    return {116.f * n.y() - 16.f, 500.f * (n.x() - n.y()), 200.f * (n.y() - n.z())};
 }
 
-Vector3d ycxczToRgb(const Vector3d& v) {
-    const double ny = (v[0] + 16.0) / 116.0;
-    const Vector3d n(ny + v[1] / 500.0, ny, ny - v[2] / 200.0);
+Vector3f ycxczToRgb(const Vector3f& v) {
+    const float ny = (v[0] + 16.f) / 116.f;
+    const Vector3f n(ny + v[1] / 500.f, ny, ny - v[2] / 200.f);
     return space().xyzToRgb * n.cwiseProduct(space().white);
 }
 
-/// CIELAB of a linear RGB colour with the Hunt adjustment (a, b scaled by 0.01·L).
-Vector3d rgbToHuntLab(const Vector3d& rgb) {
-    const Vector3d n = (space().rgbToXyz * rgb).cwiseQuotient(space().white);
-    constexpr double d = 6.0 / 29.0;
-    auto f = [](double t) { return t > d * d * d ? std::cbrt(t) : t / (3.0 * d * d) + 4.0 / 29.0; };
-    const double fx = f(n.x()), fy = f(n.y()), fz = f(n.z());
-    const double L = 116.0 * fy - 16.0;
-    return {L, 0.01 * L * 500.0 * (fx - fy), 0.01 * L * 200.0 * (fy - fz)};
+/// Cube root of t > 0: a bit-level first guess (within 3.5%) refined by two
+/// Halley steps x ← x(x³ + 2t)/(2x³ + t) (cubic convergence; relative error
+/// < 3e-7 over CIELAB's range), several times faster than std::cbrt, and
+/// CIELAB needs three per pixel of both images.
+float cubeRoot(float t) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &t, sizeof bits);
+    bits = bits / 3 + 709921077u;  // divides the exponent by 3
+    float x;
+    std::memcpy(&x, &bits, sizeof x);
+    for (int i = 0; i < 2; ++i) {
+        const float x3 = x * x * x;
+        x *= (x3 + 2.f * t) / (2.f * x3 + t);
+    }
+    return x;
 }
 
-double hyab(const Vector3d& p, const Vector3d& q) {
-    return std::abs(p[0] - q[0]) + std::hypot(p[1] - q[1], p[2] - q[2]);
+/// CIELAB of a linear RGB colour with the Hunt adjustment (a, b scaled by 0.01·L).
+Vector3f rgbToHuntLab(const Vector3f& rgb) {
+    const Vector3f n = (space().rgbToXyz * rgb).cwiseProduct(space().invWhite);
+    constexpr float d = 6.f / 29.f;
+    auto f = [](float t) { return t > d * d * d ? cubeRoot(t) : t / (3.f * d * d) + 4.f / 29.f; };
+    const float fx = f(n.x()), fy = f(n.y()), fz = f(n.z());
+    const float L = 116.f * fy - 16.f;
+    return {L, 0.01f * L * 500.f * (fx - fy), 0.01f * L * 200.f * (fy - fz)};
+}
+
+float hyab(const Vector3f& p, const Vector3f& q) {
+    const float da = p[1] - q[1], db = p[2] - q[2];
+    return std::abs(p[0] - q[0]) + std::sqrt(da * da + db * db);
 }
 
 /// Maps the exponentiated HyAB distance to [0, 1] (paper eq. 5).
-double redistribute(double e, double cmax) {
-    const double knee = kPc * cmax;
-    return e < knee ? kPt / knee * e : kPt + (e - knee) / (cmax - knee) * (1.0 - kPt);
+float redistribute(float e, float cmax) {
+    const float knee = kPc * cmax;
+    return e < knee ? kPt / knee * e : kPt + (e - knee) / (cmax - knee) * (1.f - kPt);
 }
 
 /// One Gaussian term a·sqrt(π/b)·exp(−π²r²/b) of a contrast sensitivity function.
@@ -152,8 +176,8 @@ Features detectFeatures(const Plane& lum, double ppd) {
     const Plane py = convolveColumns(rowG, d2);
     Features f{Plane(lum.width, lum.height), Plane(lum.width, lum.height)};
     tbb::parallel_for(size_t(0), lum.size(), [&](size_t i) {
-        f.edges.data[i] = std::hypot(ex.data[i], ey.data[i]);
-        f.points.data[i] = std::hypot(px.data[i], py.data[i]);
+        f.edges.data[i] = std::sqrt(ex.data[i] * ex.data[i] + ey.data[i] * ey.data[i]);
+        f.points.data[i] = std::sqrt(px.data[i] * px.data[i] + py.data[i] * py.data[i]);
     });
     return f;
 }
@@ -168,10 +192,10 @@ Prepared prepare(const RgbPlanes& img, double ppd) {
     const size_t n = size_t(w) * size_t(h);
     Plane y(w, h), cx(w, h), cz(w, h);
     tbb::parallel_for(size_t(0), n, [&](size_t i) {
-        const Vector3d v = rgbToYcxcz({img.r.data[i], img.g.data[i], img.b.data[i]});
-        y.data[i] = float(v[0]);
-        cx.data[i] = float(v[1]);
-        cz.data[i] = float(v[2]);
+        const Vector3f v = rgbToYcxcz({img.r.data[i], img.g.data[i], img.b.data[i]});
+        y.data[i] = v[0];
+        cx.data[i] = v[1];
+        cz.data[i] = v[2];
     });
     // One radius for all three filters, from the widest Gaussian (b = 0.04).
     const int radius = int(std::ceil(3.0 * std::sqrt(0.04 / (2.0 * kPi * kPi)) * ppd));
@@ -180,11 +204,11 @@ Prepared prepare(const RgbPlanes& img, double ppd) {
     const Plane czf = csfFilter({{34.1, 0.04}, {13.5, 0.025}}, ppd, radius).apply(cz);
     Prepared p{Plane(w, h), Plane(w, h), Plane(w, h), Plane(w, h)};
     tbb::parallel_for(size_t(0), n, [&](size_t i) {
-        const Vector3d rgb = ycxczToRgb({yf.data[i], cxf.data[i], czf.data[i]}).cwiseMax(0.0).cwiseMin(1.0);
-        const Vector3d lab = rgbToHuntLab(rgb);
-        p.L.data[i] = float(lab[0]);
-        p.A.data[i] = float(lab[1]);
-        p.B.data[i] = float(lab[2]);
+        const Vector3f rgb = ycxczToRgb({yf.data[i], cxf.data[i], czf.data[i]}).cwiseMax(0.f).cwiseMin(1.f);
+        const Vector3f lab = rgbToHuntLab(rgb);
+        p.L.data[i] = lab[0];
+        p.A.data[i] = lab[1];
+        p.B.data[i] = lab[2];
         p.lum.data[i] = (y.data[i] + 16.f) / 116.f;
     });
     return p;
@@ -214,16 +238,16 @@ Plane flipErrorMap(const RgbPlanes& reference, const RgbPlanes& test, const Flip
     const Features fr = detectFeatures(ref.lum, ppd);
     const Features ft = detectFeatures(tst.lum, ppd);
 
-    const double cmax = std::pow(hyab(rgbToHuntLab({0, 1, 0}), rgbToHuntLab({0, 0, 1})), kQc);
+    const float cmax = std::pow(hyab(rgbToHuntLab({0, 1, 0}), rgbToHuntLab({0, 0, 1})), kQc);
     Plane out(reference.width(), reference.height());
     tbb::parallel_for(size_t(0), out.size(), [&](size_t i) {
-        const double dc = hyab({ref.L.data[i], ref.A.data[i], ref.B.data[i]},
-                               {tst.L.data[i], tst.A.data[i], tst.B.data[i]});
-        const double ec = redistribute(std::pow(dc, kQc), cmax);
-        const double df = std::max(std::abs(fr.edges.data[i] - ft.edges.data[i]),
-                                   std::abs(fr.points.data[i] - ft.points.data[i]));
-        const double ef = std::min(1.0, std::pow(df / std::sqrt(2.0), kQf));
-        out.data[i] = float(std::pow(ec, 1.0 - ef));
+        const float dc = hyab({ref.L.data[i], ref.A.data[i], ref.B.data[i]}, {tst.L.data[i], tst.A.data[i], tst.B.data[i]});
+        const float ec = redistribute(std::pow(dc, kQc), cmax);
+        const float df = std::max(std::abs(fr.edges.data[i] - ft.edges.data[i]),
+                                  std::abs(fr.points.data[i] - ft.points.data[i]));
+        static_assert(kQf == 0.5f, "the feature exponent q_f = 0.5 is a square root");
+        const float ef = std::min(1.f, std::sqrt(df / std::sqrt(2.f)));
+        out.data[i] = std::pow(ec, 1.f - ef);
     });
     return out;
 }
