@@ -62,9 +62,11 @@ void printTable(const std::vector<FrameRecord>& records) {
 
 int runCompare(const CommandLine& cl) {
     std::unique_ptr<tbb::global_control> threads;
-    if (cl.has("--threads"))
-        threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                        size_t(numberOption(cl, "--threads", 1, 1024)));
+    if (cl.has("--threads")) {
+        const double n = numberOption(cl, "--threads", 1, 1024);
+        if (n != std::floor(n)) throw UsageError("option --threads expects an integer, got '" + cl.value("--threads") + "'");
+        threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(n));
+    }
     CompareJob job;
     std::vector<int> frames;
     if (cl.has("--scene")) {

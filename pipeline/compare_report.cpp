@@ -170,10 +170,11 @@ td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}td.l,th.l{text-alig
 svg.plot text{font-size:11px;fill:#444}svg.plot .axis{stroke:#888}svg.plot .series{fill:none;stroke:#3949ab;stroke-width:1.5}
 svg.plot .threshold{stroke:#c62828;stroke-dasharray:5 4}svg.plot circle.ok{fill:#3949ab;cursor:pointer}
 svg.plot circle.bad{fill:#c62828;cursor:pointer}.viewer{background:#222;color:#eee;padding:10px;border-radius:4px}
-.panels{display:flex;flex-wrap:wrap;gap:8px}.panels figure{margin:0}.panels img{display:block;max-width:100%}
-.panels figcaption{text-align:center;font-size:12px}.missing{width:200px;height:110px;display:flex;
+.panels{display:grid;grid-template-columns:repeat(4,minmax(0,1fr));gap:8px}.panels figure{margin:0}
+.panels img{display:block;width:100%;height:auto}
+.panels figcaption{text-align:center;font-size:12px}.missing{aspect-ratio:16/9;display:flex;
 align-items:center;justify-content:center;border:1px dashed #888}.controls{margin-bottom:8px}
-.controls input[type=range]{width:50%;vertical-align:middle}code{font-size:12px})";
+.controls input[type=range]{width:50%;vertical-align:middle}code{font-size:12px;word-break:break-all})";
 
 // The flip-book and the load-time self-check (see compare_report.h).
 const char* kScript = R"((function(){

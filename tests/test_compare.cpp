@@ -263,7 +263,7 @@ TEST(CompareMask, AveragesOnlyOverPixelsWithAlpha) {
     EXPECT_EQ(hair.flip, 0.0);
 }
 
-TEST(CompareMask, RmseOverTheMaskIsTheRmseOfThoseePixels) {
+TEST(CompareMask, RmseOverTheMaskIsTheRmseOfThosePixels) {
     // Differences only inside the mask: the masked mean squared error is the
     // whole frame's scaled by (all pixels / mask pixels).
     Image a = texture(), b = a;
@@ -469,18 +469,19 @@ TEST(CompareCli, UsageErrorsExitWith1) {
 
 TEST(CompareStage, RunComparesPreviewAgainstReferenceAndGatesOnThresholds) {
     test::TempDir dir;
-    test::writeFile(dir / "shot.yaml", "frames: 1-2\ncompare:\n  enabled: true\n  max_flip: 0.2\n");
+    test::writeFile(dir / "shot.yaml",
+                    "frames: 1-2\noutput:\n  directory: out\ncompare:\n  enabled: true\n  max_flip: 0.2\n");
     writeSequence(dir / "out", "preview/preview.####.exr", {1, 2}, [](int) { return texture(); });
     writeSequence(dir / "out", "reference/reference.####.exr", {1, 2},
                   [](int f) { return withNoise(texture(), 0.01f * f); });
-    test::ProcessResult r = test::runHairpipe("run shot.yaml --out out", dir.path());
+    test::ProcessResult r = test::runHairpipe("run shot.yaml", dir.path());
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_TRUE(fs::exists(dir / "out/compare/report.html"));
     EXPECT_TRUE(fs::exists(dir / "out/compare/flip.0002.png"));
     EXPECT_TRUE(contains(test::readFile(dir / "out/compare/metrics.json"), "\"mask\": \"hair\""));
     // A stricter threshold on the rerun: the frames are already compared (skipped),
     // yet the end-of-run check still reads every frame's metrics and fails the run.
-    r = test::runHairpipe("run shot.yaml --out out --set compare.max_flip=0.02", dir.path());
+    r = test::runHairpipe("run shot.yaml --set compare.max_flip=0.02", dir.path());
     EXPECT_EQ(r.exitCode, 2) << r.output;
     EXPECT_TRUE(contains(r.output, "2 stage outputs already present")) << r.output;
     EXPECT_TRUE(contains(r.output, "compare: 2 of 2 frames fail the comparison thresholds")) << r.output;
@@ -488,10 +489,15 @@ TEST(CompareStage, RunComparesPreviewAgainstReferenceAndGatesOnThresholds) {
     EXPECT_TRUE(contains(test::readFile(dir / "out/compare/report.html"), "FAIL"));
     // A missing reference frame fails that frame of the run.
     fs::remove(dir / "out/reference/reference.0002.exr");
-    r = test::runHairpipe("run shot.yaml --out out --force", dir.path());
+    r = test::runHairpipe("run shot.yaml --force", dir.path());
     EXPECT_EQ(r.exitCode, 2) << r.output;
     EXPECT_TRUE(contains(r.output, "frame 2 compare:")) << r.output;
     EXPECT_TRUE(contains(r.output, "reference.0002.exr: no such file")) << r.output;
+    // `hairpipe compare --scene` re-checks the shot with the scene's templates and thresholds.
+    EXPECT_EQ(test::runHairpipe("compare --scene shot.yaml --frames 1", dir.path()).exitCode, 0);
+    r = test::runHairpipe("compare --scene shot.yaml --frames 1 --max-flip 0.001 --out recheck", dir.path());
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_TRUE(fs::exists(dir / "recheck/report.html"));
 }
 
 TEST(CompareStage, OffByDefaultAndTemplatesAreChecked) {
