@@ -37,9 +37,4 @@ std::string metricsCsv(const std::vector<FrameRecord>& records);
 /// The run as JSON: inputs, settings, thresholds, summary, frames.
 std::string metricsJson(const CompareJob& job, const std::vector<FrameRecord>& records);
 
-/// A number for JSON ("null" when not finite), shortest round-trip form.
-std::string jsonNumber(double v);
-/// A JSON string literal with escapes.
-std::string jsonString(const std::string& s);
-
 }  // namespace hp

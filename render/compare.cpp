@@ -37,7 +37,7 @@ std::array<int, 3> rgbChannels(const Image& image) {
 RgbPlanes displayPlanes(const Image& image) {
     if (image.channelCount() == 0 || image.width <= 0 || image.height <= 0) throw Error("empty image");
     const std::array<int, 3> ch = rgbChannels(image);
-    RgbPlanes p{Plane(image.width, image.height), Plane(image.width, image.height), Plane(image.width, image.height)};
+    RgbPlanes p{ImagePlane(image.width, image.height), ImagePlane(image.width, image.height), ImagePlane(image.width, image.height)};
     const size_t stride = image.channels.size();
     tbb::parallel_for(size_t(0), p.r.size(), [&](size_t i) {
         const float* px = &image.pixels[i * stride];
@@ -52,16 +52,16 @@ float srgbEncode(float v) {
     return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
 }
 
-Plane luma(const RgbPlanes& p) {
-    Plane out(p.width(), p.height());
+ImagePlane luma(const RgbPlanes& p) {
+    ImagePlane out(p.width(), p.height());
     tbb::parallel_for(size_t(0), out.size(), [&](size_t i) {
         out.data[i] = srgbEncode(0.2126f * p.r.data[i] + 0.7152f * p.g.data[i] + 0.0722f * p.b.data[i]);
     });
     return out;
 }
 
-Plane makeMask(const Image& a, const Image& b, MaskMode mode) {
-    Plane mask(a.width, a.height, 1.f);
+ImagePlane makeMask(const Image& a, const Image& b, MaskMode mode) {
+    ImagePlane mask(a.width, a.height, 1.f);
     if (mode == MaskMode::None) return mask;
     const int aa = a.channelIndex("A"), ba = b.channelIndex("A");
     if (aa < 0 && ba < 0) throw Error("the hair mask needs an alpha channel (A), and neither image has one");
@@ -74,7 +74,7 @@ Plane makeMask(const Image& a, const Image& b, MaskMode mode) {
 }
 
 /// Interleaved RGB ImageBuf of the display values, zero outside the mask.
-OIIO::ImageBuf maskedBuffer(const RgbPlanes& p, const Plane& mask) {
+OIIO::ImageBuf maskedBuffer(const RgbPlanes& p, const ImagePlane& mask) {
     OIIO::ImageSpec spec(p.width(), p.height(), 3, OIIO::TypeDesc::FLOAT);
     std::vector<float> rgb(p.r.size() * 3);
     for (size_t i = 0; i < p.r.size(); ++i) {
@@ -88,7 +88,7 @@ OIIO::ImageBuf maskedBuffer(const RgbPlanes& p, const Plane& mask) {
 }
 
 /// Mean of `map` over the mask, summed in a fixed order (thread-count independent).
-double maskedMean(const Plane& map, const Plane& mask, long count) {
+double maskedMean(const ImagePlane& map, const ImagePlane& mask, long count) {
     if (count == 0) return 0.0;
     double sum = 0;
     for (size_t i = 0; i < map.size(); ++i)
@@ -136,7 +136,7 @@ Comparison compareImages(const Image& reference, const Image& test, const Compar
     return c;
 }
 
-Image flipHeatmap(const Plane& flipMap) {
+Image flipHeatmap(const ImagePlane& flipMap) {
     Image out(flipMap.width, flipMap.height, {"R", "G", "B"});
     tbb::parallel_for(size_t(0), flipMap.size(), [&](size_t i) {
         const std::array<float, 3> c = magma(flipMap.data[i]);

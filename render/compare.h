@@ -56,9 +56,9 @@ struct FrameMetrics {
 /// Metrics plus the per-pixel maps behind them.
 struct Comparison {
     FrameMetrics metrics;
-    Plane flipMap;  ///< LDR-FLIP error per pixel, [0, 1]
-    Plane ssimMap;  ///< SSIM per pixel
-    Plane mask;     ///< 1 inside the mask, 0 outside (all 1 for MaskMode::None)
+    ImagePlane flipMap;  ///< LDR-FLIP error per pixel, [0, 1]
+    ImagePlane ssimMap;  ///< SSIM per pixel
+    ImagePlane mask;     ///< 1 inside the mask, 0 outside (all 1 for MaskMode::None)
     Image absDiff;  ///< |a − b| of the display values, channels R, G, B
 };
 
@@ -70,7 +70,7 @@ Comparison compareImages(const Image& reference, const Image& test, const Compar
 
 /// The FLIP error map through the magma colour map, as an sRGB-encoded RGB
 /// image (write it with ImageWriteOptions::srgbFor8Bit = false).
-Image flipHeatmap(const Plane& flipMap);
+Image flipHeatmap(const ImagePlane& flipMap);
 
 /// The display values of an image (R, G, B clamped to [0, 1]), as in the metrics.
 Image displayImage(const Image& image);

@@ -107,12 +107,12 @@ struct CsfTerm {
 
 /// A 2-D filter that is a weighted sum of separable Gaussians.
 struct GaussianSum {
-    std::vector<std::pair<float, Kernel>> terms;  ///< (weight, normalised 1-D kernel)
+    std::vector<std::pair<float, FilterKernel>> terms;  ///< (weight, normalised 1-D kernel)
 
-    Plane apply(const Plane& in) const {
-        Plane out(in.width, in.height);
+    ImagePlane apply(const ImagePlane& in) const {
+        ImagePlane out(in.width, in.height);
         for (const auto& [weight, k] : terms) {
-            const Plane part = convolveSeparable(in, k, k);
+            const ImagePlane part = convolveSeparable(in, k, k);
             for (size_t i = 0; i < out.size(); ++i) out.data[i] += weight * part.data[i];
         }
         return out;
@@ -127,7 +127,7 @@ GaussianSum csfFilter(std::initializer_list<CsfTerm> terms, double ppd, int radi
     GaussianSum filter;
     std::vector<double> mass;
     for (const CsfTerm& t : terms) {
-        Kernel k(size_t(2 * radius + 1));
+        FilterKernel k(size_t(2 * radius + 1));
         double sum = 0;
         for (int i = -radius; i <= radius; ++i) sum += std::exp(-kPi * kPi * (i * dx) * (i * dx) / t.b);
         for (int i = -radius; i <= radius; ++i)
@@ -144,8 +144,8 @@ GaussianSum csfFilter(std::initializer_list<CsfTerm> terms, double ppd, int radi
 /// 1-D Gaussian derivative kernels of the feature detector: derivative of
 /// order 1 (edges) or 2 (points), positive weights summing to 1 and negative
 /// ones to −1, so a unit step gives a peak response of 1.
-Kernel featureKernel(double sigma, int radius, int order) {
-    Kernel k(size_t(2 * radius + 1));
+FilterKernel featureKernel(double sigma, int radius, int order) {
+    FilterKernel k(size_t(2 * radius + 1));
     double pos = 0, neg = 0;
     for (int i = -radius; i <= radius; ++i) {
         const double g = std::exp(-0.5 * i * i / (sigma * sigma));
@@ -159,22 +159,22 @@ Kernel featureKernel(double sigma, int radius, int order) {
 
 /// Edge and point strength (gradient magnitudes of the 1st and 2nd derivative filters).
 struct Features {
-    Plane edges, points;
+    ImagePlane edges, points;
 };
 
-Features detectFeatures(const Plane& lum, double ppd) {
+Features detectFeatures(const ImagePlane& lum, double ppd) {
     const double sigma = 0.5 * kFeatureWidthDegrees * ppd;
     const int radius = int(std::ceil(3.0 * sigma));
-    const Kernel g = gaussianKernel(sigma, radius);
-    const Kernel d1 = featureKernel(sigma, radius, 1);
-    const Kernel d2 = featureKernel(sigma, radius, 2);
+    const FilterKernel g = gaussianKernel(sigma, radius);
+    const FilterKernel d1 = featureKernel(sigma, radius, 1);
+    const FilterKernel d2 = featureKernel(sigma, radius, 2);
     // 2-D kernels d(x)·g(y) and g(x)·d(y): three horizontal passes shared by four vertical ones.
-    const Plane rowG = convolveRows(lum, g);
-    const Plane ex = convolveColumns(convolveRows(lum, d1), g);
-    const Plane ey = convolveColumns(rowG, d1);
-    const Plane px = convolveColumns(convolveRows(lum, d2), g);
-    const Plane py = convolveColumns(rowG, d2);
-    Features f{Plane(lum.width, lum.height), Plane(lum.width, lum.height)};
+    const ImagePlane rowG = convolveRows(lum, g);
+    const ImagePlane ex = convolveColumns(convolveRows(lum, d1), g);
+    const ImagePlane ey = convolveColumns(rowG, d1);
+    const ImagePlane px = convolveColumns(convolveRows(lum, d2), g);
+    const ImagePlane py = convolveColumns(rowG, d2);
+    Features f{ImagePlane(lum.width, lum.height), ImagePlane(lum.width, lum.height)};
     tbb::parallel_for(size_t(0), lum.size(), [&](size_t i) {
         f.edges.data[i] = std::sqrt(ex.data[i] * ex.data[i] + ey.data[i] * ey.data[i]);
         f.points.data[i] = std::sqrt(px.data[i] * px.data[i] + py.data[i] * py.data[i]);
@@ -184,13 +184,13 @@ Features detectFeatures(const Plane& lum, double ppd) {
 
 /// Hunt-adjusted CIELAB planes of the CSF-filtered image, and its unfiltered luminance Y/Yn.
 struct Prepared {
-    Plane L, A, B, lum;
+    ImagePlane L, A, B, lum;
 };
 
 Prepared prepare(const RgbPlanes& img, double ppd) {
     const int w = img.width(), h = img.height();
     const size_t n = size_t(w) * size_t(h);
-    Plane y(w, h), cx(w, h), cz(w, h);
+    ImagePlane y(w, h), cx(w, h), cz(w, h);
     tbb::parallel_for(size_t(0), n, [&](size_t i) {
         const Vector3f v = rgbToYcxcz({img.r.data[i], img.g.data[i], img.b.data[i]});
         y.data[i] = v[0];
@@ -199,10 +199,10 @@ Prepared prepare(const RgbPlanes& img, double ppd) {
     });
     // One radius for all three filters, from the widest Gaussian (b = 0.04).
     const int radius = int(std::ceil(3.0 * std::sqrt(0.04 / (2.0 * kPi * kPi)) * ppd));
-    const Plane yf = csfFilter({{1.0, 0.0047}}, ppd, radius).apply(y);
-    const Plane cxf = csfFilter({{1.0, 0.0053}}, ppd, radius).apply(cx);
-    const Plane czf = csfFilter({{34.1, 0.04}, {13.5, 0.025}}, ppd, radius).apply(cz);
-    Prepared p{Plane(w, h), Plane(w, h), Plane(w, h), Plane(w, h)};
+    const ImagePlane yf = csfFilter({{1.0, 0.0047}}, ppd, radius).apply(y);
+    const ImagePlane cxf = csfFilter({{1.0, 0.0053}}, ppd, radius).apply(cx);
+    const ImagePlane czf = csfFilter({{34.1, 0.04}, {13.5, 0.025}}, ppd, radius).apply(cz);
+    Prepared p{ImagePlane(w, h), ImagePlane(w, h), ImagePlane(w, h), ImagePlane(w, h)};
     tbb::parallel_for(size_t(0), n, [&](size_t i) {
         const Vector3f rgb = ycxczToRgb({yf.data[i], cxf.data[i], czf.data[i]}).cwiseMax(0.f).cwiseMin(1.f);
         const Vector3f lab = rgbToHuntLab(rgb);
@@ -214,7 +214,7 @@ Prepared prepare(const RgbPlanes& img, double ppd) {
     return p;
 }
 
-void checkSame(const Plane& a, const Plane& b, const char* what) {
+void checkSame(const ImagePlane& a, const ImagePlane& b, const char* what) {
     if (a.width != b.width || a.height != b.height || a.size() != b.size())
         throw Error(cat("flip: ", what, " sizes differ (", a.width, "x", a.height, " vs ", b.width, "x", b.height, ")"));
 }
@@ -225,7 +225,7 @@ double pixelsPerDegree(double distanceMetres, double widthMetres, int pixelsX) {
     return distanceMetres * (pixelsX / widthMetres) * kPi / 180.0;
 }
 
-Plane flipErrorMap(const RgbPlanes& reference, const RgbPlanes& test, const FlipSettings& settings) {
+ImagePlane flipErrorMap(const RgbPlanes& reference, const RgbPlanes& test, const FlipSettings& settings) {
     const double ppd = settings.pixelsPerDegree;
     if (!(ppd > 0) || !std::isfinite(ppd)) throw Error(cat("flip: pixels per degree must be positive, got ", ppd));
     for (const RgbPlanes* img : {&reference, &test}) {
@@ -239,7 +239,7 @@ Plane flipErrorMap(const RgbPlanes& reference, const RgbPlanes& test, const Flip
     const Features ft = detectFeatures(tst.lum, ppd);
 
     const float cmax = std::pow(hyab(rgbToHuntLab({0, 1, 0}), rgbToHuntLab({0, 0, 1})), kQc);
-    Plane out(reference.width(), reference.height());
+    ImagePlane out(reference.width(), reference.height());
     tbb::parallel_for(size_t(0), out.size(), [&](size_t i) {
         const float dc = hyab({ref.L.data[i], ref.A.data[i], ref.B.data[i]}, {tst.L.data[i], tst.A.data[i], tst.B.data[i]});
         const float ec = redistribute(std::pow(dc, kQc), cmax);

@@ -33,7 +33,7 @@ namespace hp {
 
 /// Three linear-sRGB planes of equal size with values in [0, 1].
 struct RgbPlanes {
-    Plane r, g, b;
+    ImagePlane r, g, b;
     int width() const { return r.width; }
     int height() const { return r.height; }
 };
@@ -50,6 +50,6 @@ double pixelsPerDegree(double distanceMetres, double widthMetres, int pixelsX);
 
 /// The per-pixel LDR-FLIP error map of `test` against `reference`, values in
 /// [0, 1]. Throws Error if the sizes differ or PPD is not positive.
-Plane flipErrorMap(const RgbPlanes& reference, const RgbPlanes& test, const FlipSettings& settings = {});
+ImagePlane flipErrorMap(const RgbPlanes& reference, const RgbPlanes& test, const FlipSettings& settings = {});
 
 }  // namespace hp

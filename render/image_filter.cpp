@@ -10,9 +10,9 @@
 
 namespace hp {
 
-Kernel gaussianKernel(double sigma, int radius) {
+FilterKernel gaussianKernel(double sigma, int radius) {
     if (sigma <= 0 || radius < 0) throw Error(cat("gaussianKernel: bad sigma ", sigma, " or radius ", radius));
-    Kernel k(size_t(2 * radius + 1));
+    FilterKernel k(size_t(2 * radius + 1));
     double sum = 0;
     for (int i = -radius; i <= radius; ++i) sum += std::exp(-0.5 * i * i / (sigma * sigma));
     for (int i = -radius; i <= radius; ++i) k[size_t(i + radius)] = float(std::exp(-0.5 * i * i / (sigma * sigma)) / sum);
@@ -21,17 +21,17 @@ Kernel gaussianKernel(double sigma, int radius) {
 
 namespace {
 
-int radiusOf(const Kernel& k) {
+int radiusOf(const FilterKernel& k) {
     if (k.empty() || k.size() % 2 == 0) throw Error(cat("convolution kernel must have odd length, got ", k.size()));
     return int(k.size() / 2);
 }
 
 }  // namespace
 
-Plane convolveRows(const Plane& in, const Kernel& k) {
+ImagePlane convolveRows(const ImagePlane& in, const FilterKernel& k) {
     const int r = radiusOf(k);
     const int w = in.width;
-    Plane out(in.width, in.height);
+    ImagePlane out(in.width, in.height);
     tbb::parallel_for(tbb::blocked_range<int>(0, in.height), [&](const tbb::blocked_range<int>& rows) {
         // One padded copy of the row makes the inner loop branch-free (and
         // vectorisable): taps outside the image read the replicated edge.
@@ -55,11 +55,11 @@ Plane convolveRows(const Plane& in, const Kernel& k) {
     return out;
 }
 
-Plane convolveColumns(const Plane& in, const Kernel& k) {
+ImagePlane convolveColumns(const ImagePlane& in, const FilterKernel& k) {
     const int r = radiusOf(k);
     const int w = in.width;
     const int h = in.height;
-    Plane out(in.width, in.height);
+    ImagePlane out(in.width, in.height);
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
         for (int y = rows.begin(); y != rows.end(); ++y) {
             float* dst = &out.data[size_t(y) * w];
@@ -74,7 +74,7 @@ Plane convolveColumns(const Plane& in, const Kernel& k) {
     return out;
 }
 
-Plane convolveSeparable(const Plane& in, const Kernel& kx, const Kernel& ky) {
+ImagePlane convolveSeparable(const ImagePlane& in, const FilterKernel& kx, const FilterKernel& ky) {
     return convolveColumns(convolveRows(in, kx), ky);
 }
 

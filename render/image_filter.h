@@ -14,29 +14,29 @@
 namespace hp {
 
 /// A single-channel float image, row-major, top row first.
-struct Plane {
+struct ImagePlane {
     int width = 0;
     int height = 0;
     std::vector<float> data;
 
-    Plane() = default;
-    Plane(int w, int h, float value = 0.f) : width(w), height(h), data(std::size_t(w) * std::size_t(h), value) {}
+    ImagePlane() = default;
+    ImagePlane(int w, int h, float value = 0.f) : width(w), height(h), data(std::size_t(w) * std::size_t(h), value) {}
     float& at(int x, int y) { return data[std::size_t(y) * width + x]; }
     float at(int x, int y) const { return data[std::size_t(y) * width + x]; }
     std::size_t size() const { return data.size(); }
 };
 
 /// A 1-D kernel of odd length 2r+1; tap i weighs the pixel at offset i - r.
-using Kernel = std::vector<float>;
+using FilterKernel = std::vector<float>;
 
 /// Sampled Gaussian exp(-x²/(2σ²)) for x in [-radius, radius], normalised to sum 1.
-Kernel gaussianKernel(double sigma, int radius);
+FilterKernel gaussianKernel(double sigma, int radius);
 
 /// Convolves every row with `k` (horizontal pass).
-Plane convolveRows(const Plane& in, const Kernel& k);
+ImagePlane convolveRows(const ImagePlane& in, const FilterKernel& k);
 /// Convolves every column with `k` (vertical pass).
-Plane convolveColumns(const Plane& in, const Kernel& k);
+ImagePlane convolveColumns(const ImagePlane& in, const FilterKernel& k);
 /// Horizontal pass with `kx`, then vertical pass with `ky`: the 2-D kernel kx(x)·ky(y).
-Plane convolveSeparable(const Plane& in, const Kernel& kx, const Kernel& ky);
+ImagePlane convolveSeparable(const ImagePlane& in, const FilterKernel& kx, const FilterKernel& ky);
 
 }  // namespace hp

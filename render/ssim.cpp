@@ -6,25 +6,25 @@
 
 namespace hp {
 
-Plane ssimMap(const Plane& x, const Plane& y, const SsimSettings& s) {
+ImagePlane ssimMap(const ImagePlane& x, const ImagePlane& y, const SsimSettings& s) {
     if (x.width != y.width || x.height != y.height)
         throw Error(cat("ssim: image sizes differ (", x.width, "x", x.height, " vs ", y.width, "x", y.height, ")"));
-    const Kernel w = gaussianKernel(s.sigma, s.radius);
+    const FilterKernel w = gaussianKernel(s.sigma, s.radius);
     const size_t n = x.size();
-    Plane xx(x.width, x.height), yy(x.width, x.height), xy(x.width, x.height);
+    ImagePlane xx(x.width, x.height), yy(x.width, x.height), xy(x.width, x.height);
     tbb::parallel_for(size_t(0), n, [&](size_t i) {
         xx.data[i] = x.data[i] * x.data[i];
         yy.data[i] = y.data[i] * y.data[i];
         xy.data[i] = x.data[i] * y.data[i];
     });
-    const Plane mx = convolveSeparable(x, w, w);
-    const Plane my = convolveSeparable(y, w, w);
-    const Plane exx = convolveSeparable(xx, w, w);
-    const Plane eyy = convolveSeparable(yy, w, w);
-    const Plane exy = convolveSeparable(xy, w, w);
+    const ImagePlane mx = convolveSeparable(x, w, w);
+    const ImagePlane my = convolveSeparable(y, w, w);
+    const ImagePlane exx = convolveSeparable(xx, w, w);
+    const ImagePlane eyy = convolveSeparable(yy, w, w);
+    const ImagePlane exy = convolveSeparable(xy, w, w);
     const double c1 = (s.k1 * s.range) * (s.k1 * s.range);
     const double c2 = (s.k2 * s.range) * (s.k2 * s.range);
-    Plane out(x.width, x.height);
+    ImagePlane out(x.width, x.height);
     tbb::parallel_for(size_t(0), n, [&](size_t i) {
         // Double precision here: σ² = E[x²] − μ² cancels, and the constants
         // C1, C2 are small (1e-4, 9e-4) next to it.

@@ -26,6 +26,6 @@ struct SsimSettings {
 /// Per-pixel SSIM of two planes of equal size. Windows near the border see
 /// replicated edge pixels (the paper's MATLAB code crops them instead; a full
 /// map lets callers average over any mask). Throws Error on a size mismatch.
-Plane ssimMap(const Plane& x, const Plane& y, const SsimSettings& settings = {});
+ImagePlane ssimMap(const ImagePlane& x, const ImagePlane& y, const SsimSettings& settings = {});
 
 }  // namespace hp

@@ -207,7 +207,7 @@ TEST(CompareFlip, FeatureTermConcentratesErrorAtAMovedEdge) {
                 a.at(x, y, c) = x >= 40 ? 0.8f : 0.1f;
                 b.at(x, y, c) = x >= 41 ? 0.8f : 0.1f;
             }
-    const Plane map = compareImages(a, b).flipMap;
+    const ImagePlane map = compareImages(a, b).flipMap;
     int argmax = 0;
     for (int x = 0; x < 96; ++x)
         if (map.at(x, 16) > map.at(argmax, 16)) argmax = x;

@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
     for (int threads : {1, 2}) {
         tbb::task_arena arena(threads);
         arena.execute([&] {
-            Plane x(w, h), y(w, h);
+            ImagePlane x(w, h), y(w, h);
             for (size_t i = 0; i < x.size(); ++i) x.data[i] = a.pixels[4 * i + 1], y.data[i] = b.pixels[4 * i + 1];
             RgbPlanes pa{x, x, x}, pb{y, y, y};
             const Stat ssim = time(runs, [&] { ssimMap(x, y); });
