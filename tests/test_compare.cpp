@@ -226,6 +226,8 @@ TEST(CompareFlip, FineNoiseMattersLessFromFurtherAway) {
     far.flip.pixelsPerDegree = 120;
     EXPECT_GT(compareImages(a, b, near).metrics.flip, 1.2 * compareImages(a, b, far).metrics.flip);
     EXPECT_THROW(compareImages(a, b, [] { CompareSettings s; s.flip.pixelsPerDegree = 0; return s; }()), Error);
+    // The paper's setup: a 0.7 m wide 3840-pixel display seen from 0.7 m gives its 67 PPD.
+    EXPECT_NEAR(pixelsPerDegree(0.7, 0.7, 3840), 67.02, 0.01);
 }
 
 TEST(CompareFlip, MagmaIsDarkToLightAndMonotoneInLuminance) {
