@@ -58,7 +58,6 @@ std::string expandFrame(const std::string& pattern, int frame) {
     return pattern.substr(0, t.pos) + digits + pattern.substr(t.pos + t.length);
 }
 
-
 bool matchFrame(const std::string& pattern, const std::string& fileName, int* frame) {
     Token t;
     if (findTokens(pattern, &t) != 1) return false;
