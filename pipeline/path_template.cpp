@@ -58,4 +58,24 @@ std::string expandFrame(const std::string& pattern, int frame) {
     return pattern.substr(0, t.pos) + digits + pattern.substr(t.pos + t.length);
 }
 
+bool matchFrame(const std::string& pattern, const std::string& fileName, int* frame) {
+    Token t;
+    if (findTokens(pattern, &t) != 1) return false;
+    const std::string prefix = pattern.substr(0, t.pos), suffix = pattern.substr(t.pos + t.length);
+    if (fileName.size() <= prefix.size() + suffix.size() || fileName.compare(0, prefix.size(), prefix) != 0 ||
+        fileName.compare(fileName.size() - suffix.size(), suffix.size(), suffix) != 0)
+        return false;
+    const std::string digits = fileName.substr(prefix.size(), fileName.size() - prefix.size() - suffix.size());
+    const size_t start = digits[0] == '-' ? 1 : 0;
+    if (digits.size() <= start || digits.size() - start > 9) return false;
+    for (size_t i = start; i < digits.size(); ++i)
+        if (!std::isdigit(static_cast<unsigned char>(digits[i]))) return false;
+    // expandFrame pads to at least the token's width: "0012" matches ####, "12" does not.
+    if (int(digits.size()) < t.padding + int(start)) return false;
+    const int value = std::stoi(digits);
+    if (expandFrame(pattern, value) != fileName) return false;
+    *frame = value;
+    return true;
+}
+
 }  // namespace hp

@@ -14,4 +14,9 @@ bool hasFrameToken(const std::string& pattern);
 /// would overwrite one file) or more than one.
 std::string expandFrame(const std::string& pattern, int frame);
 
+/// If `fileName` is `pattern` with its frame token replaced by a frame number
+/// (any number of digits, at least the padding, optionally negative), stores
+/// the frame and returns true. Compares names only, not folders.
+bool matchFrame(const std::string& pattern, const std::string& fileName, int* frame);
+
 }  // namespace hp

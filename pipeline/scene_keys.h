@@ -11,5 +11,6 @@ void addSceneKeys(SchemaBuilder& b);
 void addShotKeys(SchemaBuilder& b);    // top level: name, frames, fps, seed
 void addOutputKeys(SchemaBuilder& b);  // output: directory, templates
 void addRenderKeys(SchemaBuilder& b);  // render: camera, lights, materials (scene_keys_render.cpp)
+void addCompareKeys(SchemaBuilder& b);  // compare: sequences, thresholds, report (scene_keys_compare.cpp)
 
 }  // namespace hp

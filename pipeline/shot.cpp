@@ -74,6 +74,15 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
         ++report.framesDone;
         progress.advance(cat("frame ", frame));
     }
+    // Whole-run outputs (reports) once every frame is done.
+    for (StagePtr& stage : stages) {
+        try {
+            stage->finish(shot);
+        } catch (const Error& e) {
+            report.failures.push_back(cat(stage->name(), ": ", e.what()));
+            logError(stage->name(), ": ", e.what());
+        }
+    }
     return report;
 }
 

@@ -57,6 +57,11 @@ class FrameStage {
     /// Produces the outputs of one frame, each through writeAtomically.
     /// Throws hp::Error on failure; the scheduler records it and goes on.
     virtual void run(const FrameData& data) = 0;
+    /// Called once after the last frame of a run (also when frames failed or
+    /// were skipped as already done), for outputs that cover the whole run,
+    /// such as the compare stage's report. Throws hp::Error on failure; the
+    /// scheduler records it like a failed frame (exit code 2).
+    virtual void finish(const ShotSettings& shot) {}
 };
 
 using StagePtr = std::unique_ptr<FrameStage>;

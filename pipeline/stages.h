@@ -7,4 +7,7 @@
 
 namespace hp {
 
+/// compare.*: preview vs reference metrics, difference images and report (stage_compare.cpp).
+StagePtr makeCompareStage(const Scene& scene, const ShotSettings& shot);
+
 }  // namespace hp

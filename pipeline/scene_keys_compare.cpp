@@ -1,0 +1,35 @@
+// compare.*: the "compare" stage of `hairpipe run` (pipeline/stage_compare.cpp),
+// which compares two of the shot's image sequences — by default the preview
+// against the reference — with the metrics of render/compare.h.
+#include "pipeline/scene_keys.h"
+
+namespace hp {
+
+void addCompareKeys(SchemaBuilder& b) {
+    b.section("compare",
+              "Compare two rendered sequences frame by frame (FLIP, SSIM, PSNR, RMSE): difference images, "
+              "metrics tables and a self-contained HTML report; frames beyond a threshold make the run exit "
+              "with code 2. `hairpipe compare A B` does the same for any two sequences.")
+        .flag("compare.enabled", false, "Run the compare stage.")
+        .text("compare.a", "preview/preview.####.exr",
+              "Sequence A (the reference side of FLIP), a frame template relative to the output folder "
+              "(or absolute).")
+        .text("compare.b", "reference/reference.####.exr",
+              "Sequence B (the test side), a frame template relative to the output folder (or absolute).")
+        .text("compare.output", "compare",
+              "Folder, relative to the output folder, for flip.####.png (FLIP heat map), absdiff.####.exr "
+              "(|A-B|), metrics.####.json and the run's metrics.csv / metrics.json.")
+        .text("compare.report", "compare/report.html",
+              "The HTML report, relative to the output folder; empty for none. Rewritten at the end of each run.")
+        .choice("compare.mask", "hair", {"hair", "none"},
+                "hair: average the metrics over pixels whose alpha is > 0 in A or B; none: the whole frame.")
+        .number("compare.pixels_per_degree", 67, 1, 1000, "px/deg",
+                "FLIP's viewing condition; 67 is a 0.7 m wide 4K display seen from 0.7 m.")
+        .number("compare.max_flip", 1, 0, 1, "", "Fail a frame whose mean FLIP exceeds this (1: no limit).")
+        .number("compare.min_psnr", 0, 0, 1000, "dB", "Fail a frame whose PSNR is below this (0: no limit).")
+        .number("compare.min_ssim", -1, -1, 1, "", "Fail a frame whose SSIM is below this (-1: no limit).")
+        .number("compare.max_rmse", 1, 0, 1, "", "Fail a frame whose RMSE exceeds this (1: no limit).")
+        .integer("compare.report_width", 512, 16, 8192, "px", "Width of the images embedded in the report.");
+}
+
+}  // namespace hp
