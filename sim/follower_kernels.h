@@ -140,11 +140,38 @@ HP_FOLLOWER_KERNEL void rotate(float w, float x, float y, float z, float vx, flo
 }
 
 // ---------------------------------------------------------------------------
-// Segment rotations of a guide (double precision: 845 guides, per step).
+// Segment rotations of a guide (per guide and step, a few hundred flops).
+
+/// A quaternion (w, x, y, z) in float, with the few operations the guide
+/// tables need written out (Eigen's double quaternions cost 3x as much here).
+struct Quat {
+    float w = 1.f, x = 0.f, y = 0.f, z = 0.f;
+};
+
+/// Hamilton product a b (apply b, then a).
+HP_FOLLOWER_KERNEL Quat operator*(const Quat& a, const Quat& b) {
+    return {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z, a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+            a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x, a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
+}
+
+HP_FOLLOWER_KERNEL Quat conjugate(const Quat& q) { return {q.w, -q.x, -q.y, -q.z}; }
 
 /// The minimal rotation (swing) taking unit a to unit b:
-///   q = normalize(1 + a·b, a × b).
-/// Opposite vectors: a half turn about any axis perpendicular to a.
+///   q = (1 + a·b, a × b) / sqrt(2 (1 + a·b))
+/// (the norm of (1 + c, a × b) is sqrt((1 + c)² + 1 - c²)). Opposite
+/// vectors: a half turn about any axis perpendicular to a.
+inline Quat swing(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+    const float c = a.dot(b);
+    if (c < -1.f + 1e-6f) {
+        const Eigen::Vector3f axis = a.unitOrthogonal();
+        return {0.f, axis.x(), axis.y(), axis.z()};
+    }
+    const Eigen::Vector3f s = a.cross(b);
+    const float k = 1.f / std::sqrt(2.f * (1.f + c));
+    return {(1.f + c) * k, s.x() * k, s.y() * k, s.z() * k};
+}
+
+/// The same in double, for build-time frame comparisons.
 inline Eigen::Quaterniond swing(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
     const double c = a.dot(b);
     if (c < -1.0 + 1e-12) {
@@ -152,7 +179,8 @@ inline Eigen::Quaterniond swing(const Eigen::Vector3d& a, const Eigen::Vector3d&
         return Eigen::Quaterniond(0.0, axis.x(), axis.y(), axis.z());
     }
     const Eigen::Vector3d s = a.cross(b);
-    return Eigen::Quaterniond(1.0 + c, s.x(), s.y(), s.z()).normalized();
+    const double k = 1.0 / std::sqrt(2.0 * (1.0 + c));
+    return Eigen::Quaterniond((1.0 + c) * k, s.x() * k, s.y() * k, s.z() * k);
 }
 
 /// Parallel-transported frame of segment y of a polyline with unit
@@ -161,10 +189,12 @@ inline Eigen::Quaterniond swing(const Eigen::Vector3d& a, const Eigen::Vector3d&
 /// F_y takes the root normal to d_y and turns as little as possible along
 /// the way; it is defined for any strand whose consecutive segments never
 /// fold back completely, so it has no singular pose the way a rotation built
-/// from a fixed axis would.
-inline Eigen::Quaterniond transportStep(const Eigen::Quaterniond& previousFrame, const Eigen::Vector3d& previousDir,
-                                        const Eigen::Vector3d& dir) {
-    return (swing(previousDir, dir) * previousFrame).normalized();
+/// from a fixed axis would. Renormalised each step (23 float products would
+/// otherwise drift by ~1e-6).
+inline Quat transportStep(const Quat& previousFrame, const Eigen::Vector3f& previousDir, const Eigen::Vector3f& dir) {
+    Quat f = swing(previousDir, dir) * previousFrame;
+    const float k = 1.f / std::sqrt(f.w * f.w + f.x * f.x + f.y * f.y + f.z * f.z);
+    return {f.w * k, f.x * k, f.y * k, f.z * k};
 }
 
 /// Rotation of a guide segment in its root frame: q_y = C_y P_y^{-1}, where
@@ -173,9 +203,8 @@ inline Eigen::Quaterniond transportStep(const Eigen::Quaterniond& previousFrame,
 /// C_y n = c_y); at rest q_y = 1 for any rest shape, and its twist is the one
 /// transport accumulates, the same for neighbouring guides that bend alike,
 /// so slerping between two guides' q_y is meaningful.
-inline Eigen::Quaterniond segmentRotation(const Eigen::Quaterniond& currentFrame,
-                                          const Eigen::Quaterniond& restFrameInverse) {
-    return (currentFrame * restFrameInverse).normalized();
+HP_FOLLOWER_KERNEL Quat segmentRotation(const Quat& currentFrame, const Quat& restFrameInverse) {
+    return currentFrame * restFrameInverse;
 }
 
 // ---------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 // and reads every step. Not for other modules (include sim/followers.h).
 #pragma once
 
+#include "sim/follower_kernels.h"
 #include "sim/followers.h"
 
 #include <Eigen/Geometry>
@@ -45,7 +46,7 @@ struct Followers::Impl {
 
     // Guides (rest): segment offsets and inverse transported rest frames P_y⁻¹.
     std::vector<uint32_t> guideSegmentOffsets{0};
-    std::vector<Eigen::Quaterniond> restInverse;
+    std::vector<follower::Quat> restInverse;
     std::vector<Eigen::Vector3f> guideRestDirs;  ///< unit, root-frame coordinates
 
     std::vector<FollowerClass> classes;
@@ -61,7 +62,7 @@ struct Followers::Impl {
     std::vector<float> ownRestData;        ///< per follower: dx[P] dy[P] dz[P] length[P], aligned frame
     std::vector<uint32_t> vertexOffset;    ///< follower vertex offsets, relative to the follower block
     std::vector<uint32_t> ids;
-    std::vector<uint32_t> order;           ///< processing order: by class, then guide 1 (cache locality)
+    std::vector<uint32_t> order;           ///< processing order: by class, then index (streams memory)
     static constexpr uint32_t kNone = ~0u;
 
     // What the previous update wrote (finite-difference velocities).

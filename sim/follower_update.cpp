@@ -50,11 +50,27 @@ template <FollowerMode M, bool Own>
                                                     const SurfaceFrame& root, float* __restrict dx,
                                                     float* __restrict dy, float* __restrict dz,
                                                     float* __restrict w) {
-    const uint32_t P = c.pad;
+    // One pointer per table row, indexed by a size_t: with 32-bit index
+    // arithmetic (k * P + y) the compiler must allow for wrap-around and
+    // falls back to gathering element by element.
+    const size_t P = c.pad;
     const FollowerNeighbours& nb = im.neighbours[f];
-    const float* __restrict h1 = c.hot.data() + size_t(nb.guide1) * FollowerClass::kHot * P;
-    const float* __restrict h2 = c.hot.data() + size_t(nb.guide2) * FollowerClass::kHot * P;
-    const float* __restrict own = Own ? im.ownRestData.data() + im.ownRest[f] : nullptr;
+    const float* h1 = c.hot.data() + size_t(nb.guide1) * FollowerClass::kHot * P;
+    const float* h2 = c.hot.data() + size_t(nb.guide2) * FollowerClass::kHot * P;
+    const float* __restrict aW = h1;
+    const float* __restrict aX = h1 + P;
+    const float* __restrict aY = h1 + 2 * P;
+    const float* __restrict aZ = h1 + 3 * P;
+    const float* __restrict speed1 = h1 + 4 * P;
+    const float* __restrict bW = h2;
+    const float* __restrict bX = h2 + P;
+    const float* __restrict bY = h2 + 2 * P;
+    const float* __restrict bZ = h2 + 3 * P;
+    const float* own = Own ? im.ownRestData.data() + im.ownRest[f] : h1 + 5 * P;
+    const float* __restrict restX = own;
+    const float* __restrict restY = own + P;
+    const float* __restrict restZ = own + 2 * P;
+    const float* __restrict restLength = Own ? own + 3 * P : nullptr;
     const float* __restrict df = c.df.data();
 
     // Effective root frame E = [t', n, z']: the current frame turned by the
@@ -72,19 +88,19 @@ template <FollowerMode M, bool Own>
     const uint32_t hash = follower::followerHash(im.settings.seed, f);
     const float length = im.segmentLength[f];
 
-    for (uint32_t y = 0; y < P; ++y) {
-        const float aw = h1[y], ax = h1[P + y], ay = h1[2 * P + y], az = h1[3 * P + y];
+    for (size_t y = 0; y < P; ++y) {
+        const float aw = aW[y], ax = aX[y], ay = aY[y], az = aZ[y];
         float qw = aw, qx = ax, qy = ay, qz = az, weight = 0.f;
         if constexpr (M != FollowerMode::Cluster) {
             // Guide 2's rotation turned into guide 1's frame: K q2 K⁻¹, K about y.
-            const float bw = h2[y], by = h2[2 * P + y];
-            const float bx = kc * h2[P + y] + ks * h2[3 * P + y];
-            const float bz = -ks * h2[P + y] + kc * h2[3 * P + y];
+            const float bw = bW[y], by = bY[y];
+            const float bx = kc * bX[y] + ks * bZ[y];
+            const float bz = -ks * bX[y] + kc * bZ[y];
             if constexpr (M == FollowerMode::Interpolate) {
                 weight = wInterp;
             } else {
-                const float dv = follower::variableOffset(h1[4 * P + y], maxVelocity);
-                weight = follower::variedWeight(fixedOffset, df[y], follower::segmentRandom(hash, y), dv);
+                const float dv = follower::variableOffset(speed1[y], maxVelocity);
+                weight = follower::variedWeight(fixedOffset, df[y], follower::segmentRandom(hash, uint32_t(y)), dv);
             }
             float c0, c1;
             follower::slerpWeights(aw * bw + ax * bx + ay * by + az * bz, weight, c0, c1);
@@ -93,9 +109,7 @@ template <FollowerMode M, bool Own>
             qy = c0 * ay + c1 * by;
             qz = c0 * az + c1 * bz;
         }
-        const float rx = Own ? own[y] : h1[5 * P + y];
-        const float ry = Own ? own[P + y] : h1[6 * P + y];
-        const float rz = Own ? own[2 * P + y] : h1[7 * P + y];
+        const float rx = restX[y], ry = restY[y], rz = restZ[y];
         float lx, ly, lz;
         follower::rotate(qw, qx, qy, qz, rx, ry, rz, lx, ly, lz);
         const float wx = tx * lx + nx * ly + zx * lz;
@@ -103,7 +117,7 @@ template <FollowerMode M, bool Own>
         const float wz = tz * lx + nz * ly + zz * lz;
         // Renormalise: slerp's series and float rounding leave |q| = 1 ± 1e-6;
         // segment lengths come out exact to float precision.
-        const float scale = (Own ? own[3 * P + y] : length) / std::sqrt(wx * wx + wy * wy + wz * wz);
+        const float scale = (Own ? restLength[y] : length) / std::sqrt(wx * wx + wy * wy + wz * wz);
         dx[y] = wx * scale;
         dy[y] = wy * scale;
         dz[y] = wz * scale;
@@ -120,42 +134,73 @@ template <FollowerMode M, bool Own>
     const SurfaceFrame& root = ctx.roots[f];
     followerSegments<M, Own>(im, c, f, root, dx, dy, dz, w);
 
-    const uint32_t S = c.segments;
+    // Vertices: a running sum from the root, into a local buffer laid out
+    // like the output (x y z per vertex).
+    const uint32_t S = c.segments, n3 = 3 * (S + 1);
+    alignas(32) float x[3 * kMaxFollowerVertices];
+    float px = root.position.x(), py = root.position.y(), pz = root.position.z();
+    x[0] = px;
+    x[1] = py;
+    x[2] = pz;
+    for (uint32_t v = 1; v <= S; ++v) {
+        px += dx[v - 1];
+        py += dy[v - 1];
+        pz += dz[v - 1];
+        x[3 * v] = px;
+        x[3 * v + 1] = py;
+        x[3 * v + 2] = pz;
+    }
+
     const FollowerNeighbours& nb = im.neighbours[f];
     const float* cold1 = c.cold.data() + size_t(nb.guide1) * (S + 1) * FollowerClass::kCold;
-    const float* cold2 = c.cold.data() + size_t(nb.guide2) * (S + 1) * FollowerClass::kCold;
-    Vec3f* __restrict pos = ctx.positions + im.vertexOffset[f];
-    Vec3f* __restrict vel = ctx.velocities + im.vertexOffset[f];
-    const float rootRadius = c.radii[0];
-    Vec3f p = root.position;
-    for (uint32_t v = 0; v <= S; ++v) {
-        const float* g1 = cold1 + v * FollowerClass::kCold;
-        if (v > 0) {
-            const Vec3f previous = p;
-            p += Vec3f(dx[v - 1], dy[v - 1], dz[v - 1]);
-            if (ctx.collider) {
-                // The distance is 1-Lipschitz: a vertex closer to guide 1's
-                // vertex than that vertex's clearance is outside; skip the query.
-                const float clear = g1[3] - rootRadius;
-                const float gx = p.x() - g1[0], gy = p.y() - g1[1], gz = p.z() - g1[2];
-                if (!(clear > 0.f && gx * gx + gy * gy + gz * gz < clear * clear)) {
-                    ++counters.queries;
-                    Vec3f normal;
-                    const float d = ctx.collider->signedDistance(p, &normal);
+    if (ctx.collider) {
+        // Follow the leader: a vertex pushed out moves every later vertex by
+        // the same amount (`shift`), so segment directions are kept elsewhere.
+        const float rootRadius = c.radii[0];
+        Vec3f shift = Vec3f::Zero();
+        for (uint32_t v = 1; v <= S; ++v) {
+            const float* g1 = cold1 + v * FollowerClass::kCold;
+            Vec3f p = Vec3f(x[3 * v], x[3 * v + 1], x[3 * v + 2]) + shift;
+            // The distance is 1-Lipschitz: a vertex closer to guide 1's vertex
+            // than that vertex's clearance is outside; skip the query.
+            const float clear = g1[3] - rootRadius;
+            const float gx = p.x() - g1[0], gy = p.y() - g1[1], gz = p.z() - g1[2];
+            if (!(clear > 0.f && gx * gx + gy * gy + gz * gz < clear * clear)) {
+                ++counters.queries;
+                Vec3f normal;
+                const float d = ctx.collider->signedDistance(p, &normal);
+                if (d < c.radii[v]) {
+                    const Vec3f previous(x[3 * v - 3], x[3 * v - 2], x[3 * v - 1]);
+                    const Vec3f before = p;
                     const float length = std::sqrt(dx[v - 1] * dx[v - 1] + dy[v - 1] * dy[v - 1] + dz[v - 1] * dz[v - 1]);
-                    if (follower::projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p))
-                        ++counters.projected;
+                    follower::projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p);
+                    shift += p - before;
+                    ++counters.projected;
                 }
             }
+            x[3 * v] = p.x();
+            x[3 * v + 1] = p.y();
+            x[3 * v + 2] = p.z();
         }
-        if (ctx.difference) {
-            vel[v] = (p - pos[v]) * ctx.invDt;
-        } else {
+    }
+
+    float* __restrict pos = ctx.positions[0].data() + 3 * size_t(im.vertexOffset[f]);
+    float* __restrict vel = ctx.velocities[0].data() + 3 * size_t(im.vertexOffset[f]);
+    if (ctx.difference) {
+        const float invDt = ctx.invDt;
+        for (uint32_t i = 0; i < n3; ++i) {
+            vel[i] = (x[i] - pos[i]) * invDt;
+            pos[i] = x[i];
+        }
+    } else {
+        const float* cold2 = c.cold.data() + size_t(nb.guide2) * (S + 1) * FollowerClass::kCold;
+        for (uint32_t v = 0; v <= S; ++v) {
+            const float* g1 = cold1 + v * FollowerClass::kCold;
             const float* g2 = cold2 + v * FollowerClass::kCold;
             const float b = w[v > 0 ? v - 1 : 0];
-            vel[v] = Vec3f((1.f - b) * g1[4] + b * g2[4], (1.f - b) * g1[5] + b * g2[5], (1.f - b) * g1[6] + b * g2[6]);
+            for (int k = 0; k < 3; ++k) vel[3 * v + k] = (1.f - b) * g1[4 + k] + b * g2[4 + k];
         }
-        pos[v] = p;
+        for (uint32_t i = 0; i < n3; ++i) pos[i] = x[i];
     }
 }
 
@@ -200,43 +245,50 @@ void fillGuide(Impl& im, const FollowerStep& step, const Collider* collider, siz
     const Vec3f* v = guides.velocities.empty() ? nullptr : guides.velocities.data() + first;
 
     const SurfaceFrame& rf = step.guideRoots[g];
-    Eigen::Vector3d n = rf.normal.cast<double>().normalized(), t = rf.tangent.cast<double>();
-    t = (t - n * n.dot(t)).normalized();
-    const Eigen::Vector3d z = t.cross(n);
+    const Vec3f n = rf.normal.normalized();
+    const Vec3f t = (rf.tangent - n * n.dot(rf.tangent)).normalized();
+    const Vec3f z = t.cross(n);
     if (!t.allFinite() || !n.allFinite()) throw Error(cat("followers: guide ", g, " has a degenerate root frame"));
 
     float q[kMaxFollowerVertices][4], speed[kMaxFollowerVertices], clearance[kMaxFollowerVertices + 1];
-    Eigen::Quaterniond frame = Eigen::Quaterniond::Identity();
-    Eigen::Vector3d previous = Eigen::Vector3d::UnitY();
+    // NaN or infinity anywhere makes the sum non-finite: one test per guide.
+    float sum = 0.f;
+    for (uint32_t k = 0; k <= gs; ++k) sum += x[k].x() + x[k].y() + x[k].z();
+    if (!std::isfinite(sum))
+        for (uint32_t k = 0; k <= gs; ++k)
+            if (!x[k].allFinite()) throw Error(cat("followers: guide ", g, " vertex ", k, " is not finite"));
+    follower::Quat frame;
+    Vec3f previous = Vec3f::UnitY();
     for (uint32_t y = 0; y < gs; ++y) {
-        if (!x[y + 1].allFinite()) throw Error(cat("followers: guide ", g, " vertex ", y + 1, " is not finite"));
-        const Eigen::Vector3d e = (x[y + 1] - x[y]).cast<double>();
-        Eigen::Vector3d d(t.dot(e), n.dot(e), z.dot(e));  // root-frame coordinates
-        const double len = d.norm();
-        d = len > 0.0 ? Eigen::Vector3d(d / len) : previous;  // a collapsed segment keeps the last direction
+        const Vec3f e = x[y + 1] - x[y];
+        Vec3f d(t.dot(e), n.dot(e), z.dot(e));  // root-frame coordinates
+        const float len2 = d.squaredNorm();
+        d = len2 > 0.f ? Vec3f(d / std::sqrt(len2)) : previous;  // a collapsed segment keeps the last direction
         frame = follower::transportStep(frame, previous, d);
         previous = d;
-        const Eigen::Quaterniond r = follower::segmentRotation(frame, im.restInverse[segOffset + y]);
-        q[y][0] = float(r.w());
-        q[y][1] = float(r.x());
-        q[y][2] = float(r.y());
-        q[y][3] = float(r.z());
+        const follower::Quat r = follower::segmentRotation(frame, im.restInverse[segOffset + y]);
+        q[y][0] = r.w;
+        q[y][1] = r.x;
+        q[y][2] = r.y;
+        q[y][3] = r.z;
         speed[y] = v ? 0.5f * (v[y] + v[y + 1]).norm() : 0.f;
     }
     for (uint32_t k = 0; k <= gs; ++k)
         clearance[k] = collider ? collider->signedDistance(x[k]) : std::numeric_limits<float>::max();
 
     for (FollowerClass& c : im.classes) {
-        const uint32_t P = c.pad, S = c.segments;
+        const size_t P = c.pad;
+        const uint32_t S = c.segments;
         float* row = c.hot.data() + g * FollowerClass::kHot * P;
+        const bool same = S == gs;  // the usual case: no resampling
         for (uint32_t y = 0; y < S; ++y) {
-            const uint32_t s = FollowerClass::guideSegment(y, S, gs);
+            const uint32_t s = same ? y : FollowerClass::guideSegment(y, S, gs);
             for (int k = 0; k < 4; ++k) row[k * P + y] = q[s][k];
             row[4 * P + y] = speed[s];
         }
         float* cold = c.cold.data() + g * (S + 1) * FollowerClass::kCold;
         for (uint32_t k = 0; k <= S; ++k) {
-            const uint32_t gv = k == 0 ? 0 : FollowerClass::guideSegment(k - 1, S, gs) + 1;
+            const uint32_t gv = same || k == 0 ? k : FollowerClass::guideSegment(k - 1, S, gs) + 1;
             float* o = cold + k * FollowerClass::kCold;
             o[0] = x[gv].x();
             o[1] = x[gv].y();
