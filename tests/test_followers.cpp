@@ -2,6 +2,7 @@
 // modes against shapes computed independently, thread independence, lengths,
 // velocities and head collision.
 #include "core/errors.h"
+#include "pipeline/follower_settings.h"
 #include "sim/follower_kernels.h"
 #include "sim/follower_neighbours.h"
 #include "sim/followers.h"
@@ -676,4 +677,36 @@ TEST(Followers, BadInputIsReportedWithTheStrand) {
     EXPECT_NE(message([&] { followers.update({shortGuides, guideRoots, groom.followerRoots}, out); })
                   .find("guide 0 has 2 vertices in this step but 24 in the groom"),
               std::string::npos);
+}
+
+// ---------------------------------------------------------------------------
+// Scene keys
+
+TEST(FollowerSettings, SceneKeysMapOntoSettings) {
+    const FollowerSettings defaults = followerSettings(Scene::parse("", "shot.yaml", "."));
+    EXPECT_EQ(defaults.mode, FollowerMode::Varied);
+    EXPECT_EQ(defaults.neighbours, NeighbourRule::Nearest);
+    EXPECT_FLOAT_EQ(defaults.fixedOffset, 0.2f);
+    EXPECT_FLOAT_EQ(defaults.maxVelocity, 0.1f);
+    EXPECT_TRUE(defaults.collide);
+
+    const FollowerSettings s = followerSettings(Scene::parse(
+        "seed: 42\nhair:\n  followers:\n    mode: cluster\n    neighbours: shape-similarity\n"
+        "    fixed_offset: 0.3\n    max_velocity: 0.05\n    collide: false\n",
+        "shot.yaml", ".", {"hair.followers.mode=interpolate"}));
+    EXPECT_EQ(s.mode, FollowerMode::Interpolate) << "--set overrides the file";
+    EXPECT_EQ(s.neighbours, NeighbourRule::ShapeSimilarity);
+    EXPECT_FLOAT_EQ(s.fixedOffset, 0.3f);
+    EXPECT_FLOAT_EQ(s.maxVelocity, 0.05f);
+    EXPECT_FALSE(s.collide);
+    EXPECT_EQ(s.seed, 42u);
+
+    try {
+        Scene::parse("hair:\n  followers:\n    mode: clumped\n", "shot.yaml", ".");
+        FAIL() << "an unknown mode must be rejected";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(e.key(), "hair.followers.mode");
+        EXPECT_NE(std::string(e.what()).find("varied"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(Scene::parse("hair:\n  followers:\n    fixed_offset: 1.5\n", "shot.yaml", "."), SceneError);
 }
