@@ -27,6 +27,19 @@
 // shape exactly; a follower whose root frame is the guide's moved rigidly is
 // the guide moved rigidly.
 //
+// Choices where the seed is silent or Unity-specific:
+// - d_v reads guide 1's speed at the same segment (mean of the segment's two
+//   vertex velocities, world space, m/s): the seed buffers each guide
+//   segment's Rigidbody velocity. World space, as there: a turning head is
+//   motion and switches the variation on; a still head lets followers align.
+// - d_f uses qs = (S - 1) / 2 (sim/follower_kernels.h: equal to the seed's
+//   integer "half the segment count" for its 23 segments; 0 at root and tip).
+// - d_r below 0 (rand < 0 near root and tip) extrapolates the slerp past
+//   guide 1 instead of clamping to [0, 1] as Unity's Quaternion.Slerp would,
+//   so the variation is symmetric about the fixed-offset curve.
+// - rand_xy is a hash of (seed, follower index, segment): no stored table.
+// - Velocities of followers: finite differences of what is drawn (see update()).
+//
 // Why rotations relative to the root frame and transported along the strand:
 // the seed's Unity prototype slerps the segments' transform rotations; here a
 // strand is positions only, so a rotation must be derived. Expressing it in

@@ -400,6 +400,48 @@ TEST(Followers, AtRestFollowersKeepTheGroomsShape) {
     EXPECT_LT(worst, 2e-6f);
 }
 
+TEST(Followers, OwnRestShapesAreKeptAtRestInTheirOwnFrames) {
+    // Followers with their own (curly, uneven) rest shapes, given in their own
+    // mesh root frames, and guides at rest: every follower is its rest shape.
+    SphereGroomSettings s;
+    s.guides = 94;
+    s.followers = 751;
+    FollowerGroom groom = makeSphereGroom(s);
+    for (size_t f = 0; f < groom.followerRoots.size(); ++f) {
+        std::vector<Vec3f> p{Vec3f::Zero()};
+        for (int y = 0; y < 20; ++y)
+            p.push_back(p.back() + (0.004f + 0.0005f * float((y + f) % 3)) *
+                                       Vec3f(std::cos(0.9f * y + f), 1.2f, std::sin(0.9f * y + f)).normalized());
+        groom.followerShapes.add(p.data(), p.size());
+    }
+    StrandFrame guides;
+    for (size_t g = 0; g < groom.guideRoots.size(); ++g) {
+        std::vector<Vec3f> p;
+        for (uint32_t k = groom.guideShapes.offsets[g]; k < groom.guideShapes.offsets[g + 1]; ++k)
+            p.push_back(groom.guideRoots[g].position + groom.guideShapes.points[k].y() * groom.guideRoots[g].normal);
+        const std::vector<float> r(p.size(), 1e-4f);
+        guides.addStrand(uint32_t(g), p.data(), r.data(), p.size());
+    }
+    for (FollowerMode mode : {FollowerMode::Varied, FollowerMode::Interpolate, FollowerMode::Cluster}) {
+        FollowerSettings settings;
+        settings.mode = mode;
+        Followers followers(groom, settings);
+        StrandFrame out;
+        followers.update({guides, groom.guideRoots, groom.followerRoots}, out);
+        float worst = 0;
+        for (size_t f = 0; f < groom.followerRoots.size(); ++f) {
+            const SurfaceFrame& r = groom.followerRoots[f];
+            std::vector<Vec3f> expected;
+            for (uint32_t k = groom.followerShapes.offsets[f]; k < groom.followerShapes.offsets[f + 1]; ++k) {
+                const Vec3f& l = groom.followerShapes.points[k];
+                expected.push_back(r.position + l.x() * r.tangent + l.y() * r.normal + l.z() * r.tangent.cross(r.normal));
+            }
+            worst = std::max(worst, maxDistance(strandOf(out, groom.guideRoots.size() + f), expected));
+        }
+        EXPECT_LT(worst, 1e-6f) << "mode " << int(mode);
+    }
+}
+
 TEST(Followers, RigidMotionOfTheWholeHeadMovesFollowersRigidly) {
     SphereGroomSettings s;
     s.guides = 94;
