@@ -44,7 +44,8 @@ struct Counters {
 };
 
 /// Unit segment directions of follower f scaled by the segment lengths,
-/// world space, into dx/dy/dz; the slerp weight of each segment into w.
+/// world space, into dx/dy/dz; the slerp weight of each segment into w
+/// (not written in cluster mode, where it is 0).
 template <FollowerMode M, bool Own>
 [[gnu::always_inline]] inline void followerSegments(const Impl& im, const FollowerClass& c, uint32_t f,
                                                     const SurfaceFrame& root, float* __restrict dx,
@@ -121,7 +122,7 @@ template <FollowerMode M, bool Own>
         dx[y] = wx * scale;
         dy[y] = wy * scale;
         dz[y] = wz * scale;
-        w[y] = weight;
+        if constexpr (M != FollowerMode::Cluster) w[y] = weight;
     }
 }
 
@@ -156,31 +157,38 @@ template <FollowerMode M, bool Own>
     if (ctx.collider) {
         // Follow the leader: a vertex pushed out moves every later vertex by
         // the same amount (`shift`), so segment directions are kept elsewhere.
+        // Scalars in registers on the common path; a Vec3f only for queries
+        // (an address-taken vector made every vertex a store-forwarding stall).
         const float rootRadius = c.radii[0];
-        Vec3f shift = Vec3f::Zero();
+        float sx = 0.f, sy = 0.f, sz = 0.f;
+        bool shifted = false;
         for (uint32_t v = 1; v <= S; ++v) {
             const float* g1 = cold1 + v * FollowerClass::kCold;
-            Vec3f p = Vec3f(x[3 * v], x[3 * v + 1], x[3 * v + 2]) + shift;
+            const float qx = x[3 * v] + sx, qy = x[3 * v + 1] + sy, qz = x[3 * v + 2] + sz;
             // The distance is 1-Lipschitz: a vertex closer to guide 1's vertex
             // than that vertex's clearance is outside; skip the query.
             const float clear = g1[3] - rootRadius;
-            const float gx = p.x() - g1[0], gy = p.y() - g1[1], gz = p.z() - g1[2];
+            const float gx = qx - g1[0], gy = qy - g1[1], gz = qz - g1[2];
             if (!(clear > 0.f && gx * gx + gy * gy + gz * gz < clear * clear)) {
                 ++counters.queries;
-                Vec3f normal;
+                Vec3f p(qx, qy, qz), normal;
                 const float d = ctx.collider->signedDistance(p, &normal);
                 if (d < c.radii[v]) {
                     const Vec3f previous(x[3 * v - 3], x[3 * v - 2], x[3 * v - 1]);
-                    const Vec3f before = p;
                     const float length = std::sqrt(dx[v - 1] * dx[v - 1] + dy[v - 1] * dy[v - 1] + dz[v - 1] * dz[v - 1]);
                     follower::projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p);
-                    shift += p - before;
+                    sx += p.x() - qx;
+                    sy += p.y() - qy;
+                    sz += p.z() - qz;
+                    shifted = true;
                     ++counters.projected;
                 }
             }
-            x[3 * v] = p.x();
-            x[3 * v + 1] = p.y();
-            x[3 * v + 2] = p.z();
+            if (shifted) {
+                x[3 * v] = x[3 * v] + sx;
+                x[3 * v + 1] = x[3 * v + 1] + sy;
+                x[3 * v + 2] = x[3 * v + 2] + sz;
+            }
         }
     }
 
@@ -197,7 +205,7 @@ template <FollowerMode M, bool Own>
         for (uint32_t v = 0; v <= S; ++v) {
             const float* g1 = cold1 + v * FollowerClass::kCold;
             const float* g2 = cold2 + v * FollowerClass::kCold;
-            const float b = w[v > 0 ? v - 1 : 0];
+            const float b = M == FollowerMode::Cluster ? 0.f : w[v > 0 ? v - 1 : 0];
             for (int k = 0; k < 3; ++k) vel[3 * v + k] = (1.f - b) * g1[4 + k] + b * g2[4 + k];
         }
         for (uint32_t i = 0; i < n3; ++i) pos[i] = x[i];
