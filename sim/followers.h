@@ -161,6 +161,13 @@ class Followers {
     /// is drawn; otherwise it is the slerp-weighted blend of its two guides'
     /// vertex velocities, (1 - w) v1 + w v2. Throws hp::Error when the step's
     /// sizes disagree with the groom or a guide vertex is not finite.
+    ///
+    /// Runs on TBB's threads (settings.parallel); results are the same bits
+    /// for any thread count. One update at a time per Followers object. To
+    /// keep the per-step cost to the followers themselves, a guide solver
+    /// writing into `out` in place should overwrite the guide block rather
+    /// than clear() the frame (which forces the layout to be rewritten and
+    /// loses the previous positions the velocities need).
     FollowerStats update(const FollowerStep& step, StrandFrame& out);
 
     size_t guideCount() const;
