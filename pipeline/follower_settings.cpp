@@ -1,0 +1,20 @@
+#include "pipeline/follower_settings.h"
+
+namespace hp {
+
+FollowerSettings followerSettings(const Scene& s) {
+    FollowerSettings f;
+    const std::string& mode = s.text("hair.followers.mode");
+    f.mode = mode == "cluster" ? FollowerMode::Cluster
+             : mode == "interpolate" ? FollowerMode::Interpolate
+                                     : FollowerMode::Varied;
+    f.neighbours = s.text("hair.followers.neighbours") == "shape-similarity" ? NeighbourRule::ShapeSimilarity
+                                                                             : NeighbourRule::Nearest;
+    f.fixedOffset = float(s.number("hair.followers.fixed_offset"));
+    f.maxVelocity = float(s.number("hair.followers.max_velocity"));
+    f.collide = s.flag("hair.followers.collide");
+    f.seed = uint32_t(s.integer("seed"));
+    return f;
+}
+
+}  // namespace hp

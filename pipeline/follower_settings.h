@@ -1,0 +1,15 @@
+// Maps the scene's hair.followers.* keys (and the shot seed) onto
+// sim/followers.h's FollowerSettings.
+#pragma once
+
+#include "pipeline/scene.h"
+#include "sim/followers.h"
+
+namespace hp {
+
+/// Follower mode, neighbour rule, Algorithm 1's constants, collision and
+/// the seed of the per-segment random values. Radii keep FollowerSettings'
+/// defaults (0.04 mm root, 0.01 mm tip) until a hair radius key exists.
+FollowerSettings followerSettings(const Scene& scene);
+
+}  // namespace hp

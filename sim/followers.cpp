@@ -1,0 +1,336 @@
+// Building a Followers object: checks, neighbour selection, twist alignment
+// and the tables update() fills (follower_update.cpp does the per-step part).
+#include "sim/followers.h"
+
+#include "core/errors.h"
+#include "sim/follower_kernels.h"
+#include "sim/follower_neighbours.h"
+#include "sim/follower_state.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace hp {
+
+void RestShapes::add(const Vec3f* p, size_t n) {
+    points.insert(points.end(), p, p + n);
+    offsets.push_back(uint32_t(points.size()));
+}
+
+RestShapes RestShapes::straight(size_t count, int vertices, float length) {
+    RestShapes s;
+    const int n = std::max(vertices, 2);
+    s.points.reserve(count * size_t(n));
+    s.offsets.reserve(count + 1);
+    for (size_t i = 0; i < count; ++i) {
+        for (int k = 0; k < n; ++k) s.points.emplace_back(0.f, length * float(k) / float(n - 1), 0.f);
+        s.offsets.push_back(uint32_t(s.points.size()));
+    }
+    return s;
+}
+
+namespace {
+
+using Mat3d = Eigen::Matrix3d;
+using Vec3d = Eigen::Vector3d;
+
+/// Orthonormal root frame [t, n, t × n] of a rest SurfaceFrame (Gram-Schmidt,
+/// so slightly inexact mesh frames are accepted).
+Mat3d restFrame(const SurfaceFrame& f, const char* what, size_t i) {
+    Vec3d n = f.normal.cast<double>(), t = f.tangent.cast<double>();
+    if (!n.allFinite() || !t.allFinite() || !f.position.allFinite() || n.norm() < 1e-6)
+        throw Error(cat("followers: ", what, " ", i, " has a non-finite or zero root frame"));
+    n.normalize();
+    t -= n * n.dot(t);
+    if (t.norm() < 1e-6) throw Error(cat("followers: ", what, " ", i, " has a tangent parallel to its normal"));
+    t.normalize();
+    Mat3d m;
+    m << t, n, t.cross(n);
+    return m;
+}
+
+/// Rotation taking coordinates in frame A to coordinates in frame B after
+/// carrying A over to B's normal by the minimal rotation: B⁻¹ swing(n_A → n_B) A.
+/// Both normals are the local y axis, so it is a turn about y; returns its
+/// angle φ with R_y(φ) = [[cos φ, 0, sin φ], [0, 1, 0], [-sin φ, 0, cos φ]].
+double twistAngle(const Mat3d& a, const Mat3d& b) {
+    const Mat3d m = b.transpose() * follower::swing(Vec3d(a.col(1)), Vec3d(b.col(1))).toRotationMatrix() * a;
+    return std::atan2(m(0, 2) - m(2, 0), m(0, 0) + m(2, 2));
+}
+
+Vec3d rotateY(double phi, const Vec3d& v) {
+    const double c = std::cos(phi), s = std::sin(phi);
+    return Vec3d(c * v.x() + s * v.z(), v.y(), -s * v.x() + c * v.z());
+}
+
+uint32_t padTo8(uint32_t n) { return (n + 7u) & ~7u; }
+
+void checkShape(const RestShapes& shapes, size_t i, const char* what) {
+    const uint32_t n = shapes.offsets[i + 1] - shapes.offsets[i];
+    if (n < 2 || n > kMaxFollowerVertices)
+        throw Error(cat("followers: ", what, " ", i, " has ", n, " vertices (2 to ", kMaxFollowerVertices,
+                        " supported)"));
+    for (uint32_t k = shapes.offsets[i]; k + 1 < shapes.offsets[i + 1]; ++k) {
+        if (!shapes.points[k].allFinite() || !shapes.points[k + 1].allFinite())
+            throw Error(cat("followers: ", what, " ", i, " has a non-finite rest vertex"));
+        if ((shapes.points[k + 1] - shapes.points[k]).norm() <= 0.f)
+            throw Error(cat("followers: ", what, " ", i, " has a zero-length rest segment ", k - shapes.offsets[i]));
+    }
+}
+
+template <typename T>
+T perFollower(const std::vector<T>& values, size_t i) { return values.size() == 1 ? values[0] : values[i]; }
+
+}  // namespace
+
+Followers::Followers(const FollowerGroom& groom, const FollowerSettings& settings) : impl_(std::make_unique<Impl>()) {
+    Impl& im = *impl_;
+    im.settings = settings;
+    const size_t G = groom.guideRoots.size(), F = groom.followerRoots.size();
+    im.guides = G;
+    im.followers = F;
+    const bool own = groom.followerShapes.count() > 0;
+
+    // --- Checks: every message names the strand and what is wrong.
+    if (groom.guideShapes.count() != G)
+        throw Error(cat("followers: ", G, " guide roots but ", groom.guideShapes.count(), " guide rest shapes"));
+    if (F > 0 && G == 0) throw Error("followers: followers need at least one guide");
+    if (own && groom.followerShapes.count() != F)
+        throw Error(cat("followers: ", F, " follower roots but ", groom.followerShapes.count(), " follower rest shapes"));
+    if (!own) {
+        if (groom.followerVertices.size() != 1 && groom.followerVertices.size() != F)
+            throw Error("followers: followerVertices needs one value or one per follower");
+        if (groom.followerLengths.size() != 1 && groom.followerLengths.size() != F)
+            throw Error("followers: followerLengths needs one value or one per follower");
+    }
+    if (!groom.followerIds.empty() && groom.followerIds.size() != F)
+        throw Error(cat("followers: ", groom.followerIds.size(), " follower ids for ", F, " followers"));
+    if (!(settings.fixedOffset >= 0.f && settings.fixedOffset <= 1.f) ||
+        !(settings.maxVelocity >= 0.f && settings.maxVelocity <= 1e3f))
+        throw Error("followers: fixed offset must be in [0, 1] and max velocity in [0, 1000] m/s");
+    if (!(settings.rootRadius >= 0.f) || !(settings.tipRadius >= 0.f))
+        throw Error("followers: radii must be non-negative");
+    for (size_t g = 0; g < G; ++g) checkShape(groom.guideShapes, g, "guide");
+    if (own)
+        for (size_t f = 0; f < F; ++f) checkShape(groom.followerShapes, f, "follower");
+
+    // --- Guides at rest: unit directions and inverse transported frames P_y⁻¹.
+    std::vector<Mat3d> guideFrames(G);
+    for (size_t g = 0; g < G; ++g) {
+        guideFrames[g] = restFrame(groom.guideRoots[g], "guide", g);
+        const uint32_t a = groom.guideShapes.offsets[g], b = groom.guideShapes.offsets[g + 1];
+        follower::Quat frame;
+        Vec3f previous = Vec3f::UnitY();
+        for (uint32_t k = a; k + 1 < b; ++k) {
+            const Vec3f d = (groom.guideShapes.points[k + 1] - groom.guideShapes.points[k]).normalized();
+            frame = follower::transportStep(frame, previous, d);
+            previous = d;
+            im.restInverse.push_back(follower::conjugate(frame));
+            im.guideRestDirs.push_back(d);
+        }
+        im.guideSegmentOffsets.push_back(uint32_t(im.restInverse.size()));
+    }
+
+    // --- Segment-count classes.
+    auto followerSegments = [&](size_t f) -> uint32_t {
+        return own ? groom.followerShapes.offsets[f + 1] - groom.followerShapes.offsets[f] - 1
+                   : perFollower(groom.followerVertices, f) - 1;
+    };
+    im.classOf.resize(F);
+    for (size_t f = 0; f < F; ++f) {
+        const uint32_t s = followerSegments(f);
+        if (s < 1 || s + 1 > kMaxFollowerVertices)
+            throw Error(cat("followers: follower ", f, " has ", s + 1, " vertices (2 to ", kMaxFollowerVertices,
+                            " supported)"));
+        auto it = std::find_if(im.classes.begin(), im.classes.end(), [&](const FollowerClass& c) { return c.segments == s; });
+        if (it == im.classes.end()) {
+            if (im.classes.size() == 255) throw Error("followers: more than 255 distinct follower vertex counts");
+            FollowerClass c;
+            c.segments = s;
+            c.pad = padTo8(s);
+            im.classes.push_back(std::move(c));
+            it = im.classes.end() - 1;
+        }
+        im.classOf[f] = uint8_t(it - im.classes.begin());
+    }
+    for (FollowerClass& c : im.classes) {
+        const uint32_t P = c.pad;
+        c.hot.assign(G * FollowerClass::kHot * P, 0.f);
+        c.cold.assign(G * (c.segments + 1) * FollowerClass::kCold, 0.f);
+        for (size_t g = 0; g < G; ++g) {
+            float* row = c.hot.data() + g * FollowerClass::kHot * P;
+            const uint32_t gs = im.guideSegmentOffsets[g + 1] - im.guideSegmentOffsets[g];
+            for (uint32_t y = 0; y < P; ++y) {
+                row[0 * P + y] = 1.f;  // identity rotation in the padding
+                const bool real = y < c.segments;
+                const Vec3f r = real ? im.guideRestDirs[im.guideSegmentOffsets[g] + FollowerClass::guideSegment(y, c.segments, gs)]
+                                     : Vec3f::UnitY();
+                row[5 * P + y] = r.x();
+                row[6 * P + y] = r.y();
+                row[7 * P + y] = r.z();
+            }
+        }
+        c.df.resize(P);
+        for (uint32_t y = 0; y < P; ++y) c.df[y] = follower::fixedOffsetCurve(float(y), float(c.segments));
+        c.radii.resize(c.segments + 1);
+        for (uint32_t v = 0; v <= c.segments; ++v)
+            c.radii[v] = taperedRadius(settings.rootRadius, settings.tipRadius, float(v) / float(c.segments));
+    }
+
+    // --- Neighbours (grid search, in parallel; each follower independent).
+    std::vector<Vec3f> guideRootPositions(G);
+    for (size_t g = 0; g < G; ++g) guideRootPositions[g] = groom.guideRoots[g].position;
+    const PointGrid grid(std::move(guideRootPositions));
+    const bool byShape = settings.neighbours == NeighbourRule::ShapeSimilarity;
+    const int k = byShape ? std::clamp(settings.shapeCandidates, 2, 64) : 2;
+
+    im.neighbours.resize(F);
+    im.weight.resize(F);
+    im.alignC.resize(F);
+    im.alignS.resize(F);
+    im.twistC.resize(F);
+    im.twistS.resize(F);
+    im.segmentLength.assign(F, 0.f);
+    im.ownRest.assign(F, Impl::kNone);
+    im.vertexOffset.resize(F + 1);
+    im.vertexOffset[0] = 0;
+    for (size_t f = 0; f < F; ++f) im.vertexOffset[f + 1] = im.vertexOffset[f] + followerSegments(f) + 1;
+    if (own) {
+        size_t total = 0;
+        for (size_t f = 0; f < F; ++f) {
+            im.ownRest[f] = uint32_t(total);
+            total += 4 * size_t(im.classes[im.classOf[f]].pad);
+        }
+        if (total > 0xffffffffu) throw Error("followers: too many follower rest vertices");
+        im.ownRestData.assign(total, 0.f);
+    }
+
+    // Mean squared difference of unit rest directions, `b` carried into `a`'s
+    // frame; `aDirs(y)` gives a's direction of its segment y of `segs`.
+    auto shapeDistance = [&](auto aDirs, uint32_t segs, const Mat3d& aFrame, size_t b) {
+        const double phi = twistAngle(guideFrames[b], aFrame);
+        const uint32_t bs = im.guideSegmentOffsets[b + 1] - im.guideSegmentOffsets[b];
+        double sum = 0.0;
+        for (uint32_t y = 0; y < segs; ++y) {
+            const Vec3d rb = rotateY(phi, im.guideRestDirs[im.guideSegmentOffsets[b] + FollowerClass::guideSegment(y, segs, bs)].cast<double>());
+            sum += (aDirs(y) - rb).squaredNorm();
+        }
+        return sum / double(segs);
+    };
+    constexpr double kSameShape = 1e-4;  // below this (≈0.6° rms) shapes count as equal; the nearer root wins
+
+    // Frames and lengths are checked serially first, so the first bad follower is the one reported.
+    std::vector<Mat3d> followerFrames(F);
+    for (size_t f = 0; f < F; ++f) {
+        followerFrames[f] = restFrame(groom.followerRoots[f], "follower", f);
+        if (!own) {
+            const float length = perFollower(groom.followerLengths, f);
+            if (!(length > 0.f) || !std::isfinite(length))
+                throw Error(cat("followers: follower ", f, " has length ", length, " (must be > 0)"));
+        }
+    }
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, F, 512), [&](const tbb::blocked_range<size_t>& range) {
+        uint32_t idx[64];
+        float d2[64];
+        for (size_t f = range.begin(); f != range.end(); ++f) {
+            const Mat3d& Rf = followerFrames[f];
+            const int found = grid.nearest(groom.followerRoots[f].position, k, idx, d2);
+            uint32_t g1 = idx[0], g2 = found > 1 ? idx[1] : idx[0];
+            const uint32_t segs = followerSegments(f);
+            if (byShape && found > 2) {
+                // Own rest shape: rank candidates by similarity to it. Without:
+                // keep the nearest, pick the second most like the first.
+                struct Cand { double shape; float d2; uint32_t i; };
+                Cand cands[64];
+                int n = 0;
+                for (int j = own ? 0 : 1; j < found; ++j) {
+                    double s;
+                    if (own) {
+                        const uint32_t a = groom.followerShapes.offsets[f];
+                        auto dirs = [&](uint32_t y) {
+                            return Vec3d((groom.followerShapes.points[a + y + 1] - groom.followerShapes.points[a + y]).cast<double>().normalized());
+                        };
+                        s = shapeDistance(dirs, segs, Rf, idx[j]);
+                    } else {
+                        const uint32_t gs = im.guideSegmentOffsets[g1 + 1] - im.guideSegmentOffsets[g1];
+                        auto dirs = [&](uint32_t y) {
+                            return Vec3d(im.guideRestDirs[im.guideSegmentOffsets[g1] + FollowerClass::guideSegment(y, gs, gs)].cast<double>());
+                        };
+                        s = shapeDistance(dirs, gs, guideFrames[g1], idx[j]);
+                    }
+                    cands[n++] = {s < kSameShape ? 0.0 : s, d2[j], idx[j]};
+                }
+                std::stable_sort(cands, cands + n, [](const Cand& a, const Cand& b) {
+                    if (a.shape != b.shape) return a.shape < b.shape;
+                    if (a.d2 != b.d2) return a.d2 < b.d2;
+                    return a.i < b.i;
+                });
+                if (own) { g1 = cands[0].i; g2 = cands[1].i; }
+                else g2 = cands[0].i;
+            }
+            FollowerNeighbours& nb = im.neighbours[f];
+            nb.guide1 = g1;
+            nb.guide2 = g2;
+            nb.distance1 = std::sqrt(distance2(groom.followerRoots[f].position, groom.guideRoots[g1].position));
+            nb.distance2 = std::sqrt(distance2(groom.followerRoots[f].position, groom.guideRoots[g2].position));
+            im.weight[f] = follower::interpolationWeight(nb.distance1, nb.distance2);
+
+            // Twist alignment: the follower's effective frame is guide 1's
+            // frame carried to it; guide 2's rotations are turned into guide 1's frame.
+            const double phiF = twistAngle(guideFrames[g1], Rf);
+            im.alignC[f] = float(std::cos(phiF));
+            im.alignS[f] = float(std::sin(phiF));
+            const double phiK = twistAngle(guideFrames[g2], guideFrames[g1]);
+            im.twistC[f] = float(std::cos(phiK));
+            im.twistS[f] = float(std::sin(phiK));
+
+            const FollowerClass& c = im.classes[im.classOf[f]];
+            if (own) {
+                // Rest directions in the effective frame: f' = R_y(φ)ᵀ f.
+                float* out = im.ownRestData.data() + im.ownRest[f];
+                const uint32_t a = groom.followerShapes.offsets[f];
+                for (uint32_t y = 0; y < c.pad; ++y) {
+                    Vec3d d = Vec3d::UnitY();
+                    double len = 0.0;
+                    if (y < segs) {
+                        d = (groom.followerShapes.points[a + y + 1] - groom.followerShapes.points[a + y]).cast<double>();
+                        len = d.norm();
+                        d = rotateY(-phiF, d / len);
+                    }
+                    out[0 * c.pad + y] = float(d.x());
+                    out[1 * c.pad + y] = float(d.y());
+                    out[2 * c.pad + y] = float(d.z());
+                    out[3 * c.pad + y] = float(len);
+                }
+            } else {
+                im.segmentLength[f] = perFollower(groom.followerLengths, f) / float(segs);
+            }
+        }
+    });
+
+    im.ids.resize(F);
+    for (size_t f = 0; f < F; ++f) im.ids[f] = groom.followerIds.empty() ? uint32_t(G + f) : groom.followerIds[f];
+    im.order.resize(F);
+    std::iota(im.order.begin(), im.order.end(), 0u);
+    // Followers are processed in index order: their roots, per-follower
+    // tables and output vertices then stream through memory (sorting by guide
+    // made every one of those a cache miss, 4x slower at 100k followers).
+    // Only distinct vertex counts are grouped, keeping each range's loop uniform.
+    std::stable_sort(im.order.begin(), im.order.end(),
+                     [&](uint32_t a, uint32_t b) { return im.classOf[a] < im.classOf[b]; });
+}
+
+Followers::~Followers() = default;
+Followers::Followers(Followers&&) noexcept = default;
+Followers& Followers::operator=(Followers&&) noexcept = default;
+
+size_t Followers::guideCount() const { return impl_->guides; }
+size_t Followers::followerCount() const { return impl_->followers; }
+const FollowerSettings& Followers::settings() const { return impl_->settings; }
+const FollowerNeighbours& Followers::neighbours(size_t follower) const { return impl_->neighbours.at(follower); }
+
+}  // namespace hp

@@ -1,0 +1,754 @@
+// Follower strands (sim/followers.h): kernels, neighbour selection, the three
+// modes against shapes computed independently, thread independence, lengths,
+// velocities and head collision.
+#include "core/errors.h"
+#include "pipeline/follower_settings.h"
+#include "sim/follower_kernels.h"
+#include "sim/follower_neighbours.h"
+#include "sim/followers.h"
+#include "sim/synthetic_groom.h"
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <numeric>
+#include <random>
+
+using namespace hp;
+
+namespace {
+
+SurfaceFrame frameAt(const Vec3f& position, const Vec3f& normal, const Vec3f& tangent) {
+    SurfaceFrame f;
+    f.position = position;
+    f.normal = normal.normalized();
+    f.tangent = (tangent - f.normal * f.normal.dot(tangent)).normalized();
+    return f;
+}
+
+SurfaceFrame rotated(const SurfaceFrame& f, const Eigen::Quaternionf& q, const Vec3f& position) {
+    return frameAt(position, q * f.normal, q * f.tangent);
+}
+
+StrandFrame guideFrame(const std::vector<std::vector<Vec3f>>& strands, const Vec3f& velocity = Vec3f::Zero()) {
+    StrandFrame f;
+    for (size_t s = 0; s < strands.size(); ++s) {
+        const std::vector<float> r(strands[s].size(), 1e-4f);
+        const std::vector<Vec3f> v(strands[s].size(), velocity);
+        f.addStrand(uint32_t(s), strands[s].data(), r.data(), strands[s].size(), v.data());
+    }
+    f.guideCount = uint32_t(strands.size());
+    return f;
+}
+
+/// A planar strand from `root`: segment y leaves at angle theta(y) from +Y toward +X.
+template <typename Angle>
+std::vector<Vec3f> planarStrand(const Vec3f& root, int segments, float length, Angle theta) {
+    std::vector<Vec3f> p{root};
+    for (int y = 0; y < segments; ++y)
+        p.push_back(p.back() + length * Vec3f(std::sin(theta(y)), std::cos(theta(y)), 0.f));
+    return p;
+}
+
+std::vector<Vec3f> strandOf(const StrandFrame& f, size_t s) {
+    return {f.positions.begin() + f.first(s), f.positions.begin() + f.offsets[s + 1]};
+}
+
+float maxDistance(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b) {
+    EXPECT_EQ(a.size(), b.size());
+    float m = 0.f;
+    for (size_t i = 0; i < std::min(a.size(), b.size()); ++i) m = std::max(m, (a[i] - b[i]).norm());
+    return m;
+}
+
+/// One guide with frame `g` and current shape `shape`, one follower with rest frame `fRest`, current `fNow`.
+std::vector<Vec3f> singleFollower(const SurfaceFrame& g, const std::vector<Vec3f>& shape, const SurfaceFrame& fRest,
+                                  const SurfaceFrame& fNow, FollowerMode mode = FollowerMode::Cluster) {
+    FollowerGroom groom;
+    groom.guideRoots = {g};
+    groom.guideShapes = RestShapes::straight(1, int(shape.size()), 0.25f);
+    groom.followerRoots = {fRest};
+    groom.followerVertices = {uint32_t(shape.size())};
+    groom.followerLengths = {0.25f};
+    FollowerSettings settings;
+    settings.mode = mode;
+    Followers followers(groom, settings);
+    const StrandFrame guides = guideFrame({shape});
+    StrandFrame out;
+    followers.update({guides, {g}, {fNow}}, out);
+    return strandOf(out, 1);
+}
+
+std::vector<Vec3f> bentShape(const SurfaceFrame& g, int vertices) {
+    const float L = 0.25f / float(vertices - 1);
+    const Vec3f z = g.tangent.cross(g.normal);
+    std::vector<Vec3f> p{g.position};
+    for (int y = 0; y + 1 < vertices; ++y) {
+        const float a = 0.09f * y, b = 0.3f * std::sin(0.4f * y);
+        const Vec3f d = std::sin(a) * std::cos(b) * g.tangent + std::cos(a) * g.normal + std::sin(a) * std::sin(b) * z;
+        p.push_back(p.back() + L * d.normalized());
+    }
+    return p;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// Kernels
+
+TEST(FollowerKernels, FixedOffsetIsZeroAtRootAndTipAndOneInTheMiddle) {
+    // The seed: 23 segments, qs = 23 / 2 = 11 in integer arithmetic = (23 - 1) / 2.
+    EXPECT_EQ(follower::fixedOffsetCurve(0, 23), 0.f);
+    EXPECT_EQ(follower::fixedOffsetCurve(22, 23), 0.f);  // y = 2 qs, the tip segment
+    EXPECT_EQ(follower::fixedOffsetCurve(11, 23), 1.f);
+    for (int y = 0; y < 23; ++y) {
+        EXPECT_FLOAT_EQ(follower::fixedOffsetCurve(float(y), 23), follower::fixedOffsetCurve(float(22 - y), 23));
+        if (y < 11) {
+            EXPECT_LT(follower::fixedOffsetCurve(float(y), 23), follower::fixedOffsetCurve(float(y + 1), 23));
+        }
+    }
+    // Even counts stay symmetric: 0 at both ends, the two middle segments equal and maximal.
+    EXPECT_EQ(follower::fixedOffsetCurve(0, 24), 0.f);
+    EXPECT_EQ(follower::fixedOffsetCurve(23, 24), 0.f);
+    EXPECT_FLOAT_EQ(follower::fixedOffsetCurve(11, 24), follower::fixedOffsetCurve(12, 24));
+    EXPECT_GT(follower::fixedOffsetCurve(11, 24), follower::fixedOffsetCurve(10, 24));
+    EXPECT_EQ(follower::fixedOffsetCurve(0, 1), 0.f);
+}
+
+TEST(FollowerKernels, SlerpSeriesMatchesExactSlerp) {
+    std::mt19937 rng(7);
+    std::normal_distribution<double> n;
+    std::uniform_real_distribution<double> ut(-0.5, 1.5);
+    double worst = 0, worstNear = 0;
+    for (int i = 0; i < 20000; ++i) {
+        Eigen::Quaterniond a(n(rng), n(rng), n(rng), n(rng)), b(n(rng), n(rng), n(rng), n(rng));
+        a.normalize();
+        b.normalize();
+        if (i % 2) b = Eigen::Quaterniond(a.coeffs() + 0.3 * b.coeffs()).normalized();  // nearby pairs
+        const double t = ut(rng);
+        // Exact slerp along the shorter arc, extrapolating outside [0, 1].
+        double d = a.dot(b);
+        Eigen::Vector4d bc = b.coeffs();
+        if (d < 0) { d = -d; bc = -bc; }
+        const double th = std::acos(std::min(1.0, d));
+        const Eigen::Vector4d exact = th < 1e-9 ? Eigen::Vector4d(a.coeffs())
+                                                : Eigen::Vector4d((std::sin((1 - t) * th) * a.coeffs() + std::sin(t * th) * bc) / std::sin(th));
+        float c0, c1;
+        follower::slerpWeights(float(a.dot(b)), float(t), c0, c1);
+        const Eigen::Vector4d got = double(c0) * a.coeffs().cast<float>().cast<double>() + double(c1) * b.coeffs().cast<float>().cast<double>();
+        const double err = (got - exact).norm();
+        worst = std::max(worst, err);
+        if (d >= 0.7) worstNear = std::max(worstNear, err);
+    }
+    EXPECT_LT(worst, 1e-4);
+    EXPECT_LT(worstNear, 2e-6);
+}
+
+TEST(FollowerKernels, SegmentRandomIsFixedUniformAndDecorrelated) {
+    const uint32_t a = follower::followerHash(1, 10), b = follower::followerHash(2, 10), c = follower::followerHash(1, 11);
+    double sum = 0, sum2 = 0;
+    int differ = 0;
+    float lo = 1, hi = -1;
+    for (uint32_t y = 0; y < 20000; ++y) {
+        const float r = follower::segmentRandom(a, y);
+        EXPECT_EQ(r, follower::segmentRandom(follower::followerHash(1, 10), y));
+        lo = std::min(lo, r);
+        hi = std::max(hi, r);
+        sum += r;
+        sum2 += r * r;
+        differ += r != follower::segmentRandom(b, y) && r != follower::segmentRandom(c, y);
+    }
+    EXPECT_GE(lo, -1.f);
+    EXPECT_LT(hi, 1.f);
+    EXPECT_LT(lo, -0.99f);
+    EXPECT_GT(hi, 0.99f);
+    EXPECT_NEAR(sum / 20000, 0.0, 0.02);
+    EXPECT_NEAR(sum2 / 20000, 1.0 / 3.0, 0.02);  // uniform on [-1, 1]
+    EXPECT_GT(differ, 19990);
+}
+
+// ---------------------------------------------------------------------------
+// Neighbours
+
+TEST(FollowerNeighbours, GridEqualsBruteForce) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    for (int set = 0; set < 3; ++set) {
+        std::vector<Vec3f> pts;
+        const int n = set == 0 ? 845 : set == 1 ? 50 : 3000;
+        for (int i = 0; i < n; ++i) {
+            Vec3f p(u(rng), u(rng), u(rng));
+            if (set != 1) p = 0.1f * p.normalized();  // on a sphere, like scalp roots
+            pts.push_back(p);
+        }
+        for (int i = 0; i < 20; ++i) pts.push_back(pts[i * 7]);  // exact duplicates: ties by index
+        const PointGrid grid(pts);
+        for (int q = 0; q < 2000; ++q) {
+            const Vec3f query = q % 10 == 0 ? Vec3f(3.f * u(rng), 3.f * u(rng), 3.f * u(rng))   // outside the grid
+                                : q % 10 == 1 ? pts[q % pts.size()]                               // on a point
+                                : Vec3f(0.11f * Vec3f(u(rng), u(rng), u(rng)).normalized());
+            std::vector<uint32_t> brute(pts.size());
+            std::iota(brute.begin(), brute.end(), 0u);
+            std::sort(brute.begin(), brute.end(), [&](uint32_t a, uint32_t b) {
+                const float da = distance2(query, pts[a]), db = distance2(query, pts[b]);
+                return da != db ? da < db : a < b;
+            });
+            for (int k : {1, 2, 8}) {
+                uint32_t idx[8];
+                float d2[8];
+                ASSERT_EQ(grid.nearest(query, k, idx, d2), k);
+                for (int j = 0; j < k; ++j) {
+                    ASSERT_EQ(idx[j], brute[j]) << "set " << set << " query " << q << " k " << k << " rank " << j;
+                    ASSERT_EQ(d2[j], distance2(query, pts[brute[j]]));
+                }
+            }
+        }
+    }
+}
+
+TEST(FollowerNeighbours, FollowersUseTheTwoNearestGuideRootsInOrder) {
+    SphereGroomSettings s;
+    s.guides = 94;
+    s.followers = 751;
+    const FollowerGroom groom = makeSphereGroom(s);
+    const Followers followers(groom, {});
+    for (size_t f = 0; f < groom.followerRoots.size(); ++f) {
+        std::vector<std::pair<float, uint32_t>> d;
+        for (uint32_t g = 0; g < groom.guideRoots.size(); ++g)
+            d.emplace_back(distance2(groom.followerRoots[f].position, groom.guideRoots[g].position), g);
+        std::sort(d.begin(), d.end());
+        EXPECT_EQ(followers.neighbours(f).guide1, d[0].second);
+        EXPECT_EQ(followers.neighbours(f).guide2, d[1].second);
+        EXPECT_LE(followers.neighbours(f).distance1, followers.neighbours(f).distance2);
+    }
+}
+
+TEST(FollowerNeighbours, ShapeSimilarityPicksGuidesOfTheSameStyle) {
+    // Guides in a row, styles alternating: even ones comb toward +x, odd toward -x.
+    FollowerGroom groom;
+    auto combed = [](float side) {
+        std::vector<Vec3f> p{Vec3f::Zero()};
+        for (int y = 0; y < 11; ++y) p.push_back(p.back() + 0.02f * Vec3f(side * 0.08f * y, 1.f, 0.f).normalized());
+        return p;
+    };
+    for (int g = 0; g < 20; ++g) {
+        groom.guideRoots.push_back(frameAt(Vec3f(0.01f * g, 0, 0), Vec3f::UnitY(), Vec3f::UnitX()));
+        const auto shape = combed(g % 2 ? -1.f : 1.f);
+        groom.guideShapes.add(shape.data(), shape.size());
+    }
+    // Followers next to even guides but combed like the odd ones.
+    for (int f = 0; f < 8; ++f) {
+        groom.followerRoots.push_back(frameAt(Vec3f(0.02f * (f + 2) + 0.001f, 0, 0.0005f), Vec3f::UnitY(), Vec3f::UnitX()));
+        const auto shape = combed(-1.f);
+        groom.followerShapes.add(shape.data(), shape.size());
+    }
+    FollowerSettings nearest, similar;
+    similar.neighbours = NeighbourRule::ShapeSimilarity;
+    const Followers a(groom, nearest), b(groom, similar);
+    for (size_t f = 0; f < groom.followerRoots.size(); ++f) {
+        EXPECT_EQ(a.neighbours(f).guide1 % 2, 0u) << "the nearest root is an even guide";
+        EXPECT_EQ(b.neighbours(f).guide1 % 2, 1u);
+        EXPECT_EQ(b.neighbours(f).guide2 % 2, 1u);
+    }
+    // Without own shapes: keep the nearest guide, take the second of its style.
+    groom.followerShapes = RestShapes();
+    groom.followerVertices = {12};
+    groom.followerLengths = {0.22f};
+    const Followers c(groom, similar);
+    for (size_t f = 0; f < groom.followerRoots.size(); ++f) {
+        EXPECT_EQ(c.neighbours(f).guide1, a.neighbours(f).guide1);
+        EXPECT_EQ(c.neighbours(f).guide2 % 2, 0u);
+        EXPECT_NE(c.neighbours(f).guide2, c.neighbours(f).guide1);
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Modes
+
+TEST(Followers, ClusterIsTheGuideMovedToTheFollowersRoot) {
+    const SurfaceFrame g = frameAt(Vec3f(0.01f, 0.1f, 0.f), Vec3f(0.1f, 1.f, 0.f), Vec3f(1.f, 0.f, 0.3f));
+    const std::vector<Vec3f> shape = bentShape(g, 24);
+    // Same frame, other place: the guide translated.
+    const Vec3f offset(0.004f, -0.001f, 0.006f);
+    SurfaceFrame f = g;
+    f.position += offset;
+    std::vector<Vec3f> expected = shape;
+    for (Vec3f& p : expected) p += offset;
+    EXPECT_LT(maxDistance(singleFollower(g, shape, f, f), expected), 2e-6f);
+
+    // Frame tilted by a rotation about an axis across the normal: the guide rotated.
+    const Eigen::Quaternionf tilt(Eigen::AngleAxisf(0.5f, g.normal.cross(Vec3f(0.3f, 0.f, 1.f)).normalized()));
+    const SurfaceFrame ft = rotated(g, tilt, g.position + offset);
+    for (size_t i = 0; i < shape.size(); ++i) expected[i] = ft.position + tilt * (shape[i] - g.position);
+    EXPECT_LT(maxDistance(singleFollower(g, shape, ft, ft), expected), 2e-6f);
+
+    // The follower's frame turning now (rest frames equal): the shape turns with it.
+    const Eigen::Quaternionf spin(Eigen::AngleAxisf(0.7f, g.normal));
+    const SurfaceFrame fs = rotated(f, spin, f.position);
+    for (size_t i = 0; i < shape.size(); ++i) expected[i] = f.position + spin * (shape[i] - g.position);
+    EXPECT_LT(maxDistance(singleFollower(g, shape, f, fs), expected), 2e-6f);
+}
+
+TEST(Followers, RestTangentsDoNotTwistFollowers) {
+    // Mesh tangents follow triangle edges and differ between neighbours; a
+    // follower whose rest tangent is turned 45° still copies the guide unturned.
+    const SurfaceFrame g = frameAt(Vec3f(0, 0.1f, 0), Vec3f::UnitY(), Vec3f::UnitX());
+    const std::vector<Vec3f> shape = bentShape(g, 24);
+    const Vec3f offset(0.005f, 0.f, 0.f);
+    const Eigen::Quaternionf turn(Eigen::AngleAxisf(float(M_PI / 4), Vec3f::UnitY()));
+    const SurfaceFrame f = rotated(g, turn, g.position + offset);
+    std::vector<Vec3f> expected = shape;
+    for (Vec3f& p : expected) p += offset;
+    EXPECT_LT(maxDistance(singleFollower(g, shape, f, f), expected), 2e-6f);
+    EXPECT_LT(maxDistance(singleFollower(g, shape, f, f, FollowerMode::Varied), expected), 2e-6f)
+        << "one guide: varied slerps the guide with itself";
+}
+
+TEST(Followers, FixedOffsetShapeWithStillGuidesAndDistanceWeightWhenInterpolating) {
+    // Two guides bent in the XY plane (frames: normal +Y, tangent +X), so every
+    // segment rotation is about Z and slerp is a blend of angles:
+    // follower angle(y) = (1 - w) θ1(y) + w θ2(y).
+    const int S = 23;
+    const float L = 0.25f / S;
+    auto th1 = [](int y) { return 0.05f * y; };
+    auto th2 = [](int y) { return 0.02f * y + 0.3f * std::sin(0.3f * y); };
+    const SurfaceFrame g1 = frameAt(Vec3f::Zero(), Vec3f::UnitY(), Vec3f::UnitX());
+    const SurfaceFrame g2 = frameAt(Vec3f(0.02f, 0, 0), Vec3f::UnitY(), Vec3f::UnitX());
+    const SurfaceFrame f = frameAt(Vec3f(0.005f, 0, 0), Vec3f::UnitY(), Vec3f::UnitX());
+    FollowerGroom groom;
+    groom.guideRoots = {g1, g2};
+    groom.guideShapes = RestShapes::straight(2, S + 1, 0.25f);
+    groom.followerRoots = {f};
+    const StrandFrame still = guideFrame({planarStrand(g1.position, S, L, th1), planarStrand(g2.position, S, L, th2)});
+
+    for (FollowerMode mode : {FollowerMode::Varied, FollowerMode::Interpolate}) {
+        FollowerSettings settings;
+        settings.mode = mode;
+        Followers followers(groom, settings);
+        StrandFrame out;
+        followers.update({still, {g1, g2}, {f}}, out);
+        auto weight = [&](int y) {
+            return mode == FollowerMode::Varied ? 0.2f * follower::fixedOffsetCurve(float(y), S) : 0.005f / 0.02f;
+        };
+        const std::vector<Vec3f> expected =
+            planarStrand(f.position, S, L, [&](int y) { return (1 - weight(y)) * th1(y) + weight(y) * th2(y); });
+        EXPECT_LT(maxDistance(strandOf(out, 2), expected), 2e-6f);
+        if (mode == FollowerMode::Varied) {
+            // d_f = 0 at root and tip: those segments are guide 1's.
+            const auto p = strandOf(out, 2);
+            EXPECT_LT(((p[1] - p[0]) - (still.positions[1] - still.positions[0])).norm(), 1e-7f);
+            EXPECT_LT(((p[S] - p[S - 1]) - (still.positions[S] - still.positions[S - 1])).norm(), 1e-7f);
+        }
+    }
+
+    // Moving guides: each segment's weight varies by at most d_v = min(|v1|, 0.1) around 0.2 d_f.
+    for (float speed : {0.03f, 2.f}) {
+        Followers followers(groom, {});
+        const StrandFrame moving = guideFrame({planarStrand(g1.position, S, L, th1), planarStrand(g2.position, S, L, th2)},
+                                              Vec3f(0, 0, speed));
+        StrandFrame out;
+        followers.update({moving, {g1, g2}, {f}}, out);
+        const auto p = strandOf(out, 2);
+        float largest = 0;
+        for (int y = 1; y < S; ++y) {
+            const Vec3f d = (p[y + 1] - p[y]) / L;
+            const float angle = std::atan2(d.x(), d.y());
+            const float w = (angle - th1(y)) / (th2(y) - th1(y));
+            const float dev = w - 0.2f * follower::fixedOffsetCurve(float(y), S);
+            EXPECT_LE(std::abs(dev), std::min(speed, 0.1f) * 1.001f + 1e-4f) << "segment " << y;
+            largest = std::max(largest, std::abs(dev));
+        }
+        EXPECT_GT(largest, 0.5f * std::min(speed, 0.1f)) << "the variation is switched on by guide speed";
+    }
+}
+
+TEST(Followers, AtRestFollowersKeepTheGroomsShape) {
+    SphereGroomSettings s;
+    s.guides = 94;
+    s.followers = 751;
+    FollowerGroom groom = makeSphereGroom(s);
+    // A curved rest style shared by all guides (in each root frame).
+    std::vector<Vec3f> style{Vec3f::Zero()};
+    for (int y = 0; y < 23; ++y) style.push_back(style.back() + (0.25f / 23) * Vec3f(0.06f * y, 1.f, -0.02f * y).normalized());
+    groom.guideShapes = RestShapes();
+    for (size_t g = 0; g < groom.guideRoots.size(); ++g) groom.guideShapes.add(style.data(), style.size());
+    Followers followers(groom, {});  // varied
+    StrandFrame guides;
+    for (size_t g = 0; g < groom.guideRoots.size(); ++g) {
+        const SurfaceFrame& r = groom.guideRoots[g];
+        std::vector<Vec3f> p;
+        for (const Vec3f& l : style) p.push_back(r.position + l.x() * r.tangent + l.y() * r.normal + l.z() * r.tangent.cross(r.normal));
+        const std::vector<float> radius(p.size(), 1e-4f);
+        guides.addStrand(uint32_t(g), p.data(), radius.data(), p.size());
+    }
+    StrandFrame out;
+    followers.update({guides, groom.guideRoots, groom.followerRoots}, out);
+    // Expected: the nearest guide carried to the follower's root by the minimal rotation between the normals.
+    float worst = 0;
+    for (size_t f = 0; f < groom.followerRoots.size(); ++f) {
+        const uint32_t g = followers.neighbours(f).guide1;
+        const Eigen::Quaternionf carry = Eigen::Quaternionf::FromTwoVectors(groom.guideRoots[g].normal, groom.followerRoots[f].normal);
+        std::vector<Vec3f> expected;
+        for (size_t k = 0; k < style.size(); ++k)
+            expected.push_back(groom.followerRoots[f].position + carry * (guides.positions[guides.first(g) + k] - groom.guideRoots[g].position));
+        worst = std::max(worst, maxDistance(strandOf(out, groom.guideRoots.size() + f), expected));
+    }
+    EXPECT_LT(worst, 2e-6f);
+}
+
+TEST(Followers, OwnRestShapesAreKeptAtRestInTheirOwnFrames) {
+    // Followers with their own (curly, uneven) rest shapes, given in their own
+    // mesh root frames, and guides at rest: every follower is its rest shape.
+    SphereGroomSettings s;
+    s.guides = 94;
+    s.followers = 751;
+    FollowerGroom groom = makeSphereGroom(s);
+    for (size_t f = 0; f < groom.followerRoots.size(); ++f) {
+        std::vector<Vec3f> p{Vec3f::Zero()};
+        for (int y = 0; y < 20; ++y)
+            p.push_back(p.back() + (0.004f + 0.0005f * float((y + f) % 3)) *
+                                       Vec3f(std::cos(0.9f * y + f), 1.2f, std::sin(0.9f * y + f)).normalized());
+        groom.followerShapes.add(p.data(), p.size());
+    }
+    StrandFrame guides;
+    for (size_t g = 0; g < groom.guideRoots.size(); ++g) {
+        std::vector<Vec3f> p;
+        for (uint32_t k = groom.guideShapes.offsets[g]; k < groom.guideShapes.offsets[g + 1]; ++k)
+            p.push_back(groom.guideRoots[g].position + groom.guideShapes.points[k].y() * groom.guideRoots[g].normal);
+        const std::vector<float> r(p.size(), 1e-4f);
+        guides.addStrand(uint32_t(g), p.data(), r.data(), p.size());
+    }
+    for (FollowerMode mode : {FollowerMode::Varied, FollowerMode::Interpolate, FollowerMode::Cluster}) {
+        FollowerSettings settings;
+        settings.mode = mode;
+        Followers followers(groom, settings);
+        StrandFrame out;
+        followers.update({guides, groom.guideRoots, groom.followerRoots}, out);
+        float worst = 0;
+        for (size_t f = 0; f < groom.followerRoots.size(); ++f) {
+            const SurfaceFrame& r = groom.followerRoots[f];
+            std::vector<Vec3f> expected;
+            for (uint32_t k = groom.followerShapes.offsets[f]; k < groom.followerShapes.offsets[f + 1]; ++k) {
+                const Vec3f& l = groom.followerShapes.points[k];
+                expected.push_back(r.position + l.x() * r.tangent + l.y() * r.normal + l.z() * r.tangent.cross(r.normal));
+            }
+            worst = std::max(worst, maxDistance(strandOf(out, groom.guideRoots.size() + f), expected));
+        }
+        EXPECT_LT(worst, 1e-6f) << "mode " << int(mode);
+    }
+}
+
+TEST(Followers, RigidMotionOfTheWholeHeadMovesFollowersRigidly) {
+    SphereGroomSettings s;
+    s.guides = 94;
+    s.followers = 751;
+    const FollowerGroom groom = makeSphereGroom(s);
+    SyntheticGuideSettings gs;
+    gs.degreesPerSecond = 0;
+    const SyntheticGuides motion(groom, gs);
+    StrandFrame guides;
+    std::vector<SurfaceFrame> guideRoots;
+    motion.sample(0.4, guides, guideRoots);
+    const SphereCollider head(Vec3f::Zero(), 0.1f);
+    Followers followers(groom, {});
+    StrandFrame a, b;
+    followers.update({guides, guideRoots, groom.followerRoots, &head}, a);
+
+    const Eigen::Quaternionf q = Eigen::Quaternionf(Eigen::AngleAxisf(1.1f, Vec3f(0.3f, 1.f, -0.5f).normalized()));
+    for (Vec3f& p : guides.positions) p = q * p;
+    for (Vec3f& v : guides.velocities) v = q * v;
+    std::vector<SurfaceFrame> guideRootsQ, followerRootsQ;
+    rotateRoots(guideRoots, q, guideRootsQ);
+    rotateRoots(groom.followerRoots, q, followerRootsQ);
+    followers.update({guides, guideRootsQ, followerRootsQ, &head}, b);
+    float worstP = 0, worstV = 0;
+    for (size_t i = a.offsets[a.guideCount]; i < a.vertexCount(); ++i) {
+        worstP = std::max(worstP, (q * a.positions[i] - b.positions[i]).norm());
+        worstV = std::max(worstV, (q * a.velocities[i] - b.velocities[i]).norm());
+    }
+    EXPECT_LT(worstP, 1e-5f);
+    EXPECT_LT(worstV, 1e-4f);
+}
+
+// ---------------------------------------------------------------------------
+// Determinism, lengths, velocities, collision, errors
+
+TEST(Followers, SameBitsOnOneAndTwoThreadsAndSerial) {
+    SphereGroomSettings s;
+    s.guides = 200;
+    s.followers = 6000;
+    const FollowerGroom groom = makeSphereGroom(s);
+    const SyntheticGuides motion(groom, {});
+    const SphereCollider head(Vec3f::Zero(), 0.1f);
+    auto run = [&](int threads, bool parallel, FollowerMode mode) {
+        FollowerSettings settings;
+        settings.parallel = parallel;
+        settings.mode = mode;
+        Followers followers(groom, settings);
+        StrandFrame guides, out;
+        std::vector<SurfaceFrame> guideRoots, followerRoots;
+        size_t projected = 0;
+        tbb::task_arena arena(threads);
+        arena.execute([&] {
+            for (int step = 0; step < 3; ++step) {
+                const double t = 0.3 + 0.02 * step;
+                motion.sample(t, guides, guideRoots);
+                rotateRoots(groom.followerRoots, motion.headRotation(t), followerRoots);
+                projected += followers.update({guides, guideRoots, followerRoots, &head, step ? 0.02 : 0.0}, out).projected;
+            }
+        });
+        return std::make_pair(out, projected);
+    };
+    for (FollowerMode mode : {FollowerMode::Varied, FollowerMode::Interpolate, FollowerMode::Cluster}) {
+        const auto one = run(1, true, mode), two = run(2, true, mode), serial = run(2, false, mode);
+        ASSERT_EQ(one.first.positions.size(), two.first.positions.size());
+        const size_t bytes = one.first.positions.size() * sizeof(Vec3f);
+        EXPECT_EQ(std::memcmp(one.first.positions.data(), two.first.positions.data(), bytes), 0);
+        EXPECT_EQ(std::memcmp(one.first.velocities.data(), two.first.velocities.data(), bytes), 0);
+        EXPECT_EQ(std::memcmp(one.first.positions.data(), serial.first.positions.data(), bytes), 0);
+        EXPECT_EQ(one.second, two.second);
+        EXPECT_NO_THROW(two.first.validate());
+    }
+}
+
+TEST(Followers, SegmentLengthsArePreserved) {
+    SphereGroomSettings s;
+    s.guides = 60;
+    s.followers = 900;
+    FollowerGroom groom = makeSphereGroom(s);
+    // Three vertex counts (resampled guide tables) and per-follower lengths.
+    groom.followerVertices.clear();
+    groom.followerLengths.clear();
+    for (size_t f = 0; f < groom.followerRoots.size(); ++f) {
+        groom.followerVertices.push_back(f % 3 == 0 ? 24 : f % 3 == 1 ? 13 : 40);
+        groom.followerLengths.push_back(0.15f + 0.1f * float(f % 7) / 6.f);
+    }
+    const SyntheticGuides motion(groom, {});
+    StrandFrame guides;
+    std::vector<SurfaceFrame> guideRoots, followerRoots;
+    motion.sample(0.7, guides, guideRoots);
+    rotateRoots(groom.followerRoots, motion.headRotation(0.7), followerRoots);
+    for (FollowerMode mode : {FollowerMode::Varied, FollowerMode::Interpolate, FollowerMode::Cluster}) {
+        FollowerSettings settings;
+        settings.mode = mode;
+        Followers followers(groom, settings);
+        StrandFrame out;
+        followers.update({guides, guideRoots, followerRoots}, out);
+        double worst = 0;
+        for (size_t f = 0; f < groom.followerRoots.size(); ++f) {
+            const auto p = strandOf(out, guides.strandCount() + f);
+            ASSERT_EQ(p.size(), groom.followerVertices[f]);
+            const float L = groom.followerLengths[f] / float(p.size() - 1);
+            for (size_t k = 1; k < p.size(); ++k) worst = std::max(worst, std::abs(double((p[k] - p[k - 1]).norm()) / L - 1.0));
+        }
+        EXPECT_LT(worst, 1e-5) << "mode " << int(mode);
+    }
+    // Own rest shapes with uneven segments.
+    groom.followerShapes = RestShapes();
+    std::vector<std::vector<float>> lengths;
+    for (size_t f = 0; f < groom.followerRoots.size(); ++f) {
+        std::vector<Vec3f> p{Vec3f::Zero()};
+        lengths.emplace_back();
+        for (int y = 0; y < 17; ++y) {
+            lengths.back().push_back(0.005f + 0.001f * float((y * 7 + f) % 5));
+            p.push_back(p.back() + lengths.back().back() * Vec3f(0.1f * std::sin(0.5f * y + f), 1.f, 0.f).normalized());
+        }
+        groom.followerShapes.add(p.data(), p.size());
+    }
+    Followers followers(groom, {});
+    StrandFrame out;
+    followers.update({guides, guideRoots, followerRoots}, out);
+    double worst = 0;
+    for (size_t f = 0; f < groom.followerRoots.size(); ++f) {
+        const auto p = strandOf(out, guides.strandCount() + f);
+        for (size_t k = 1; k < p.size(); ++k)
+            worst = std::max(worst, std::abs(double((p[k] - p[k - 1]).norm()) / lengths[f][k - 1] - 1.0));
+    }
+    EXPECT_LT(worst, 1e-5);
+}
+
+TEST(Followers, VelocitiesAreFiniteDifferencesOrGuideBlends) {
+    SphereGroomSettings s;
+    s.guides = 94;
+    s.followers = 751;
+    const FollowerGroom groom = makeSphereGroom(s);
+    // First update: no previous positions, a blend of guide velocities; with
+    // every guide moving at u, followers move at u.
+    FollowerSettings cluster;
+    cluster.mode = FollowerMode::Cluster;
+    Followers still(groom, cluster);
+    StrandFrame guides;
+    for (size_t g = 0; g < groom.guideRoots.size(); ++g) {
+        std::vector<Vec3f> p;
+        for (uint32_t k = groom.guideShapes.offsets[g]; k < groom.guideShapes.offsets[g + 1]; ++k)
+            p.push_back(groom.guideRoots[g].position + groom.guideShapes.points[k].y() * groom.guideRoots[g].normal);
+        const std::vector<float> r(p.size(), 1e-4f);
+        const std::vector<Vec3f> v(p.size(), Vec3f(0.1f, -0.2f, 0.3f));
+        guides.addStrand(uint32_t(g), p.data(), r.data(), p.size(), v.data());
+    }
+    StrandFrame out;
+    const FollowerStats first = still.update({guides, groom.guideRoots, groom.followerRoots}, out);
+    EXPECT_FALSE(first.differenceVelocities);
+    EXPECT_TRUE(first.layoutWritten);
+    for (size_t i = guides.vertexCount(); i < out.vertexCount(); ++i) EXPECT_EQ(out.velocities[i], Vec3f(0.1f, -0.2f, 0.3f));
+
+    // Later updates into the same frame: (x - x_prev) / dt.
+    const SyntheticGuides motion(groom, {});
+    Followers followers(groom, {});
+    std::vector<SurfaceFrame> guideRoots, followerRoots;
+    motion.sample(0.5, guides, guideRoots);
+    rotateRoots(groom.followerRoots, motion.headRotation(0.5), followerRoots);
+    followers.update({guides, guideRoots, followerRoots}, out);
+    const std::vector<Vec3f> before = out.positions;
+    motion.sample(0.52, guides, guideRoots);
+    rotateRoots(groom.followerRoots, motion.headRotation(0.52), followerRoots);
+    const FollowerStats second = followers.update({guides, guideRoots, followerRoots, nullptr, 0.02}, out);
+    EXPECT_TRUE(second.differenceVelocities);
+    EXPECT_FALSE(second.layoutWritten);
+    for (size_t i = guides.vertexCount(); i < out.vertexCount(); ++i)
+        ASSERT_LT((out.velocities[i] - (out.positions[i] - before[i]) / 0.02f).norm(), 1e-4f);
+    // A different frame object holds no previous positions: back to the blend.
+    StrandFrame other;
+    EXPECT_FALSE(followers.update({guides, guideRoots, followerRoots, nullptr, 0.02}, other).differenceVelocities);
+}
+
+TEST(Followers, InPlaceAppendEqualsSeparateOutput) {
+    SphereGroomSettings s;
+    s.guides = 94;
+    s.followers = 751;
+    const FollowerGroom groom = makeSphereGroom(s);
+    const SyntheticGuides motion(groom, {});
+    StrandFrame guides, out;
+    std::vector<SurfaceFrame> guideRoots, followerRoots;
+    motion.sample(0.2, guides, guideRoots);
+    rotateRoots(groom.followerRoots, motion.headRotation(0.2), followerRoots);
+    Followers followers(groom, {});
+    followers.update({guides, guideRoots, followerRoots}, out);
+    StrandFrame inPlace = guides;
+    followers.update({inPlace, guideRoots, followerRoots}, inPlace);
+    EXPECT_EQ(inPlace.positions, out.positions);
+    EXPECT_EQ(inPlace.radii, out.radii);
+    EXPECT_EQ(inPlace.ids, out.ids);
+    EXPECT_EQ(inPlace.offsets, out.offsets);
+    EXPECT_EQ(inPlace.guideCount, 94u);
+    // Radii taper from root to tip.
+    EXPECT_FLOAT_EQ(out.radii[out.first(100)], 0.00004f);
+    EXPECT_FLOAT_EQ(out.radii[out.offsets[101] - 1], 0.00001f);
+}
+
+TEST(Followers, CollisionLeavesNoVertexInsideTheHead) {
+    SphereGroomSettings s;
+    s.guides = 94;
+    s.followers = 2000;
+    const FollowerGroom groom = makeSphereGroom(s);
+    // Guides lie over the head and differ a lot between neighbours at the
+    // crown, so interpolated followers cut into the head (the seed's Fig. 5.4).
+    const SyntheticGuides motion(groom, {});
+    StrandFrame guides;
+    std::vector<SurfaceFrame> guideRoots, followerRoots;
+    motion.sample(0.7, guides, guideRoots);
+    rotateRoots(groom.followerRoots, motion.headRotation(0.7), followerRoots);
+    const SphereCollider head(Vec3f::Zero(), 0.1f);
+    auto inside = [&](const StrandFrame& out, double* stretch) {
+        size_t count = 0;
+        *stretch = 0;
+        for (size_t sIdx = out.guideCount; sIdx < out.strandCount(); ++sIdx)
+            for (uint32_t v = out.first(sIdx) + 1; v < out.offsets[sIdx + 1]; ++v) {
+                count += head.signedDistance(out.positions[v]) < out.radii[v];
+                *stretch = std::max(*stretch, std::abs(double((out.positions[v] - out.positions[v - 1]).norm()) / (0.25 / 23) - 1));
+            }
+        return count;
+    };
+    FollowerSettings off;
+    off.collide = false;
+    Followers loose(groom, off), colliding(groom, {});
+    StrandFrame a, b;
+    double stretchA, stretchB;
+    loose.update({guides, guideRoots, followerRoots, &head}, a);
+    const size_t before = inside(a, &stretchA);
+    EXPECT_GT(before, 100u) << "interpolated followers dip into the head without collision";
+    const FollowerStats stats = colliding.update({guides, guideRoots, followerRoots, &head}, b);
+    EXPECT_EQ(inside(b, &stretchB), 0u);
+    EXPECT_GT(stats.projected, 0u);
+    EXPECT_GE(stats.collisionQueries, stats.projected);
+    EXPECT_LT(stats.collisionQueries, b.vertexCount()) << "the guide-distance bound skips far vertices";
+    EXPECT_LT(stretchB, 1e-4) << "follow-the-leader keeps segment lengths";
+    RecordProperty("max_stretch_after_collision", std::to_string(stretchB));
+    std::printf("inside before %zu, projected %zu, queries %zu of %zu vertices, max stretch %.2e\n", before,
+                stats.projected, stats.collisionQueries, b.vertexCount() - guides.vertexCount(), stretchB);
+}
+
+TEST(Followers, BadInputIsReportedWithTheStrand) {
+    SphereGroomSettings s;
+    s.guides = 10;
+    s.followers = 50;
+    FollowerGroom groom = makeSphereGroom(s);
+    auto message = [](auto&& f) {
+        try { f(); } catch (const Error& e) { return std::string(e.what()); }
+        return std::string("no error");
+    };
+    FollowerGroom bad = groom;
+    bad.guideShapes = RestShapes::straight(9, 24, 0.25f);
+    EXPECT_NE(message([&] { Followers x(bad, {}); }).find("10 guide roots but 9 guide rest shapes"), std::string::npos);
+    bad = groom;
+    bad.followerLengths = {0.25f, 0.2f};
+    EXPECT_NE(message([&] { Followers x(bad, {}); }).find("followerLengths"), std::string::npos);
+    bad = groom;
+    bad.followerRoots[7].normal = Vec3f(NAN, 0, 0);
+    EXPECT_NE(message([&] { Followers x(bad, {}); }).find("follower 7"), std::string::npos);
+
+    Followers followers(groom, {});
+    const SyntheticGuides motion(groom, {});
+    StrandFrame guides, out;
+    std::vector<SurfaceFrame> guideRoots;
+    motion.sample(0, guides, guideRoots);
+    std::vector<SurfaceFrame> fewer(groom.followerRoots.begin(), groom.followerRoots.end() - 1);
+    EXPECT_NE(message([&] { followers.update({guides, guideRoots, fewer}, out); }).find("49 follower root frames for 50"),
+              std::string::npos);
+    guides.positions[guides.first(3) + 5].x() = NAN;
+    EXPECT_NE(message([&] { followers.update({guides, guideRoots, groom.followerRoots}, out); }).find("guide 3 vertex 5"),
+              std::string::npos);
+    StrandFrame shortGuides;
+    const Vec3f two[2] = {Vec3f::Zero(), Vec3f::UnitY()};
+    const float r[2] = {1e-4f, 1e-4f};
+    for (int g = 0; g < 10; ++g) shortGuides.addStrand(g, two, r, 2);
+    EXPECT_NE(message([&] { followers.update({shortGuides, guideRoots, groom.followerRoots}, out); })
+                  .find("guide 0 has 2 vertices in this step but 24 in the groom"),
+              std::string::npos);
+}
+
+// ---------------------------------------------------------------------------
+// Scene keys
+
+TEST(FollowerSettings, SceneKeysMapOntoSettings) {
+    const FollowerSettings defaults = followerSettings(Scene::parse("", "shot.yaml", "."));
+    EXPECT_EQ(defaults.mode, FollowerMode::Varied);
+    EXPECT_EQ(defaults.neighbours, NeighbourRule::Nearest);
+    EXPECT_FLOAT_EQ(defaults.fixedOffset, 0.2f);
+    EXPECT_FLOAT_EQ(defaults.maxVelocity, 0.1f);
+    EXPECT_TRUE(defaults.collide);
+
+    const FollowerSettings s = followerSettings(Scene::parse(
+        "seed: 42\nhair:\n  followers:\n    mode: cluster\n    neighbours: shape-similarity\n"
+        "    fixed_offset: 0.3\n    max_velocity: 0.05\n    collide: false\n",
+        "shot.yaml", ".", {"hair.followers.mode=interpolate"}));
+    EXPECT_EQ(s.mode, FollowerMode::Interpolate) << "--set overrides the file";
+    EXPECT_EQ(s.neighbours, NeighbourRule::ShapeSimilarity);
+    EXPECT_FLOAT_EQ(s.fixedOffset, 0.3f);
+    EXPECT_FLOAT_EQ(s.maxVelocity, 0.05f);
+    EXPECT_FALSE(s.collide);
+    EXPECT_EQ(s.seed, 42u);
+
+    try {
+        Scene::parse("hair:\n  followers:\n    mode: clumped\n", "shot.yaml", ".");
+        FAIL() << "an unknown mode must be rejected";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(e.key(), "hair.followers.mode");
+        EXPECT_NE(std::string(e.what()).find("varied"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(Scene::parse("hair:\n  followers:\n    fixed_offset: 1.5\n", "shot.yaml", "."), SceneError);
+}
