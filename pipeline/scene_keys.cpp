@@ -7,11 +7,8 @@ void addSceneKeys(SchemaBuilder& b) {
     addShotKeys(b);
     addOutputKeys(b);
     addRenderKeys(b);
-<<<<<<< HEAD
     addCompareKeys(b);
-=======
     addFollowerKeys(b);
->>>>>>> followers
 }
 
 void addShotKeys(SchemaBuilder& b) {

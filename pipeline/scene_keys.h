@@ -11,10 +11,7 @@ void addSceneKeys(SchemaBuilder& b);
 void addShotKeys(SchemaBuilder& b);    // top level: name, frames, fps, seed
 void addOutputKeys(SchemaBuilder& b);  // output: directory, templates
 void addRenderKeys(SchemaBuilder& b);  // render: camera, lights, materials (scene_keys_render.cpp)
-<<<<<<< HEAD
 void addCompareKeys(SchemaBuilder& b);  // compare: sequences, thresholds, report (scene_keys_compare.cpp)
-=======
 void addFollowerKeys(SchemaBuilder& b);  // hair.followers: follower modes (scene_keys_followers.cpp)
->>>>>>> followers
 
 }  // namespace hp
