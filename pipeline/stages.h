@@ -7,4 +7,7 @@
 
 namespace hp {
 
+/// The GL preview (stage_preview.cpp); null unless preview.enabled.
+StagePtr makePreviewStage(const Scene& scene, const ShotSettings& shot);
+
 }  // namespace hp
