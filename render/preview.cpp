@@ -41,7 +41,7 @@ double wallMilliseconds() {
 struct PreviewRenderer::Impl {
     PreviewSettings settings;
     PreviewStats stats;
-    GlProgram strand, strandVoxel, fur, furVoxel, head, headDepth, prefix, resolveMs, resolveSs, present;
+    GlProgram strand, strandLines, strandVoxel, fur, furVoxel, head, headDepth, prefix, resolveMs, resolveSs, present;
     StrandBuffers strands;
     HeadBuffers headBuffers;
     RenderTargets targets;
@@ -121,11 +121,17 @@ struct PreviewRenderer::Impl {
                               {ShaderStage::TessEvaluation, "strand.tese"}};
         std::vector<std::string> defines = shading;
         defines.push_back(cat("PATCH_SIZE ", patchSize));
-        Files camera = stages, voxel = stages;
+        Files camera = stages, lines = stages, voxel = stages;
         camera.push_back({ShaderStage::Geometry, "ribbon.geom"});
         camera.push_back({ShaderStage::Fragment, "hair.frag"});
+        lines.push_back({ShaderStage::Fragment, "hair.frag"});
         voxel.push_back({ShaderStage::Fragment, "voxelize.frag"});
-        strand = GlProgram("strands", camera, defines);
+        std::vector<std::string> thick = defines, thin = defines;
+        thick.push_back("THICK_PASS");
+        thin.push_back("THIN_PASS");
+        thin.push_back("LINE_OUTPUT");
+        strand = GlProgram("strand ribbons", camera, thick);
+        strandLines = GlProgram("strand lines", lines, thin);
         strandVoxel = GlProgram("strand voxelization", voxel, {cat("PATCH_SIZE ", patchSize)});
         fur = GlProgram("generated hair",
                         {{ShaderStage::Vertex, "fur.vert"},
@@ -136,6 +142,17 @@ struct PreviewRenderer::Impl {
                         shading);
         strandPatchSize = patchSize;
         shadedPerFragment = perFragment;
+    }
+
+    /// Thin strands are drawn as lines of the minimum width when the
+    /// rasterizer draws multisampled lines as exact rectangles of that width
+    /// (GL spec 14.5.2.2), which keeps their coverage right.
+    float linePathWidth() const {
+        const float width = settings.minPixelWidth * float(supersample());
+        if (samples() < 2) return 0.f;
+        GLfloat range[2] = {1.f, 1.f};
+        glGetFloatv(GL_SMOOTH_LINE_WIDTH_RANGE, range);
+        return width >= range[0] && width <= range[1] ? width : 0.f;
     }
 
     int samples() const { return std::clamp(settings.msaa, 1, maxSamples); }
@@ -256,7 +273,7 @@ struct PreviewRenderer::Impl {
         }
     }
 
-    void cameraPass(bool voxelsOn, bool mapOn) {
+    void cameraPass(bool voxelsOn, bool mapOn, float lineWidth) {
         glBindBufferBase(GL_UNIFORM_BUFFER, 0, cameraUbo);
         glBindFramebuffer(GL_FRAMEBUFFER, targets.msFbo);
         glViewport(0, 0, targets.width * targets.supersample, targets.height * targets.supersample);
@@ -298,6 +315,11 @@ struct PreviewRenderer::Impl {
         glEnablei(GL_BLEND, 2);
         glBlendEquationi(2, GL_FUNC_ADD);
         glBlendFunci(2, GL_ZERO, GL_ONE_MINUS_SRC_COLOR);
+        if (lineWidth > 0.f) {
+            glLineWidth(lineWidth);
+            drawStrands(strandLines);
+            glLineWidth(1.f);
+        }
         drawStrands(strand);
         mark("strands");
         if (query) glBeginQuery(GL_GEOMETRY_SHADER_INVOCATIONS, query);
@@ -429,6 +451,8 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
 
     FrameUniforms u;
     fillUniforms(u, view, frame, blendReference);
+    const float lineWidth = linePathWidth();
+    u.blend[2] = lineWidth > 0.f ? 1.f : 0.f;
     u.counts[1] = grid.valid ? sh.light : -1;
     u.counts[2] = (voxelsOn ? kFlagVoxels : 0) | (mapOn ? kFlagShadowMap : 0);
     glNamedBufferSubData(cameraUbo, 0, sizeof(u), &u);
@@ -441,7 +465,7 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
         shadowPasses(headDrawn, mapOn, voxelsOn);
     }
     targets.ensure(cam.width, cam.height, samples(), supersample());
-    cameraPass(voxelsOn, mapOn);
+    cameraPass(voxelsOn, mapOn, lineWidth);
     resolve(view);
     mark("resolve");
     fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);

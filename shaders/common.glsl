@@ -19,7 +19,7 @@ layout(std140, binding = 0) uniform Frame {
     vec4 uHeadColor;    // rgb albedo, ambient
     vec4 uShadow;       // alpha, pcf radius, 1 / shadow map size, shadow-map depth bias
     vec4 uTess;         // max level, target pixels per piece, curve (0 Catmull-Rom, 1 B-spline), min width (px)
-    vec4 uBlend;        // reference depth (m), depth scale (m)
+    vec4 uBlend;        // reference depth (m), depth scale (m), thin strands drawn as lines (0/1)
     vec4 uGravity;      // generated hair: xyz gravity
     vec4 uWind;         // xyz wind, w gust strength
     vec4 uFurTime;      // time (s), gust frequency (Hz), gust wavelength (m), inner level
