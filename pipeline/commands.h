@@ -14,6 +14,7 @@ CommandSpec renderCommandSpec();
 CommandSpec validateCommandSpec();
 CommandSpec infoCommandSpec();
 CommandSpec helpCommandSpec();
+CommandSpec viewCommandSpec();  // command_view.cpp
 
 /// A scene loaded from a command line (scene path, --set, --seed) with the
 /// run options (--frames, --out, --force) and the --threads limit, which
