@@ -66,7 +66,8 @@ CommandSpec viewCommandSpec() {
     c.details =
         "Keys: space play/pause, left/right step, home/end, V voxel shadows, M shadow map,\n"
         "B voxel mode (binary-nearest, additive-nearest, additive-trilinear), S sum along\n"
-        "the light, G generated hair, H head, F per-fragment shading, R reset camera, Q quit.\n"
+        "the light, X voxel lookup filter, G generated hair, H head, F per-fragment shading,\n"
+        "R reset camera, Q quit.\n"
         "Mouse: drag to orbit, wheel to zoom. Needs a display (X11); headless frames come\n"
         "from `hairpipe render --preview`.";
     c.options = {{"--size", "WxH", "window size (default 1280x720)"},

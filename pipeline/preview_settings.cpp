@@ -28,6 +28,7 @@ PreviewSettings makePreviewSettings(const Scene& s) {
                "(seed 004 compares nearest/binary, nearest/additive and trilinear/additive)");
     sh.sumAlongLight = s.flag("preview.shadow.sum");
     sh.resolution = int(s.integer("preview.shadow.resolution"));
+    sh.filter = s.flag("preview.shadow.filter");
     sh.alpha = float(s.number("preview.shadow.alpha"));
     sh.shadowMap = s.flag("preview.shadow.map");
     sh.shadowMapSize = int(s.integer("preview.shadow.map_size"));

@@ -31,8 +31,10 @@ void addPreviewKeys(SchemaBuilder& b) {
         .choice("preview.tessellation.curve", "catmull-rom", {"catmull-rom", "b-spline"},
                 "Curve through the strand's vertices (Catmull-Rom) or approximating them (uniform B-spline).")
         .integer("preview.tessellation.level", 8, 1, 64, "", "Most pieces per strand segment.")
-        .number("preview.tessellation.pixels", 12, 0, 1000, "px",
-                "Target on-screen length of a piece (the level adapts per strand); 0 = always the most.");
+        .number("preview.tessellation.pixels", 20, 0, 1000, "px",
+                "Target on-screen length of a piece: each strand's curve is cut into about its screen length / "
+                "this pieces (at most `level` per segment). 20 px keeps chords within ~0.25 px of curves of "
+                "radius > 200 px; smaller is smoother and slower (llvmpipe pays per piece). 0 = always `level`.");
     b.section("preview.shadow",
               "Shadows of one light (seed 004, 2.3): hair voxelized from the light into a 3D texture and "
               "summed along the light (transmittance alpha^C), times a PCF shadow map of the head. "
@@ -47,6 +49,9 @@ void addPreviewKeys(SchemaBuilder& b) {
               "Sum the grid along the light (the seed's C). Off shades with the raw voxel values, the seed's "
               "figures of the voxelization itself.")
         .integer("preview.shadow.resolution", 256, 8, 1024, "voxels", "Voxels along each axis of the light's box.")
+        .flag("preview.shadow.filter", true,
+              "Average C over 2 x 2 voxels across the light when shading (hides the moire rings regularly spaced "
+              "hair casts); off = the seed's single lookup.")
         .number("preview.shadow.alpha", 0.85, 0.001, 1, "",
                 "Transmittance per unit of C: light reaching a point is alpha^C, C counting strand fragments "
                 "(additive) or occupied voxels (binary) in front of it.")

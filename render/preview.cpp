@@ -454,7 +454,8 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
     const float lineWidth = linePathWidth();
     u.blend[2] = lineWidth > 0.f ? 1.f : 0.f;
     u.counts[1] = grid.valid ? sh.light : -1;
-    u.counts[2] = (voxelsOn ? kFlagVoxels : 0) | (mapOn ? kFlagShadowMap : 0);
+    u.counts[2] = (voxelsOn ? kFlagVoxels : 0) | (mapOn ? kFlagShadowMap : 0) |
+                  (voxelsOn && sh.filter ? kFlagVoxelFilter : 0);
     glNamedBufferSubData(cameraUbo, 0, sizeof(u), &u);
     if (voxelsOn || mapOn) {
         FrameUniforms l = u;
@@ -482,6 +483,8 @@ void PreviewRenderer::setSettings(const PreviewSettings& settings) { impl_->sett
 const PreviewStats& PreviewRenderer::stats() const { return impl_->stats; }
 
 void PreviewRenderer::draw(const View& view, const PreviewFrame& frame) { impl_->draw(view, frame); }
+
+void PreviewRenderer::finish() const { glFinish(); }
 
 Image PreviewRenderer::render(const View& view, const PreviewFrame& frame) {
     draw(view, frame);

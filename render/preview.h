@@ -5,22 +5,32 @@
 //
 // How hair is drawn (shaders/ holds the GLSL):
 // - Strand polylines are uploaded to persistently mapped buffers (reallocated
-//   only when a frame has more vertices than any before), drawn as 4-point
-//   patches (previous, this, next, after-next vertex) and smoothed by an
-//   isoline tessellation stage (uniform Catmull-Rom through the vertices, or a
-//   uniform cubic B-spline; mirrored end points make both reach the root and
-//   tip). The level adapts to on-screen length, up to `tessellationLevel`.
-// - A geometry shader turns each piece into a ribbon facing the camera, 2r
-//   wide (r interpolated along the strand). Hair far thinner than a pixel
-//   would alias away, so a ribbon is never drawn narrower than
-//   `minPixelWidth` pixels; its alpha becomes true width / drawn width, which
-//   keeps the expected coverage equal to the projected area of the strand.
-//   Multisampling (and optional supersampling) antialiases the edges.
+//   only when a frame has more vertices than any before) and drawn as one
+//   patch per strand (the per-patch cost dominates on llvmpipe). An isoline
+//   tessellation stage smooths them — uniform Catmull-Rom through the
+//   vertices or a uniform cubic B-spline; mirrored end points make both reach
+//   the root and tip — cut into about screen length / `tessellationPixels`
+//   pieces per strand (at most `tessellationLevel` per segment).
+// - Strands at least `minPixelWidth` wide somewhere become camera-facing
+//   ribbons in a geometry shader, 2r wide (r interpolated along the strand).
+//   Thinner hair would alias away, so it is drawn `minPixelWidth` wide with
+//   alpha = true width / drawn width, which keeps its expected coverage equal
+//   to its projected area; with MSAA such strands are drawn as multisampled
+//   lines of that width (exact rectangles per the GL spec, one primitive per
+//   piece instead of a ribbon's two: ~1.5x faster on llvmpipe). Multisampling
+//   (and optional supersampling) antialiases the edges.
+// - Shading (Kajiya-Kay, mirroring kajiyaKay() in render/view.cpp, times each
+//   light's visibility) runs per tessellated strand point by default and is
+//   interpolated along the strand, or per fragment (`shadePerFragment`).
 // - Hair is semi-transparent and unsorted, so it is composited with weighted
 //   blended order-independent transparency (McGuire & Bavoil 2013): alpha is
 //   exact (1 - prod(1 - a_i)), colour a weighted mean favouring fragments
 //   nearer than the scene's front by `blendDepthScale` metres. Opaque head
 //   fragments hide the hair behind them through the depth test.
+// - Shadows of one light: the hair voxelized from the light into an r32ui 3D
+//   texture with image atomics (seed 004's binary/additive, nearest/trilinear),
+//   summed along the light in a compute pass, transmittance alpha^C; times a
+//   PCF shadow map of the head. Point lights use a perspective frustum.
 // - Output: R, G, B premultiplied linear radiance (the environment colour
 //   fills what coverage leaves), A the coverage of hair and head, Z the
 //   camera-space depth in metres (distance along the view axis, not along
@@ -57,6 +67,9 @@ struct PreviewShadowSettings {
     /// voxel value V, the seed's visualisation of the voxelization itself.
     bool sumAlongLight = true;
     int resolution = 256;         ///< voxels along each axis of the light's box
+    /// Average C over 2 x 2 voxels across the beam at lookup: hides the moire
+    /// rings regularly spaced hair casts through one-voxel-wide lines.
+    bool filter = true;
     /// Transmittance alpha per unit of C: light reaching a point is alpha^C,
     /// where C counts strand fragments (Additive) or occupied voxels (Binary)
     /// between the light and the point.
@@ -71,7 +84,7 @@ struct PreviewSettings {
     int supersample = 1;          ///< render at N x N the resolution and average
     CurveType curve = CurveType::CatmullRom;
     int tessellationLevel = 8;    ///< most pieces per strand segment (1..64)
-    float tessellationPixels = 6.f;  ///< target on-screen length of a piece; 0 = always the most
+    float tessellationPixels = 20.f;  ///< target on-screen length of a piece; 0 = always the most
     float minPixelWidth = 1.f;    ///< thinnest ribbon drawn (output pixels); alpha scales coverage below
     float blendDepthScale = 0.02f;   ///< metres; smaller = nearer hair dominates more
     /// Shade hair per fragment instead of per ribbon vertex (tessellated
@@ -140,6 +153,8 @@ class PreviewRenderer {
     /// Renders a frame into the internal target (view.camera's size).
     /// Throws FrameError when GL reports an error.
     void draw(const View& view, const PreviewFrame& frame);
+    /// Blocks until the GL has finished the last draw (glFinish), for timing.
+    void finish() const;
     /// The last draw as R, G, B, A, Z (top row first).
     Image readback() const;
     /// draw + readback.

@@ -39,6 +39,7 @@ struct FrameUniforms {
 
 inline constexpr int kFlagVoxels = 1;
 inline constexpr int kFlagShadowMap = 2;
+inline constexpr int kFlagVoxelFilter = 4;
 
 /// A buffer mapped once for writing and kept mapped (GL 4.4 persistent,
 /// coherent mapping): per-frame uploads are a memcpy, and the storage is only

@@ -67,6 +67,7 @@ void onKey(GLFWwindow* window, int key, int, int action, int) {
         case GLFW_KEY_V: sh.voxels = !sh.voxels; break;
         case GLFW_KEY_M: sh.shadowMap = !sh.shadowMap; break;
         case GLFW_KEY_S: sh.sumAlongLight = !sh.sumAlongLight; break;
+        case GLFW_KEY_X: sh.filter = !sh.filter; break;
         case GLFW_KEY_G: s.generated.enabled = !s.generated.enabled; break;
         case GLFW_KEY_H: s.drawHead = !s.drawHead; break;
         case GLFW_KEY_F: s.shadePerFragment = !s.shadePerFragment; break;

@@ -40,8 +40,9 @@ struct ViewerOptions {
 /// Opens the window and runs until it is closed (or exitAfter frames).
 /// Keys: space play/pause, left/right step, home/end first/last frame,
 /// V voxel shadows, M shadow map, B voxel mode (binary-nearest,
-/// additive-nearest, additive-trilinear), S sum along the light, G generated
-/// hair, H head, F per-fragment shading, R reset camera, Q/Esc quit.
+/// additive-nearest, additive-trilinear), S sum along the light, X voxel
+/// lookup filter, G generated hair, H head, F per-fragment shading, R reset
+/// camera, Q/Esc quit.
 /// Mouse: left-drag orbits around the camera target, wheel zooms.
 /// Throws hp::Error when no window with OpenGL 4.5 core can be opened (no
 /// display: the message says so).

@@ -29,6 +29,7 @@ layout(std140, binding = 0) uniform Frame {
 
 const int kFlagVoxels = 1;
 const int kFlagShadowMap = 2;
+const int kFlagVoxelFilter = 4;
 
 // Grid coordinates of a world point in the light's box (render/light_grid.h).
 vec3 lightGrid(vec3 world) {

@@ -198,12 +198,12 @@ TEST(Preview, KajiyaKayMatchesCpuReference) {
 }
 
 /// A dense slab of hair between the light and a strand: the strand is darker
-/// with voxel shadows on; a strand beside the slab is not.
+/// with voxel shadows on; a strand beside the slab is not. Directional lights
+/// use an orthographic light box, point lights a perspective frustum.
 TEST(Preview, VoxelShadowsDarkenStrandBehindSlab) {
     HP_REQUIRE_GL();
     View v = testView(320, 240);
     v.camera.position = Vec3f(0.f, 0.f, -1.f);  // looks at the lit strand from behind the slab's shadow side
-    v.lights[0].direction = Vec3f(0.f, -0.3f, -1.f);  // travels toward -z: slab (z = +0.05) shadows z = -0.05
     StrandFrame strands;
     for (int i = 0; i < 120; ++i)
         for (int k = 0; k < 10; ++k) {
@@ -214,22 +214,33 @@ TEST(Preview, VoxelShadowsDarkenStrandBehindSlab) {
     const Vec3f litA(0.09f, 0.01f, -0.05f), litB(0.13f, 0.01f, -0.05f);
     addLine(strands, shadowedA, shadowedB, 0.006f);  // ~4 px wide: fully covered centre pixels
     addLine(strands, litA, litB, 0.006f);
-    auto brightness = [&](bool voxels, const Vec3f& a, const Vec3f& b) {
-        PreviewSettings s;
-        s.shadow.voxels = voxels;
-        s.shadow.shadowMap = false;
-        PreviewRenderer renderer(s);
-        PreviewFrame frame;
-        frame.strands = &strands;
-        const Image img = renderer.render(v, frame);
-        const Vec2f p = project(v, (a + b) * 0.5f);
-        return meanIn(img, 1, int(p.x()) - 3, int(p.y()) - 1, int(p.x()) + 3, int(p.y()) + 2);
-    };
-    const double off = brightness(false, shadowedA, shadowedB), on = brightness(true, shadowedA, shadowedB);
-    EXPECT_GT(off, 0.01);
-    EXPECT_LT(on, 0.6 * off) << "behind the slab: off " << off << ", on " << on;
-    const double litOff = brightness(false, litA, litB), litOn = brightness(true, litA, litB);
-    EXPECT_NEAR(litOn / litOff, 1.0, 0.02) << "beside the slab";
+    Light directional;
+    directional.direction = Vec3f(0.f, -0.3f, -1.f);  // travels toward -z: the slab (z = +0.05) shadows z = -0.05
+    Light point;
+    point.type = LightType::Point;
+    point.position = Vec3f(0.f, 0.1f, 0.6f);
+    point.intensity = 1.f;
+    for (const Light& light : {directional, point}) {
+        v.lights = {light};
+        auto brightness = [&](bool voxels, const Vec3f& a, const Vec3f& b) {
+            PreviewSettings s;
+            s.shadow.voxels = voxels;
+            s.shadow.shadowMap = false;
+            PreviewRenderer renderer(s);
+            PreviewFrame frame;
+            frame.strands = &strands;
+            const Image img = renderer.render(v, frame);
+            EXPECT_EQ(renderer.stats().shadowed, voxels);
+            const Vec2f p = project(v, (a + b) * 0.5f);
+            return meanIn(img, 1, int(p.x()) - 3, int(p.y()) - 1, int(p.x()) + 3, int(p.y()) + 2);
+        };
+        const char* kind = light.type == LightType::Point ? "point light" : "directional light";
+        const double off = brightness(false, shadowedA, shadowedB), on = brightness(true, shadowedA, shadowedB);
+        EXPECT_GT(off, 0.01) << kind;
+        EXPECT_LT(on, 0.6 * off) << kind << ", behind the slab: off " << off << ", on " << on;
+        const double litOff = brightness(false, litA, litB), litOn = brightness(true, litA, litB);
+        EXPECT_NEAR(litOn / litOff, 1.0, 0.02) << kind << ", beside the slab";
+    }
 }
 
 /// The head's shadow map darkens hair in the head's shadow.
