@@ -53,6 +53,7 @@ struct PreviewRenderer::Impl {
     bool voxelsDrawn = false;
     bool warnedUnshadowed = false;
     int strandPatchSize = 0;
+    bool strandsVisible = false, headVisible = false, furVisible = false;  // what this frame draws
     bool shadedPerFragment = false;
     LightGrid grid;
 
@@ -201,7 +202,7 @@ struct PreviewRenderer::Impl {
     }
 
     void drawStrands(const GlProgram& program) {
-        if (!strands.indexCount) return;
+        if (!strandsVisible || !strands.indexCount) return;
         program.use();
         glBindVertexArray(strands.vao);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, strands.patchSegments);
@@ -210,7 +211,7 @@ struct PreviewRenderer::Impl {
     }
 
     void drawFur(const GlProgram& program) {
-        if (!headBuffers.furIndexCount) return;
+        if (!furVisible || !headBuffers.furIndexCount) return;
         program.use();
         glBindVertexArray(headBuffers.vao);
         glVertexArrayElementBuffer(headBuffers.vao, headBuffers.furIndices);
@@ -221,7 +222,7 @@ struct PreviewRenderer::Impl {
     }
 
     void drawHead(const GlProgram& program) {
-        if (!headBuffers.indexCount) return;
+        if (!headVisible || !headBuffers.indexCount) return;
         program.use();
         glBindVertexArray(headBuffers.vao);
         glVertexArrayElementBuffer(headBuffers.vao, headBuffers.indices);
@@ -389,10 +390,8 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
         compileHairPrograms(strands.patchSize);
         stats.strandSegments = strands.segments;
         for (const Vec3f& p : frame.strands->positions) bounds.extend(p);
-    } else {
-        strands.indexCount = 0;
-        strands.offsets.clear();
     }
+    strandsVisible = drawStrandsNow;
     compileHairPrograms(strandPatchSize);  // follows a changed shading rate
     std::vector<uint8_t> types;
     if (headNow) {
@@ -406,19 +405,17 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
             }
         }
         headBuffers.upload(*frame.head, types, settings.generated.types);
-        if (!settings.drawHead) headBuffers.indexCount = 0;
         Eigen::AlignedBox3f hb = frame.head->bounds();
-        if (headBuffers.furIndexCount) {
+        if (settings.generated.enabled && headBuffers.furIndexCount) {
             const float pad = settings.generated.maxLength();
             hb.extend(hb.min() - Vec3f::Constant(pad));
             hb.extend(hb.max() + Vec3f::Constant(pad));
         }
         bounds.extend(hb);
-    } else {
-        headBuffers.indexCount = headBuffers.furIndexCount = 0;
-        headBuffers.triangles.clear();
     }
-    stats.furTriangles = headBuffers.furIndexCount / 3;
+    headVisible = headDrawn;
+    furVisible = headNow && settings.generated.enabled && headBuffers.furIndexCount > 0;
+    stats.furTriangles = furVisible ? headBuffers.furIndexCount / 3 : 0;
     stats.generatedStrands = 0;
 
     mark("upload");
