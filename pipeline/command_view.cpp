@@ -72,8 +72,7 @@ CommandSpec viewCommandSpec() {
         "from `hairpipe render --preview`.";
     c.options = {{"--size", "WxH", "window size (default 1280x720)"},
                  {"--paused", "", "start paused on the first frame"},
-                 {"--synthetic", "N", "show N synthetic strands on the benchmark sphere head instead of the "
-                                      "scene's frames (a look check without simulation)"},
+                 {"--synthetic", "N", "show N synthetic strands on a sphere head (look check, no simulation)"},
                  {"--exit-after", "N", "scripted: quit after displaying N frames"},
                  {"--screenshot", "FILE", "scripted: save the last displayed frame (PNG)"}};
     c.run = [](const CommandLine& cl) {
