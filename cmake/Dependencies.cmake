@@ -34,6 +34,7 @@ endif()
 # the pkg-config module is reliable. Float precision (the "bullet" module).
 pkg_check_modules(BULLET REQUIRED IMPORTED_TARGET bullet)
 pkg_check_modules(EPOXY REQUIRED IMPORTED_TARGET epoxy)
+pkg_check_modules(GLFW REQUIRED IMPORTED_TARGET glfw3)  # the interactive viewer's window
 find_package(OpenGL REQUIRED COMPONENTS OpenGL EGL)
 
 if(HAIRPIPE_BUILD_TESTS)

@@ -18,6 +18,7 @@ const std::vector<CommandSpec>& commands() {
         runCommandSpec(),
         renderCommandSpec(),
         compareCommandSpec(),
+        viewCommandSpec(),
         validateCommandSpec(),
         infoCommandSpec(),
         helpCommandSpec(),

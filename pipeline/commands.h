@@ -15,6 +15,7 @@ CommandSpec validateCommandSpec();
 CommandSpec infoCommandSpec();
 CommandSpec helpCommandSpec();
 CommandSpec compareCommandSpec();
+CommandSpec viewCommandSpec();  // command_view.cpp
 
 /// A scene loaded from a command line (scene path, --set, --seed) with the
 /// run options (--frames, --out, --force) and the --threads limit, which

@@ -9,6 +9,7 @@ void addSceneKeys(SchemaBuilder& b) {
     addRenderKeys(b);
     addCompareKeys(b);
     addFollowerKeys(b);
+    addPreviewKeys(b);
 }
 
 void addShotKeys(SchemaBuilder& b) {

@@ -13,5 +13,6 @@ void addOutputKeys(SchemaBuilder& b);  // output: directory, templates
 void addRenderKeys(SchemaBuilder& b);  // render: camera, lights, materials (scene_keys_render.cpp)
 void addCompareKeys(SchemaBuilder& b);  // compare: sequences, thresholds, report (scene_keys_compare.cpp)
 void addFollowerKeys(SchemaBuilder& b);  // hair.followers: follower modes (scene_keys_followers.cpp)
+void addPreviewKeys(SchemaBuilder& b); // preview: the GL preview pass (scene_keys_preview.cpp)
 
 }  // namespace hp

@@ -31,6 +31,7 @@ std::vector<StagePtr> makeStages(const Scene& scene, const ShotSettings& shot, c
     auto add = [&](StagePtr stage) {
         if (stage && (only.empty() || only.count(stage->name()))) stages.push_back(std::move(stage));
     };
+    add(makePreviewStage(scene, shot));
     add(makeCompareStage(scene, shot));  // last: reads the other stages' files
     return stages;
 }

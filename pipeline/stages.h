@@ -9,5 +9,7 @@ namespace hp {
 
 /// compare.*: preview vs reference metrics, difference images and report (stage_compare.cpp).
 StagePtr makeCompareStage(const Scene& scene, const ShotSettings& shot);
+/// The GL preview (stage_preview.cpp); null unless preview.enabled.
+StagePtr makePreviewStage(const Scene& scene, const ShotSettings& shot);
 
 }  // namespace hp

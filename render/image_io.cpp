@@ -83,7 +83,10 @@ void writeImage(const std::string& path, const Image& image, const ImageWriteOpt
             const int alpha = buf.spec().alpha_channel;
             OIIO::ROI colour = buf.roi();
             colour.chend = std::min(alpha >= 0 ? alpha : buf.nchannels(), 3);
-            OIIO::ImageBufAlgo::colorconvert(buf, buf, "linear", "sRGB", false, "", "", nullptr, colour);
+            // Colour is premultiplied (associated) and the PNG writer divides by
+            // alpha: encode the unpremultiplied colour (unpremult = true), or
+            // partly covered pixels come out too bright and hue-shifted.
+            OIIO::ImageBufAlgo::colorconvert(buf, buf, "linear", "sRGB", true, "", "", nullptr, colour);
         }
         format = eightBit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
     }

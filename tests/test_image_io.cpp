@@ -52,6 +52,17 @@ TEST(ImageIo, PngIsSrgbEncodedRgba) {
     EXPECT_NEAR(lin.at(0, 0, 0), 0.2f, 0.01f);
 }
 
+TEST(ImageIo, PngOfPartialAlphaEncodesTheUnpremultipliedColour) {
+    test::TempDir dir;
+    Image in(1, 1, {"R", "G", "B", "A"});
+    in.at(0, 0, 0) = in.at(0, 0, 1) = in.at(0, 0, 2) = 0.1f;  // premultiplied: colour 0.5 at alpha 0.2
+    in.at(0, 0, 3) = 0.2f;
+    writeImage((dir / "p.png").string(), in);
+    const Image back = readImage((dir / "p.png").string());  // OIIO associates alpha on read
+    ASSERT_NEAR(back.at(0, 0, 3), 0.2f, 0.005f);
+    EXPECT_NEAR(back.at(0, 0, 0) / back.at(0, 0, 3), 0.735f, 0.02f) << "sRGB(0.5), stored unassociated";
+}
+
 TEST(ImageIo, MissingOrBrokenFileNamesTheFile) {
     test::TempDir dir;
     try {

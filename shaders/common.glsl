@@ -1,0 +1,52 @@
+// Shared by every preview program: the per-pass uniform block (mirrors
+// FrameUniforms in render/preview_gpu.h, std140) and small helpers.
+
+layout(std140, binding = 0) uniform Frame {
+    mat4 uViewProj;     // world -> clip of this pass (camera, or the light for shadow passes)
+    mat4 uView;         // world -> camera view
+    mat4 uLightClip;    // world -> clip of the shadowed light (shadow map lookups)
+    mat4 uLightView;    // world -> light view (voxel grid mapping)
+    vec4 uEye;          // xyz camera position; w: focal length in target pixels (ribbon widths)
+    vec4 uViewport;     // target width, height, 1/width, 1/height
+    vec4 uGridMap;      // light grid: scale.xy, offset.xy
+    vec4 uGridDepth;    // near depth, far depth, perspective (0/1), voxel resolution
+    vec4 uLightVec[16]; // xyz: unit direction to a directional light, or a point light's position; w: 0 / 1
+    vec4 uLightRad[16]; // rgb radiance (directional) or intensity (point, / distance^2)
+    vec4 uHairColor;    // rgb albedo, kd
+    vec4 uSpecColor;    // rgb, ks
+    vec4 uSecondColor;  // rgb, secondary ks
+    vec4 uHairShape;    // shininess, secondary shininess, primary shift, secondary shift
+    vec4 uHeadColor;    // rgb albedo, ambient
+    vec4 uShadow;       // alpha, pcf radius, 1 / shadow map size, shadow-map depth bias
+    vec4 uTess;         // max level, target pixels per piece, curve (0 Catmull-Rom, 1 B-spline), min width (px)
+    vec4 uBlend;        // reference depth (m), depth scale (m), thin strands drawn as lines (0/1)
+    vec4 uGravity;      // generated hair: xyz gravity
+    vec4 uWind;         // xyz wind, w gust strength
+    vec4 uFurTime;      // time (s), gust frequency (Hz), gust wavelength (m), inner level
+    vec4 uFurLevels;    // outer level
+    ivec4 uCounts;      // light count, shadowed light (-1 none), flags (kFlag*), two lobes
+};
+
+const int kFlagVoxels = 1;
+const int kFlagShadowMap = 2;
+const int kFlagVoxelFilter = 4;
+
+// Grid coordinates of a world point in the light's box (render/light_grid.h).
+vec3 lightGrid(vec3 world) {
+    vec4 v = uLightView * vec4(world, 1.0);
+    float depth = -v.z;
+    vec2 q = uGridDepth.z > 0.5 ? v.xy / depth : v.xy;
+    return vec3(q * uGridMap.xy + uGridMap.zw, (depth - uGridDepth.x) / (uGridDepth.y - uGridDepth.x));
+}
+
+// Unit direction from p toward light i, and its radiance there (render/view.cpp Light::toLight).
+vec3 toLight(int i, vec3 p, out vec3 radiance) {
+    if (uLightVec[i].w < 0.5) {
+        radiance = uLightRad[i].rgb;
+        return uLightVec[i].xyz;
+    }
+    vec3 d = uLightVec[i].xyz - p;
+    float r2 = max(dot(d, d), 1e-8);
+    radiance = uLightRad[i].rgb / r2;
+    return d / sqrt(r2);
+}

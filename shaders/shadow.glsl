@@ -1,0 +1,42 @@
+// Visibility of the shadowed light (seed 004, 2.3): hair transmittance
+// alpha^C from the summed voxel grid, times the PCF shadow map of the head.
+
+layout(binding = 0) uniform sampler3D uDensity;        // C (or V when the sum is off), trilinear
+layout(binding = 1) uniform sampler2DShadow uShadowMap; // head depth from the light, compare mode on
+
+float shadowMapVisibility(vec3 world) {
+    vec4 c = uLightClip * vec4(world, 1.0);
+    vec3 p = c.xyz / c.w * 0.5 + 0.5;
+    if (any(lessThan(p.xy, vec2(0.0))) || any(greaterThan(p.xy, vec2(1.0)))) return 1.0;
+    int r = int(uShadow.y);
+    float lit = 0.0;
+    // Seed eq. 8: the fraction of shadow-map texels around p that are not closer to the light.
+    for (int y = -r; y <= r; ++y)
+        for (int x = -r; x <= r; ++x)
+            lit += texture(uShadowMap, vec3(p.xy + vec2(x, y) * uShadow.z, p.z - uShadow.w));
+    float n = float(2 * r + 1);
+    return lit / (n * n);
+}
+
+// C in front of a point. The grid stores at each voxel centre what lies
+// strictly in front of that voxel; looking up half a voxel toward the light
+// keeps a strand's own fragments (and its voxel neighbours behind it) out of
+// its shadow, the voxel method's "acne". With kFlagVoxelFilter four lookups
+// average C over 2 x 2 voxels across the beam (a tent over ~3 x 3): regularly
+// spaced hair otherwise casts moire rings, since one-voxel-wide lines fill
+// neighbouring columns unevenly.
+float voxelDensity(vec3 world) {
+    vec3 g = lightGrid(world) - vec3(0.0, 0.0, 0.5 / uGridDepth.w);
+    if ((uCounts.z & kFlagVoxelFilter) == 0) return texture(uDensity, g).r;
+    float h = 0.75 / uGridDepth.w;
+    return 0.25 * (texture(uDensity, g + vec3(-h, -h, 0.0)).r + texture(uDensity, g + vec3(h, -h, 0.0)).r +
+                   texture(uDensity, g + vec3(-h, h, 0.0)).r + texture(uDensity, g + vec3(h, h, 0.0)).r);
+}
+
+float lightVisibility(int light, vec3 world) {
+    if (light != uCounts.y) return 1.0;
+    float v = 1.0;
+    if ((uCounts.z & kFlagVoxels) != 0) v *= pow(uShadow.x, voxelDensity(world));
+    if ((uCounts.z & kFlagShadowMap) != 0) v *= shadowMapVisibility(world);
+    return v;
+}

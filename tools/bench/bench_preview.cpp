@@ -1,0 +1,147 @@
+// Benchmark of the GL preview (BENCHMARKS.md "B-render", preview part):
+// milliseconds per 1920x1080 frame with shadows on (voxel grid + shadow
+// map) and 4x MSAA, camera (0, 0.05, 0.9) looking at the origin, vertical
+// FOV 40 deg, one directional light (-1, -1, -1) of intensity 3, black
+// background. Strands: makeSyntheticHair (24 vertices, 0.04 -> 0.01 mm radius)
+// on the sphere head of radius 0.1 m, until the simulation provides the
+// 845 guides + followers; the count is the same.
+//
+//   bench_preview [--strands 10000,100000] [--frames 3] [--warmup 1]
+//                 [--profile] [--png out.png]
+// Per strand count: median, min and max of the timed frames (draw + glFinish,
+// wall and process CPU time, llvmpipe's threads included), readback time,
+// peak resident memory; --profile adds a per-pass breakdown of one extra frame.
+#include "core/errors.h"
+#include "render/gl_context.h"
+#include "render/preview.h"
+#include "sim/synthetic.h"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace hp;
+
+namespace {
+
+double cpuSeconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + double(t.tv_nsec) * 1e-9;
+}
+
+double wallSeconds() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double peakMiB() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_maxrss) / 1024.0;
+}
+
+struct Stats {
+    double median, min, max;
+};
+
+Stats stats(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return {v[v.size() / 2], v.front(), v.back()};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::vector<size_t> counts = {10000, 100000};
+    int frames = 3, warmup = 1;
+    bool profile = false;
+    std::string png;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        const bool more = i + 1 < argc;
+        if (a == "--strands" && more) {
+            counts.clear();
+            std::stringstream list(argv[++i]);
+            for (std::string item; std::getline(list, item, ',');) counts.push_back(std::stoul(item));
+        } else if (a == "--frames" && more) {
+            frames = std::max(1, std::atoi(argv[++i]));
+        } else if (a == "--warmup" && more) {
+            warmup = std::max(0, std::atoi(argv[++i]));
+        } else if (a == "--profile") {
+            profile = true;
+        } else if (a == "--png" && more) {
+            png = argv[++i];
+        } else {
+            std::cerr << "usage: bench_preview [--strands N,M] [--frames N] [--warmup N] [--profile] [--png FILE]\n";
+            return 1;
+        }
+    }
+    try {
+        auto context = GlContext::createHeadless();
+        View view;  // the defaults are B-render's camera, light and black background
+        view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
+        view.camera.target = Vec3f::Zero();
+        view.camera.fovY = 40.f;
+        view.camera.width = 1920;
+        view.camera.height = 1080;
+        view.lights = {Light{}};
+        view.lights[0].direction = Vec3f(-1.f, -1.f, -1.f);
+        view.lights[0].intensity = 3.f;
+        view.environment = Vec3f::Zero();
+        PreviewSettings settings;  // 4x MSAA, voxels (additive, nearest, 256^3) + 2048^2 PCF shadow map
+        const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 32, 64);
+        std::printf("bench_preview: %s\n", context->description().c_str());
+        std::printf("B-render preview, 1920x1080, 4x MSAA, voxel shadows %d^3 + shadow map %d^2, tessellation "
+                    "%.0f px pieces, %d timed frames after %d warm-up\n",
+                    settings.shadow.resolution, settings.shadow.shadowMapSize, settings.tessellationPixels, frames,
+                    warmup);
+        std::printf("%9s %9s | %12s %10s %10s | %12s | %11s | %8s\n", "strands", "segments", "wall ms med",
+                    "min", "max", "cpu ms med", "readback ms", "peak MiB");
+        for (size_t count : counts) {
+            SyntheticHairSettings hs;
+            hs.strands = count;
+            hs.vertices = 24;
+            const StrandFrame strands = makeSyntheticHair(hs);
+            PreviewRenderer renderer(settings);
+            PreviewFrame frame;
+            frame.strands = &strands;
+            frame.head = &head;
+            std::vector<double> wall, cpu;
+            for (int f = 0; f < warmup + frames; ++f) {
+                frame.time = f / 24.0;
+                const double w0 = wallSeconds(), c0 = cpuSeconds();
+                renderer.draw(view, frame);
+                renderer.finish();
+                if (f >= warmup) wall.push_back((wallSeconds() - w0) * 1e3), cpu.push_back((cpuSeconds() - c0) * 1e3);
+            }
+            const double r0 = wallSeconds();
+            const Image image = renderer.readback();
+            const double readbackMs = (wallSeconds() - r0) * 1e3;
+            const Stats w = stats(wall), c = stats(cpu);
+            std::printf("%9zu %9zu | %12.0f %10.0f %10.0f | %12.0f | %11.0f | %8.0f\n", count,
+                        renderer.stats().strandSegments, w.median, w.min, w.max, c.median, readbackMs, peakMiB());
+            if (!png.empty() && count == counts.back()) writeImage(png, image);
+            if (profile) {
+                PreviewSettings p = settings;
+                p.profile = true;
+                renderer.setSettings(p);
+                renderer.draw(view, frame);
+                for (const PreviewStats::Pass& pass : renderer.stats().passes)
+                    std::printf("    %-16s wall %8.1f ms  cpu %8.1f ms\n", pass.name.c_str(), pass.wallMs, pass.cpuMs);
+                renderer.setSettings(settings);
+            }
+        }
+    } catch (const Error& e) {
+        std::fprintf(stderr, "bench_preview: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}
