@@ -1,0 +1,56 @@
+// A narrow-band signed distance grid of a closed triangle mesh (OpenVDB's
+// meshToSignedDistanceField), sampled trilinearly with an analytic gradient.
+//
+// Why a grid: the guide solver asks for the head's distance at every strand
+// vertex every 0.02 s step (20k+ queries per step at 845 guides), so a query
+// must cost ~100 ns. An exact BVH query (sim/mesh_query.h) costs ~1 µs; eight
+// lookups in a sparse VDB tree through a non-registering accessor stay well
+// under the budget, and OpenVDB's sign flood fill gives the inside sign of a
+// closed mesh robustly. The grid is built once, in the rest pose, and moved
+// rigidly with the head (sim/mesh_collider.h); 1 mm voxels put the trilinear
+// error well under the ~1 mm the solvers need near the scalp.
+#pragma once
+
+#include "sim/head.h"
+
+#include <memory>
+
+namespace hp {
+
+struct LevelSetSettings {
+    float voxelSize = 0.001f;     ///< metres
+    float exteriorBand = 0.01f;   ///< metres of exact distance kept outside the surface
+    float interiorBand = 0.01f;   ///< and inside
+};
+
+/// @brief Signed distance grid of a mesh (negative inside). Immutable after
+/// construction; sample() is thread-safe.
+class LevelSet {
+  public:
+    /// Builds the grid; the mesh should be closed (a hole wider than a voxel
+    /// lets the inside/outside flood fill leak). Throws Error on an empty mesh.
+    LevelSet(const TriangleMesh& mesh, const LevelSetSettings& settings);
+    ~LevelSet();
+    LevelSet(const LevelSet&) = delete;
+    LevelSet& operator=(const LevelSet&) = delete;
+
+    /// Trilinear signed distance at `p`. `gradient` (optional) gets the
+    /// interpolant's gradient (not normalised). Returns false when a corner of
+    /// the cell lies outside the narrow band: then the value is only a bound
+    /// (±band) and the gradient is meaningless.
+    bool sample(const Vec3f& p, float& distance, Vec3f* gradient = nullptr) const;
+
+    const LevelSetSettings& settings() const { return settings_; }
+    /// World-space box of the active (narrow-band) voxels.
+    const Eigen::AlignedBox3f& bounds() const { return bounds_; }
+    size_t activeVoxelCount() const;
+    size_t memoryBytes() const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+    LevelSetSettings settings_;
+    Eigen::AlignedBox3f bounds_;
+};
+
+}  // namespace hp
