@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
 
 namespace hp {
 
@@ -67,11 +66,10 @@ Vec3f latticeCenter(const TriangleMesh& mesh, const std::vector<uint8_t>& scalp)
 std::vector<SurfacePoint> fibonacciRoots(const TriangleMesh& mesh, const std::vector<uint8_t>& scalp,
                                          const RootSettings& settings) {
     const Vec3f c = settings.center ? *settings.center : latticeCenter(mesh, scalp);
-    // The cone of directions (from c) that holds the scalp: the lattice is
-    // only generated there, so no ray is wasted on the face or the neck.
-    Vec3f axis = Vec3f::Zero();
     float reach = 0.f;
     for (const Vec3f& p : mesh.positions) reach = std::max(reach, (p - c).norm());
+    // The cone of directions (from c) that holds the scalp: the lattice is
+    // only generated there, so no ray is wasted on the face or the neck.
     std::vector<Vec3f> dirs;
     for (size_t t = 0; t < mesh.triangles.size(); ++t)
         if (selected(scalp, t))
@@ -79,23 +77,31 @@ std::vector<SurfacePoint> fibonacciRoots(const TriangleMesh& mesh, const std::ve
                 const Vec3f d = mesh.positions[v] - c;
                 if (d.norm() > 0.f) dirs.push_back(d.normalized());
             }
+    Vec3f axis = Vec3f::Zero();
     for (const Vec3f& d : dirs) axis += d;
-    float minCos = -1.f;
-    if (axis.norm() > 1e-3f * float(dirs.size())) {
-        axis.normalize();
-        minCos = 1.f;
-        for (const Vec3f& d : dirs) minCos = std::min(minCos, d.dot(axis));
-        minCos = std::max(-1.f, minCos - 0.02f);  // margin: triangle interiors bulge past their corners
-    } else {
-        axis = Vec3f::UnitY();
-    }
+    if (settings.axis && settings.axis->norm() > 0.f) axis = settings.axis->normalized();
+    else if (axis.norm() > 1e-3f * float(dirs.size())) axis.normalize();
+    else axis = Vec3f::UnitY();  // the scalp surrounds the centre: use the whole sphere
+    float minCos = 1.f;
+    for (const Vec3f& d : dirs) minCos = std::min(minCos, d.dot(axis));
+    minCos = std::max(-1.f, minCos - 0.02f);  // margin: triangle interiors bulge past their corners
+    const Eigen::Quaternionf toAxis = Eigen::Quaternionf::FromTwoVectors(Vec3f::UnitY(), axis);
 
     const MeshQuery all(mesh);
     const MeshQuery onScalp(mesh, scalp);
     const float start = 1.01f * reach + 1e-3f;
-    // Projects each lattice direction; hits[i] is valid when on the scalp.
-    auto project = [&](size_t latticeCount, std::vector<SurfacePoint>& hits, std::vector<uint8_t>& ok) {
-        const std::vector<Vec3f> lattice = fibonacciCap(latticeCount, axis, minCos);
+    std::vector<SurfacePoint> hits;
+    std::vector<uint8_t> ok;
+    // Projects the cap of an n-point sphere lattice; returns the number of
+    // directions whose outermost surface point lies on the scalp.
+    auto project = [&](size_t n) {
+        std::vector<Vec3f> lattice;
+        // Heights decrease with the index: the cap is a prefix of the lattice.
+        for (size_t i = 0; i < n; ++i) {
+            const Vec3f p = fibonacciPoint(i, n);
+            if (p.y() < minCos) break;
+            lattice.push_back(toAxis * p);
+        }
         hits.assign(lattice.size(), SurfacePoint{});
         ok.assign(lattice.size(), 0);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, lattice.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
@@ -105,35 +111,41 @@ std::vector<SurfacePoint> fibonacciRoots(const TriangleMesh& mesh, const std::ve
                 // Re-derive the point by a closest-point query: its index
                 // tie-break makes a hit on a shared edge pick the same
                 // triangle whatever the BVH's traversal order.
-                const MeshPoint q = onScalp.closest(pointOf(mesh, h.point));
-                hits[i] = q.point;
+                hits[i] = onScalp.closest(pointOf(mesh, h.point)).point;
                 ok[i] = 1;
             }
         });
         return size_t(std::count(ok.begin(), ok.end(), uint8_t(1)));
     };
 
+    // The smallest lattice that puts `want` roots on the scalp (the seed's
+    // lattice itself when the scalp is its cap): grow by the hit ratio until
+    // enough land, then bisect. Large counts stop within 0.05 % of the
+    // target and drop the few extra roots evenly.
     const size_t want = settings.count;
-    std::vector<SurfacePoint> hits;
-    std::vector<uint8_t> ok;
-    size_t lattice = want;
-    size_t found = project(lattice, hits, ok);
-    // Hits grow in proportion to the lattice size: rescale until there are
-    // at least `want`, with few to spare.
-    for (int iteration = 0; iteration < 12 && (found < want || found > want + want / 200 + 2); ++iteration) {
-        if (found == 0)
-            throw Error("root placement: no Fibonacci lattice direction reaches the scalp from its centre "
-                        "(is the scalp hidden under other geometry?)");
-        const double scale = double(want) / double(found);
-        size_t next = size_t(std::ceil(double(lattice) * scale * (found < want ? 1.002 : 1.0)));
-        if (next == lattice) next += found < want ? 1 + lattice / 1000 : 0;
-        if (next == lattice) break;
-        lattice = next;
-        found = project(lattice, hits, ok);
+    const size_t slack = want > 10000 ? want / 2000 : 0;
+    size_t hi = size_t(std::ceil(double(want) * 2.0 / (1.0 - double(minCos)))), lo = 0;
+    size_t found = project(hi);
+    for (int i = 0; found < want; ++i) {
+        if (found == 0 || i > 20)
+            throw Error(cat("root placement: the Fibonacci lattice reaches only ", found, " of ", want,
+                            " roots on the scalp (is the scalp hidden under other geometry?)"));
+        lo = hi;
+        hi = std::max(hi + 1, size_t(std::ceil(double(hi) * double(want) / double(found) * 1.001)));
+        found = project(hi);
     }
-    if (found < want) throw Error(cat("root placement: the lattice reached only ", found, " of ", want, " roots"));
+    size_t foundHi = found;
+    if (lo == 0) lo = size_t(double(hi) * double(want) / double(found) * 0.999);
+    size_t last = hi;
+    while (hi - lo > 1 && foundHi - want > slack) {
+        const size_t mid = lo + (hi - lo) / 2;
+        const size_t f = project(last = mid);
+        if (f >= want) hi = mid, foundHi = f;
+        else lo = mid;
+    }
+    if (last != hi) project(hi);
     std::vector<SurfacePoint> roots;
-    roots.reserve(want);
+    roots.reserve(found);
     for (size_t i = 0; i < hits.size(); ++i)
         if (ok[i]) roots.push_back(hits[i]);
     // Drop the few extra roots evenly spread over the lattice order.
@@ -150,6 +162,52 @@ std::vector<SurfacePoint> fibonacciRoots(const TriangleMesh& mesh, const std::ve
     }
     return roots;
 }
+
+/// A cell coordinate packed into 63 bits (21 per axis, two's complement).
+uint64_t cellKey(const Eigen::Vector3i& c) {
+    return (uint64_t(uint32_t(c.x()) & 0x1FFFFF) << 42) | (uint64_t(uint32_t(c.y()) & 0x1FFFFF) << 21) |
+           uint64_t(uint32_t(c.z()) & 0x1FFFFF);
+}
+
+/// Cell key -> [begin, end) range of a key-sorted array: open addressing
+/// with linear probing (a node-based map's pointer chasing was the cost).
+class CellTable {
+  public:
+    explicit CellTable(const std::vector<std::pair<uint64_t, uint32_t>>& sorted) {
+        size_t cells = 0;
+        for (size_t i = 0; i < sorted.size(); ++i) cells += i == 0 || sorted[i].first != sorted[i - 1].first;
+        size_t capacity = 16;
+        while (capacity < 2 * cells) capacity *= 2;
+        mask_ = capacity - 1;
+        slots_.assign(capacity, Slot{kEmpty, 0, 0});
+        for (uint32_t i = 0; i < sorted.size();) {
+            uint32_t j = i;
+            while (j < sorted.size() && sorted[j].first == sorted[i].first) ++j;
+            size_t h = hash(sorted[i].first);
+            while (slots_[h].key != kEmpty) h = (h + 1) & mask_;
+            slots_[h] = {sorted[i].first, i, j};
+            i = j;
+        }
+    }
+    static constexpr uint32_t kNone = ~0u;
+    /// The cell's range, or {kNone, kNone} when no candidate lies in it.
+    std::pair<uint32_t, uint32_t> find(uint64_t key) const {
+        for (size_t h = hash(key);; h = (h + 1) & mask_) {
+            if (slots_[h].key == key) return {slots_[h].begin, slots_[h].end};
+            if (slots_[h].key == kEmpty) return {kNone, kNone};
+        }
+    }
+
+  private:
+    static constexpr uint64_t kEmpty = ~0ull;  // keys use 63 bits
+    struct Slot {
+        uint64_t key;
+        uint32_t begin, end;
+    };
+    size_t hash(uint64_t key) const { return size_t(mix(key)) & mask_; }
+    std::vector<Slot> slots_;
+    size_t mask_ = 0;
+};
 
 /// A max-heap of candidate weights that supports lowering a weight (sample
 /// elimination removes the heaviest and lightens its neighbours). Ties go to
@@ -228,68 +286,96 @@ std::vector<SurfacePoint> blueNoiseRoots(const TriangleMesh& mesh, const std::ve
     });
     if (m == want) return cand;
 
-    // Yuksel's parameters for 2-D sampling domains: r_max of the densest
-    // packing, r_min to limit the weight of very close pairs, exponent 8.
+    // Yuksel's parameters for 2-D sampling domains: r_max is the disk radius
+    // of the densest (hexagonal) packing, so neighbours within 2 r_max
+    // interact; distances below r_min weigh alike (weight limiting, β = 0.65,
+    // γ = 1.5); exponent α = 8.
     const double rMax = std::sqrt(total / (2.0 * std::sqrt(3.0) * double(want)));
-    const double rMin = rMax * 0.65 * (1.0 - std::pow(double(want) / double(m), 1.5));
     const double reach = 2.0 * rMax;
-    auto weight = [&](double d) { return std::pow(1.0 - std::max(d, rMin) / reach, 8.0); };
+    const double rMin = reach * 0.65 * (1.0 - std::pow(double(want) / double(m), 1.5));
+    auto weight = [&](double d) {
+        const double t = 1.0 - std::max(d, rMin) / reach, t2 = t * t, t4 = t2 * t2;
+        return t4 * t4;  // (1 - d̂ / 2r_max)^8
+    };
 
-    // A hash grid of cell size 2 r_max: neighbours lie in the 27 cells around.
+    // A hash grid of cell size 2 r_max: neighbours lie in the 27 cells
+    // around. Candidates are renumbered in cell order so that a cell's
+    // points are contiguous in memory (the scans are memory-bound).
     auto cellOf = [&](const Vec3f& p) {
         return Eigen::Vector3i(int(std::floor(p.x() / reach)), int(std::floor(p.y() / reach)),
                                int(std::floor(p.z() / reach)));
     };
-    auto key = [](const Eigen::Vector3i& c) {
-        return (uint64_t(uint32_t(c.x()) & 0x1FFFFF) << 42) | (uint64_t(uint32_t(c.y()) & 0x1FFFFF) << 21) |
-               uint64_t(uint32_t(c.z()) & 0x1FFFFF);
-    };
-    std::vector<std::pair<uint64_t, uint32_t>> sorted(m);
-    for (uint32_t i = 0; i < m; ++i) sorted[i] = {key(cellOf(pos[i])), i};
-    std::sort(sorted.begin(), sorted.end());
-    std::unordered_map<uint64_t, std::pair<uint32_t, uint32_t>> cells;
-    for (uint32_t i = 0; i < m;) {
-        uint32_t j = i;
-        while (j < m && sorted[j].first == sorted[i].first) ++j;
-        cells.emplace(sorted[i].first, std::make_pair(i, j));
-        i = j;
+    std::vector<std::pair<uint64_t, uint32_t>> order(m);
+    for (uint32_t i = 0; i < m; ++i) order[i] = {cellKey(cellOf(pos[i])), i};
+    std::sort(order.begin(), order.end());
+    std::vector<Vec3f> spos(m);
+    for (uint32_t s = 0; s < m; ++s) spos[s] = pos[order[s].second];
+    // Cells in key order: cellStart[c] is the first candidate of cell c.
+    std::vector<uint32_t> cellStart, cellOfCandidate(m);
+    for (uint32_t t = 0; t < m; ++t) {
+        if (t == 0 || order[t].first != order[t - 1].first) cellStart.push_back(t);
+        cellOfCandidate[t] = uint32_t(cellStart.size() - 1);
     }
-    auto forNeighbours = [&](uint32_t i, auto&& visit) {
-        const Eigen::Vector3i c = cellOf(pos[i]);
-        for (int dx = -1; dx <= 1; ++dx)
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dz = -1; dz <= 1; ++dz) {
-                    const auto it = cells.find(key(c + Eigen::Vector3i(dx, dy, dz)));
-                    if (it == cells.end()) continue;
-                    for (uint32_t s = it->second.first; s < it->second.second; ++s) {
-                        const uint32_t j = sorted[s].second;
-                        if (j == i) continue;
-                        const double d = double((pos[i] - pos[j]).norm());
-                        if (d < reach) visit(j, d);
-                    }
-                }
+    const size_t cellCount = cellStart.size();
+    cellStart.push_back(uint32_t(m));
+    // Each cell's non-empty neighbour cells (itself included), found once per
+    // cell rather than once per candidate.
+    std::vector<uint32_t> neighbourStart(cellCount + 1, 0), neighbours;
+    {
+        const CellTable table(order);
+        std::vector<std::vector<uint32_t>> lists(cellCount);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, cellCount, 256), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t c = r.begin(); c != r.end(); ++c) {
+                const Eigen::Vector3i cc = cellOf(spos[cellStart[c]]);
+                for (int dx = -1; dx <= 1; ++dx)
+                    for (int dy = -1; dy <= 1; ++dy)
+                        for (int dz = -1; dz <= 1; ++dz) {
+                            const uint32_t begin = table.find(cellKey(cc + Eigen::Vector3i(dx, dy, dz))).first;
+                            if (begin != CellTable::kNone) lists[c].push_back(cellOfCandidate[begin]);
+                        }
+            }
+        });
+        for (size_t c = 0; c < cellCount; ++c) {
+            neighbours.insert(neighbours.end(), lists[c].begin(), lists[c].end());
+            neighbourStart[c + 1] = uint32_t(neighbours.size());
+        }
+    }
+    auto forNeighbours = [&](uint32_t s, auto&& visit) {
+        const uint32_t c = cellOfCandidate[s];
+        for (uint32_t k = neighbourStart[c]; k < neighbourStart[c + 1]; ++k) {
+            const uint32_t nc = neighbours[k];
+            for (uint32_t t = cellStart[nc]; t < cellStart[nc + 1]; ++t) {
+                if (t == s) continue;
+                const double d = double((spos[s] - spos[t]).norm());
+                if (d < reach) visit(t, d);
+            }
+        }
     };
 
     std::vector<double> w(m, 0.0);
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(m), 1024), [&](const tbb::blocked_range<uint32_t>& r) {
-        for (uint32_t i = r.begin(); i != r.end(); ++i) forNeighbours(i, [&](uint32_t, double d) { w[i] += weight(d); });
+        for (uint32_t s = r.begin(); s != r.end(); ++s) forNeighbours(s, [&](uint32_t, double d) { w[s] += weight(d); });
     });
     // Remove the most crowded candidate until `want` remain, taking its
     // contribution off its neighbours' weights.
     WeightHeap heap(w);
     while (heap.size() > want) {
-        const uint32_t i = heap.pop();
-        forNeighbours(i, [&](uint32_t j, double d) {
-            if (heap.contains(j)) {
-                w[j] -= weight(d);
-                heap.lower(j, w[j]);
+        const uint32_t s = heap.pop();
+        forNeighbours(s, [&](uint32_t t, double d) {
+            if (heap.contains(t)) {
+                w[t] -= weight(d);
+                heap.lower(t, w[t]);
             }
         });
     }
+    std::vector<uint32_t> kept;
+    kept.reserve(want);
+    for (uint32_t s = 0; s < m; ++s)
+        if (heap.contains(s)) kept.push_back(order[s].second);
+    std::sort(kept.begin(), kept.end());
     std::vector<SurfacePoint> roots;
     roots.reserve(want);
-    for (uint32_t i = 0; i < m; ++i)
-        if (heap.contains(i)) roots.push_back(cand[i]);
+    for (uint32_t i : kept) roots.push_back(cand[i]);
     return roots;
 }
 

@@ -32,6 +32,9 @@ struct RootSettings {
     /// Fibonacci: centre of the lattice sphere; default: a least-squares
     /// sphere fitted to the scalp (the skull's centre for a cap-like scalp).
     std::optional<Vec3f> center;
+    /// Fibonacci: the lattice's pole; default: the mean direction of the scalp
+    /// from the centre (a scalp cap's own axis makes the lattice the seed's).
+    std::optional<Vec3f> axis;
     /// Blue noise: candidates per root (Yuksel uses 3-5; more is slower and slightly more even).
     float candidateRatio = 4.f;
 };
