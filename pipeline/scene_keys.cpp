@@ -7,6 +7,8 @@ void addSceneKeys(SchemaBuilder& b) {
     addShotKeys(b);
     addOutputKeys(b);
     addRenderKeys(b);
+    addHeadKeys(b);
+    addHairKeys(b);
 }
 
 void addShotKeys(SchemaBuilder& b) {

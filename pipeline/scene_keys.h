@@ -11,5 +11,7 @@ void addSceneKeys(SchemaBuilder& b);
 void addShotKeys(SchemaBuilder& b);    // top level: name, frames, fps, seed
 void addOutputKeys(SchemaBuilder& b);  // output: directory, templates
 void addRenderKeys(SchemaBuilder& b);  // render: camera, lights, materials (scene_keys_render.cpp)
+void addHeadKeys(SchemaBuilder& b);    // head: import, clip, scalp, collider (scene_keys_head.cpp)
+void addHairKeys(SchemaBuilder& b);    // hair: root counts and placement (scene_keys_hair.cpp)
 
 }  // namespace hp
