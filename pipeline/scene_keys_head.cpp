@@ -57,9 +57,9 @@ void addHeadKeys(SchemaBuilder& b) {
                 "each frame's deformed mesh (a build per frame); exact: closest-triangle queries on the "
                 "deformed mesh (slower queries); none: no head collision.")
         .number("head.collider.voxel_size", 0.002, 1e-5, 1, "m", "Grid voxel size (trilinear error ≲ voxel/2 at sharp features).")
-        .number("head.collider.exterior_band", 0.008, 1e-5, 10, "m",
+        .number("head.collider.exterior_band", 0.006, 1e-5, 10, "m",
                 "Exact distances are kept this far outside the surface; beyond, a lower bound.")
-        .number("head.collider.interior_band", 0.008, 1e-5, 10, "m",
+        .number("head.collider.interior_band", 0.006, 1e-5, 10, "m",
                 "And this far inside; deeper points are measured exactly against the rest mesh.");
 }
 

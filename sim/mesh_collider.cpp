@@ -138,6 +138,14 @@ LevelSetCollider::LevelSetCollider(std::shared_ptr<const LevelSet> grid, const E
 
 float LevelSetCollider::signedDistance(const Vec3f& p, Vec3f* normal) const {
     const Vec3f r = worldToRest_ * p;
+    const Eigen::AlignedBox3f& box = grid_->bounds();
+    const float boxDistance = box.exteriorDistance(r);
+    if (boxDistance > 0.f) {
+        // Outside the band's box: farther than the band from the surface, so
+        // the bound needs no grid lookup (most strand vertices away from the head).
+        if (normal) *normal = rotation_ * (r - box.center()).normalized();
+        return std::max(boxDistance, grid_->settings().exteriorBand);
+    }
     float d = 0.f;
     Vec3f g;
     if (grid_->sample(r, d, normal ? &g : nullptr)) {
@@ -155,12 +163,11 @@ float LevelSetCollider::signedDistance(const Vec3f& p, Vec3f* normal) const {
         if (normal) *normal = rotation_ * n;
         return e;
     }
-    const Eigen::AlignedBox3f& box = grid_->bounds();
     if (normal) {
         const Vec3f away = r - box.center();
         *normal = rotation_ * (away.norm() > 0.f ? Vec3f(away.normalized()) : Vec3f::UnitY());
     }
-    return d < 0.f ? d : std::max(d, box.exteriorDistance(r));
+    return d;
 }
 
 }  // namespace hp

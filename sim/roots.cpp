@@ -88,66 +88,66 @@ std::vector<SurfacePoint> fibonacciRoots(const TriangleMesh& mesh, const std::ve
     const Eigen::Quaternionf toAxis = Eigen::Quaternionf::FromTwoVectors(Vec3f::UnitY(), axis);
 
     const MeshQuery all(mesh);
-    const MeshQuery onScalp(mesh, scalp);
     const float start = 1.01f * reach + 1e-3f;
-    std::vector<SurfacePoint> hits;
-    std::vector<uint8_t> ok;
-    // Projects the cap of an n-point sphere lattice; returns the number of
-    // directions whose outermost surface point lies on the scalp.
-    auto project = [&](size_t n) {
-        std::vector<Vec3f> lattice;
+    std::vector<Vec3f> lattice;
+    std::vector<RayHit> hits;
+    // Casts the cap of an n-point sphere lattice; returns how many
+    // directions' outermost surface point lies on the scalp.
+    auto cast = [&](size_t n) {
+        lattice.clear();
         // Heights decrease with the index: the cap is a prefix of the lattice.
         for (size_t i = 0; i < n; ++i) {
             const Vec3f p = fibonacciPoint(i, n);
             if (p.y() < minCos) break;
             lattice.push_back(toAxis * p);
         }
-        hits.assign(lattice.size(), SurfacePoint{});
-        ok.assign(lattice.size(), 0);
+        hits.assign(lattice.size(), RayHit{});
         tbb::parallel_for(tbb::blocked_range<size_t>(0, lattice.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i != r.end(); ++i) {
                 const RayHit h = all.intersect(c + start * lattice[i], -lattice[i]);
-                if (!h.hit() || !selected(scalp, h.point.triangle)) continue;
-                // Re-derive the point by a closest-point query: its index
-                // tie-break makes a hit on a shared edge pick the same
-                // triangle whatever the BVH's traversal order.
-                hits[i] = onScalp.closest(pointOf(mesh, h.point)).point;
-                ok[i] = 1;
+                if (h.hit() && selected(scalp, h.point.triangle)) hits[i] = h;
             }
         });
-        return size_t(std::count(ok.begin(), ok.end(), uint8_t(1)));
+        return size_t(std::count_if(hits.begin(), hits.end(), [](const RayHit& h) { return h.hit(); }));
     };
 
     // The smallest lattice that puts `want` roots on the scalp (the seed's
-    // lattice itself when the scalp is its cap): grow by the hit ratio until
-    // enough land, then bisect. Large counts stop within 0.05 % of the
-    // target and drop the few extra roots evenly.
+    // lattice itself when the scalp is its cap). Hits grow nearly in
+    // proportion to the lattice size, so proportional guesses, kept inside
+    // the bracket [lo, hi] found so far, converge in a few casts. Large
+    // counts stop within 0.1 % of the target and drop the extra roots evenly.
     const size_t want = settings.count;
-    const size_t slack = want > 10000 ? want / 2000 : 0;
-    size_t hi = size_t(std::ceil(double(want) * 2.0 / (1.0 - double(minCos)))), lo = 0;
-    size_t found = project(hi);
-    for (int i = 0; found < want; ++i) {
-        if (found == 0 || i > 20)
+    const size_t slack = want > 10000 ? want / 1000 : 0;
+    size_t n = size_t(std::ceil(double(want) * 2.0 / (1.0 - double(minCos)))), lo = 0, hi = 0, foundHi = 0;
+    size_t found = cast(n);
+    for (int i = 0;; ++i) {
+        if (found >= want && (hi == 0 || n < hi)) hi = n, foundHi = found;
+        if (found < want) lo = std::max(lo, n);
+        if (hi && (foundHi - want <= slack || hi - lo <= 1)) break;
+        if (found == 0 || i > 40)
             throw Error(cat("root placement: the Fibonacci lattice reaches only ", found, " of ", want,
                             " roots on the scalp (is the scalp hidden under other geometry?)"));
-        lo = hi;
-        hi = std::max(hi + 1, size_t(std::ceil(double(hi) * double(want) / double(found) * 1.001)));
-        found = project(hi);
+        size_t next = size_t(std::llround(double(n) * double(want) / double(found)));
+        if (found < want) next = std::max(next, n + 1 + n / 2000);
+        if (hi) next = std::min(next, hi - 1);
+        if (next <= lo) next = hi ? lo + (hi - lo) / 2 : lo + 1;
+        n = next;
+        found = cast(n);
     }
-    size_t foundHi = found;
-    if (lo == 0) lo = size_t(double(hi) * double(want) / double(found) * 0.999);
-    size_t last = hi;
-    while (hi - lo > 1 && foundHi - want > slack) {
-        const size_t mid = lo + (hi - lo) / 2;
-        const size_t f = project(last = mid);
-        if (f >= want) hi = mid, foundHi = f;
-        else lo = mid;
-    }
-    if (last != hi) project(hi);
-    std::vector<SurfacePoint> roots;
-    roots.reserve(found);
+    if (n != hi) cast(hi);
+    std::vector<size_t> onScalpHits;
     for (size_t i = 0; i < hits.size(); ++i)
-        if (ok[i]) roots.push_back(hits[i]);
+        if (hits[i].hit()) onScalpHits.push_back(i);
+    const MeshQuery onScalp(mesh, scalp);
+    std::vector<SurfacePoint> roots(onScalpHits.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, roots.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t k = r.begin(); k != r.end(); ++k) {
+            // Re-derive the point by a closest-point query: its index
+            // tie-break makes a hit on a shared edge pick the same triangle
+            // whatever the BVH's traversal order.
+            roots[k] = onScalp.closest(pointOf(mesh, hits[onScalpHits[k]].point)).point;
+        }
+    });
     // Drop the few extra roots evenly spread over the lattice order.
     const size_t extra = roots.size() - want;
     if (extra > 0) {
