@@ -141,10 +141,12 @@ float LevelSetCollider::signedDistance(const Vec3f& p, Vec3f* normal) const {
     const Eigen::AlignedBox3f& box = grid_->bounds();
     const float boxDistance = box.exteriorDistance(r);
     if (boxDistance > 0.f) {
-        // Outside the band's box: farther than the band from the surface, so
-        // the bound needs no grid lookup (most strand vertices away from the head).
+        // Outside the box of the band's voxel centres, which reaches at least
+        // (band - voxel) beyond every surface point: a lower bound without a
+        // grid lookup (most strand vertices away from the head).
         if (normal) *normal = rotation_ * (r - box.center()).normalized();
-        return std::max(boxDistance, grid_->settings().exteriorBand);
+        const LevelSetSettings& s = grid_->settings();
+        return boxDistance + std::max(0.f, s.exteriorBand - s.voxelSize);
     }
     float d = 0.f;
     Vec3f g;

@@ -50,11 +50,12 @@ class MeshCollider final : public Collider {
 /// @brief A rest-pose signed distance grid carried by a rigid transform:
 /// d(p) = grid(T⁻¹ p), normal = R · ∇grid.
 ///
-/// Beyond the grid's exterior band the result is a lower bound: the larger of
-/// the band width and the distance to the band's bounding box (with the
-/// normal pointing away from the box centre), so far-away strand vertices
-/// cost no more than near ones. Deeper inside than the interior band it asks
-/// `exact` (the rest mesh's MeshCollider) when given.
+/// Beyond the grid's exterior band the result is a lower bound of the
+/// distance (the band's values, or outside the band's box the distance to
+/// the box plus band - voxel), with the normal pointing away from the box
+/// centre, so far-away strand vertices cost no more than near ones. Deeper
+/// inside than the interior band it asks `exact` (the rest mesh's
+/// MeshCollider) when given.
 class LevelSetCollider final : public Collider {
   public:
     LevelSetCollider(std::shared_ptr<const LevelSet> grid, const Eigen::Isometry3f& restToWorld,

@@ -362,10 +362,15 @@ TEST(HeadAnimation, ColliderMatchesTheDeformedHead) {
         const size_t scalpVertices = rig->meshes[0].positions.size();
         for (size_t v = 0; v < m.positions.size(); v += 3) {
             if (head.rest().positions[v].y() < 0.0f) continue;
-            for (float off : {-0.004f, -0.001f, 0.002f, 0.005f}) {
+            for (float off : {-0.004f, -0.001f, 0.002f, 0.0035f, 0.012f}) {
                 const Vec3f q = m.positions[v] + off * m.normals[v];
                 const float d = p.collider->signedDistance(q, &n), e = exact.signedDistance(q);
                 ASSERT_EQ(d < 0.f, e < 0.f) << "sign at offset " << off << ", method " << int(method);
+                if (e > 0.004f) {
+                    // Beyond the band (6 mm less a voxel) the grid gives a lower bound.
+                    ASSERT_LE(d, e + 1e-4f) << "offset " << off << ", method " << int(method);
+                    continue;
+                }
                 worst = std::max(worst, std::abs(d - e));
                 if (v < scalpVertices) scalpError = std::max(scalpError, std::abs(d - e));
             }
