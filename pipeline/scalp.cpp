@@ -24,6 +24,8 @@ float sampleMask(const Image& img, int c, const Vec2f& uv) {
     return (1 - ay) * ((1 - ax) * at(i, j) + ax * at(i + 1, j)) + ay * ((1 - ax) * at(i, j + 1) + ax * at(i + 1, j + 1));
 }
 
+std::string show(const Vec3f& v) { return cat("[", v.x(), ", ", v.y(), ", ", v.z(), "]"); }
+
 std::string describe(ScalpMethod m) {
     switch (m) {
         case ScalpMethod::All: return "all";
@@ -101,8 +103,8 @@ std::vector<uint8_t> selectScalp(const HeadRig& rig, const TriangleMesh& rest, c
         if (s.method == ScalpMethod::VertexColor || s.method == ScalpMethod::Texture)
             detail = cat(" (channel ", kChannelNames[s.channel], " never reaches ", s.threshold, ")");
         if (s.method == ScalpMethod::Region)
-            detail = cat(" (no triangle lies within ", s.angleDegrees, " deg of the axis [", s.axis.transpose(),
-                         "] around [", s.center.transpose(), "])");
+            detail = cat(" (no triangle lies within ", s.angleDegrees, " deg of the axis ", show(s.axis), " around ",
+                         show(s.center), ")");
         throw Error(cat("the scalp selection (", describe(s.method), ") selects no triangle of ", rig.file, detail));
     }
     return mask;
