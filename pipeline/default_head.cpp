@@ -116,6 +116,7 @@ HeadRig makeDefaultHead(const DefaultHeadOptions& o) {
     for (uint32_t material : {0u, 1u}) {
         RigMesh m;
         m.name = material == 0 ? "scalp" : "skin";
+        m.instance = int(material);
         m.node = 1 + int(material);
         m.material = material;
         m.boneNodes = {3, 4};

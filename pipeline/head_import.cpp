@@ -236,6 +236,7 @@ HeadRig importHead(const HeadImportSettings& settings) {
     for (size_t i = 0; i < instances.size(); ++i) {
         if (!keep[i]) continue;
         RigMesh m = convertMesh(instances[i].mesh, instances[i].node, nodeIndex, file);
+        m.instance = int(i);
         if (!m.triangles.empty()) rig.meshes.push_back(std::move(m));
     }
     if (rig.meshes.empty()) throw AssetError(file, "contains no triangle mesh");

@@ -200,13 +200,14 @@ std::string HeadRig::summary() const {
     std::ostringstream s;
     s << std::fixed << std::setprecision(2);
     s << "  file:      " << file << "\n";
-    s << "  meshes:    " << meshes.size() << " (";
-    for (size_t i = 0; i < meshes.size(); ++i) {
-        const RigMesh& m = meshes[i];
-        s << (i ? ", " : "") << m.name << ": " << m.triangles.size() << " tris";
+    s << "  meshes:    " << meshes.size() << "\n";
+    for (const RigMesh& m : meshes) {
+        s << "    " << m.instance << ": " << m.name << ", " << m.triangles.size() << " triangles";
         if (m.material < materials.size() && !materials[m.material].empty()) s << ", material " << materials[m.material];
+        if (m.skinned()) s << ", skinned";
+        if (!m.morphNames.empty()) s << ", " << m.morphNames.size() << " morph targets";
+        s << "\n";
     }
-    s << ")\n";
     s << "  triangles: " << triangleCount() << ", vertices: " << vertexCount() << "\n";
     size_t skinned = 0, morphed = 0;
     for (const RigMesh& m : meshes) skinned += m.skinned(), morphed += !m.morphPositions.empty();

@@ -59,6 +59,7 @@ struct RigClip {
 /// One mesh instance (an assimp mesh placed by a node).
 struct RigMesh {
     std::string name;
+    int instance = 0;       ///< index among the file's mesh instances (what head.meshes counts)
     int node = -1;          ///< the node that places it (unskinned meshes move with it)
     uint32_t material = 0;  ///< index in HeadRig::materials
     std::vector<Vec3f> positions, normals;  ///< bind pose, mesh space
