@@ -2,6 +2,7 @@
 
 #include "core/log.h"
 #include "pipeline/frame_range.h"
+#include "pipeline/head_setup.h"
 #include "pipeline/progress.h"
 #include "pipeline/schema.h"
 #include "pipeline/view_settings.h"
@@ -128,6 +129,7 @@ CommandSpec validateCommandSpec() {
         CommandContext ctx(cl);
         resolveShot(ctx.scene, ctx.options);
         makeView(ctx.scene);  // checks across render keys
+        if (sceneHasHead(ctx.scene)) loadHead(ctx.scene);  // mesh, clip and scalp selections
         std::cout << ctx.scene.name() << ": ok\n";
         return int(kExitOk);
     };
@@ -146,8 +148,15 @@ CommandSpec infoCommandSpec() {
                   << "frames:  " << formatFrameRange(shot.frames) << " (" << shot.frames.size() << " frames at "
                   << shot.fps << " fps)\n"
                   << "output:  " << shot.outputDir.string() << "\n"
-                  << "seed:    " << shot.seed << "\n\nresolved keys:\n"
-                  << ctx.scene.dump();
+                  << "seed:    " << shot.seed << "\n";
+        if (sceneHasHead(ctx.scene)) {
+            try {
+                std::cout << "head:\n" << importHead(headImportSettings(ctx.scene)).summary();
+            } catch (const RigSelectionError& e) {
+                ctx.scene.fail("head.meshes", e.what());
+            }
+        }
+        std::cout << "\nresolved keys:\n" << ctx.scene.dump();
         return int(kExitOk);
     };
     return c;

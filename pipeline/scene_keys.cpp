@@ -6,10 +6,12 @@ namespace hp {
 void addSceneKeys(SchemaBuilder& b) {
     addShotKeys(b);
     addOutputKeys(b);
-    addRenderKeys(b);
-    addCompareKeys(b);
+    addHeadKeys(b);
+    addHairKeys(b);
     addFollowerKeys(b);
+    addRenderKeys(b);
     addPreviewKeys(b);
+    addCompareKeys(b);
 }
 
 void addShotKeys(SchemaBuilder& b) {

@@ -14,5 +14,7 @@ void addRenderKeys(SchemaBuilder& b);  // render: camera, lights, materials (sce
 void addCompareKeys(SchemaBuilder& b);  // compare: sequences, thresholds, report (scene_keys_compare.cpp)
 void addFollowerKeys(SchemaBuilder& b);  // hair.followers: follower modes (scene_keys_followers.cpp)
 void addPreviewKeys(SchemaBuilder& b); // preview: the GL preview pass (scene_keys_preview.cpp)
+void addHeadKeys(SchemaBuilder& b);    // head: import, clip, scalp, collider (scene_keys_head.cpp)
+void addHairKeys(SchemaBuilder& b);    // hair: root counts and placement (scene_keys_hair.cpp)
 
 }  // namespace hp

@@ -1,5 +1,8 @@
 #include "pipeline/stages.h"
 
+#include "pipeline/head_setup.h"
+#include "pipeline/head_source.h"
+
 namespace hp {
 
 namespace {
@@ -23,6 +26,7 @@ class TimeOnlySource final : public FrameSource {
 }  // namespace
 
 std::unique_ptr<FrameSource> makeFrameSource(const Scene& scene, const ShotSettings& shot) {
+    if (sceneHasHead(scene)) return makeHeadFrameSource(loadHead(scene).motion, shot.fps);
     return std::make_unique<TimeOnlySource>(shot.fps);
 }
 

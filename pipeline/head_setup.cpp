@@ -1,0 +1,176 @@
+#include "pipeline/head_setup.h"
+
+#include "core/log.h"
+
+#include <chrono>
+#include <sstream>
+
+namespace hp {
+
+namespace {
+
+std::vector<std::string> splitList(const std::string& text) {
+    std::vector<std::string> items;
+    std::stringstream in(text);
+    for (std::string item; std::getline(in, item, ',');) {
+        const size_t b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
+        if (b != std::string::npos) items.push_back(item.substr(b, e - b + 1));
+    }
+    return items;
+}
+
+Eigen::Matrix3f eulerXYZ(const Vec3f& degrees) {
+    const Vec3f r = degrees * float(M_PI / 180.0);
+    // X first, then Y, then Z: R = Rz · Ry · Rx.
+    return (Eigen::AngleAxisf(r.z(), Vec3f::UnitZ()) * Eigen::AngleAxisf(r.y(), Vec3f::UnitY()) *
+            Eigen::AngleAxisf(r.x(), Vec3f::UnitX()))
+        .toRotationMatrix();
+}
+
+double seconds(std::chrono::steady_clock::time_point since) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+}  // namespace
+
+bool sceneHasHead(const Scene& scene) { return !scene.file("head.file").empty(); }
+
+HeadImportSettings headImportSettings(const Scene& scene) {
+    HeadImportSettings s;
+    s.file = scene.file("head.file");
+    s.meshes = splitList(scene.text("head.meshes"));
+    s.unitScale = scene.number("head.unit_scale");
+    const std::string up = scene.text("head.up_axis");
+    s.upAxis = up == "z" ? UpAxis::Z : up == "x" ? UpAxis::X : UpAxis::Y;
+    s.placement = Affine3f::Identity();
+    s.placement.translate(scene.vec3f("head.translate"));
+    s.placement.linear() = eulerXYZ(scene.vec3f("head.rotate"));
+    return s;
+}
+
+HeadAnimationSettings headAnimationSettings(const Scene& scene, const HeadRig& rig) {
+    HeadAnimationSettings s;
+    try {
+        s.clip = findClip(rig, scene.text("head.clip"));
+    } catch (const RigSelectionError& e) {
+        scene.fail("head.clip", e.what());
+    }
+    s.clipOffset = scene.number("head.clip_offset");
+    s.clipSpeed = scene.number("head.clip_speed");
+    s.loop = scene.flag("head.loop");
+    s.restTime = scene.number("head.rest_time");
+    const Curve& yaw = scene.curve("head.animate.yaw");
+    const Curve& pitch = scene.curve("head.animate.pitch");
+    const Curve& roll = scene.curve("head.animate.roll");
+    const bool animated = yaw.animated() || pitch.animated() || roll.animated() || yaw.eval(0) != 0.0 ||
+                          pitch.eval(0) != 0.0 || roll.eval(0) != 0.0;
+    if (animated) {
+        const Vec3f pivot = scene.vec3f("head.animate.pivot");
+        const double fps = scene.number("fps");
+        // Curves are keyed by frame; the motion is asked by time.
+        s.motion = [=](double time) {
+            const double f = time * fps, k = M_PI / 180.0;
+            const Eigen::Matrix3f r = (Eigen::AngleAxisf(float(roll.eval(f) * k), Vec3f::UnitZ()) *
+                                       Eigen::AngleAxisf(float(pitch.eval(f) * k), Vec3f::UnitX()) *
+                                       Eigen::AngleAxisf(float(yaw.eval(f) * k), Vec3f::UnitY()))
+                                          .toRotationMatrix();
+            Eigen::Isometry3f a = Eigen::Isometry3f::Identity();
+            a.linear() = r;
+            a.translation() = pivot - r * pivot;
+            return a;
+        };
+    }
+    const std::string method = scene.text("head.collider.method");
+    s.collider = method == "per_frame" ? ColliderMethod::PerFrame
+                 : method == "exact"   ? ColliderMethod::Exact
+                 : method == "none"    ? ColliderMethod::None
+                                       : ColliderMethod::Rigid;
+    s.levelSet.voxelSize = float(scene.number("head.collider.voxel_size"));
+    s.levelSet.exteriorBand = float(scene.number("head.collider.exterior_band"));
+    s.levelSet.interiorBand = float(scene.number("head.collider.interior_band"));
+    if (s.levelSet.exteriorBand < s.levelSet.voxelSize)
+        scene.fail("head.collider.exterior_band", "must be at least head.collider.voxel_size");
+    if (s.levelSet.interiorBand < s.levelSet.voxelSize)
+        scene.fail("head.collider.interior_band", "must be at least head.collider.voxel_size");
+    return s;
+}
+
+ScalpSettings scalpSettings(const Scene& scene) {
+    ScalpSettings s;
+    const std::string method = scene.text("head.scalp.method");
+    s.method = method == "material"       ? ScalpMethod::Material
+               : method == "vertex_color" ? ScalpMethod::VertexColor
+               : method == "texture"      ? ScalpMethod::Texture
+               : method == "region"       ? ScalpMethod::Region
+                                          : ScalpMethod::All;
+    s.materials = splitList(scene.text("head.scalp.materials"));
+    if (s.method == ScalpMethod::Material && s.materials.empty())
+        scene.fail("head.scalp.materials", "head.scalp.method is material: name at least one material");
+    s.channel = int(std::string("rgba").find(scene.text("head.scalp.channel")));
+    s.threshold = float(scene.number("head.scalp.threshold"));
+    s.mask = scene.file("head.scalp.mask");
+    if (s.method == ScalpMethod::Texture && s.mask.empty())
+        scene.fail("head.scalp.mask", "head.scalp.method is texture: give the mask image");
+    s.center = scene.vec3f("head.scalp.center");
+    s.axis = scene.vec3f("head.scalp.axis");
+    if (s.axis.norm() == 0.f) scene.fail("head.scalp.axis", "must not be zero");
+    s.angleDegrees = float(scene.number("head.scalp.angle"));
+    return s;
+}
+
+HeadSetup loadHead(const Scene& scene) {
+    if (!sceneHasHead(scene)) scene.fail("head.file", "the scene has no head file");
+    const auto start = std::chrono::steady_clock::now();
+    HeadSetup h;
+    try {
+        h.rig = std::make_shared<const HeadRig>(importHead(headImportSettings(scene)));
+    } catch (const RigSelectionError& e) {
+        scene.fail("head.meshes", e.what());
+    }
+    auto motion = std::make_shared<AnimatedHead>(h.rig, headAnimationSettings(scene, *h.rig));
+    h.rest = motion->rest();
+    const ScalpSettings scalp = scalpSettings(scene);
+    try {
+        h.scalp = selectScalp(*h.rig, h.rest, scalp);
+    } catch (const AssetError&) {
+        throw;
+    } catch (const Error& e) {
+        scene.fail(scalp.method == ScalpMethod::Material ? "head.scalp.materials" : "head.scalp.method", e.what());
+    }
+    motion->setFitTriangles(h.scalp);
+    h.motion = std::move(motion);
+    size_t scalpTriangles = 0;
+    for (uint8_t s : h.scalp) scalpTriangles += s;
+    logVerbose("head: ", h.rest.triangleCount(), " triangles, ", scalpTriangles, " on the scalp (",
+               surfaceArea(h.rest, h.scalp) * 1e4, " cm²), set up in ", seconds(start), " s");
+    return h;
+}
+
+RootSettings rootSettings(const Scene& scene, size_t count, uint64_t seed) {
+    RootSettings r;
+    r.count = count;
+    r.seed = seed;
+    r.method = scene.text("hair.roots.method") == "blue-noise" ? RootMethod::BlueNoise : RootMethod::Fibonacci;
+    if (scene.text("head.scalp.method") == "region") {
+        // The seed's partial sphere: the lattice shares the cap's centre and pole.
+        r.center = scene.vec3f("head.scalp.center");
+        r.axis = scene.vec3f("head.scalp.axis").normalized();
+    }
+    return r;
+}
+
+GroomRoots placeGroomRoots(const Scene& scene, const HeadSetup& head) {
+    const auto start = std::chrono::steady_clock::now();
+    const uint64_t seed = uint64_t(scene.integer("seed"));
+    GroomRoots g;
+    // Independent placements: the followers' stream differs from the guides'.
+    g.guides = placeRoots(head.rest, head.scalp,
+                          rootSettings(scene, size_t(scene.integer("hair.guides.count")), seed * 2 + 0));
+    g.followers = placeRoots(head.rest, head.scalp,
+                             rootSettings(scene, size_t(scene.integer("hair.followers.count")), seed * 2 + 1));
+    logVerbose("roots: ", g.guides.size(), " guides, ", g.followers.size(), " followers (",
+               scene.text("hair.roots.method"), ") in ", seconds(start), " s");
+    return g;
+}
+
+}  // namespace hp
