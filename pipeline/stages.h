@@ -7,4 +7,7 @@
 
 namespace hp {
 
+/// The Embree reference renderer (stage_reference.cpp); null unless reference.enabled.
+StagePtr makeReferenceStage(const Scene& scene, const ShotSettings& shot);
+
 }  // namespace hp

@@ -108,7 +108,11 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
     const View& view = ctx.view;
     Vec3f beta = Vec3f::Ones();
     Vec3f l;
+    // Past the last bounce one more BSDF-sampled ray still gathers the
+    // environment (its direct light), when there is one.
+    const bool environment = view.environment.maxCoeff() > 0.f;
     for (int bounce = 0;; ++bounce) {
+        const bool last = bounce >= ctx.settings.bounces;
         const Vec3f p = o + hit.t * d;
         const Vec3f wo = -d;
         Vec3f nextDir;
@@ -128,7 +132,7 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
                 r.radiance += beta.cwiseProduct(f).cwiseProduct(radiance);
                 if (bounce == 0) r.specular += lobes[0].cwiseProduct(radiance);
             }
-            if (bounce >= ctx.settings.bounces) break;
+            if (last && !environment) break;
             const Vec2f u0 = sampler.next2D(), u1 = sampler.next2D();
             const HairSample s = bsdf.sample(woL, u0, u1);
             if (!s.valid) break;
@@ -147,7 +151,7 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
                 if (c > 0.f && l.dot(ng) > 0.f)
                     r.radiance += beta.cwiseProduct(albedo * (c * kInvPi)).cwiseProduct(radiance);
             }
-            if (bounce >= ctx.settings.bounces) break;
+            if (last && !environment) break;
             Vec3f b1, b2;
             sampling::orthonormalBasis(n, &b1, &b2);
             const Vec3f w = sampling::cosineHemisphere(sampler.next2D());
@@ -157,7 +161,7 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
         }
         // Russian roulette after two bounces keeps long dark paths cheap
         // without bias.
-        if (bounce >= 2) {
+        if (bounce >= 2 && !last) {
             const float q = std::max(0.05f, 1.f - beta.maxCoeff());
             if (sampler.next1D() < q) break;
             beta /= 1.f - q;
@@ -170,6 +174,7 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
             r.radiance += beta.cwiseProduct(view.environment);
             break;
         }
+        if (last) break;
     }
     r.diffuse = r.radiance - r.specular;
     return r;
