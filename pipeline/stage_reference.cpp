@@ -70,7 +70,7 @@ class ReferenceStage final : public FrameStage {
     void run(const FrameData& data) override {
         const TriangleMesh* head = data.head && !data.head->mesh.triangles.empty() ? &data.head->mesh : nullptr;
         if (!data.strands && !head)
-            throw FrameError(cat("reference: frame ", data.frame,
+            throw FrameError(cat("frame ", data.frame,
                                  " has neither strands nor a head to render (no hair or head stage produced them)"));
         if (!data.strands) logVerbose("reference: frame ", data.frame, " has no strands; rendering the head alone");
 

@@ -55,6 +55,10 @@ struct ReferenceSettings {
 struct ReferenceStats {
     double buildSeconds = 0.0;   ///< Embree scene construction
     double renderSeconds = 0.0;  ///< tracing and shading
+    /// Process CPU time of the two phases (all threads): the work done, which
+    /// a busy shared machine inflates far less than wall time.
+    double buildCpuSeconds = 0.0;
+    double renderCpuSeconds = 0.0;
     int64_t sceneBytes = 0;      ///< Embree memory held by the frame's scene (memory monitor)
     int64_t peakBytes = 0;       ///< Embree peak over build and render
     size_t strands = 0;

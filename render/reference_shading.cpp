@@ -159,12 +159,15 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
             if (nextDir.dot(ng) <= 0.f) break;
             beta = beta.cwiseProduct(albedo);  // (albedo/π · cos) / (cos/π)
         }
-        // Russian roulette after two bounces keeps long dark paths cheap
-        // without bias.
-        if (bounce >= 2 && !last) {
-            const float q = std::max(0.05f, 1.f - beta.maxCoeff());
-            if (sampler.next1D() < q) break;
-            beta /= 1.f - q;
+        // Russian roulette: continue with probability max(β) (≤ 1) and
+        // reweight, which is unbiased and stops the many paths that dark
+        // hair has already absorbed.
+        if (!last) {
+            const float survive = std::min(1.f, beta.maxCoeff());
+            if (survive < 1.f) {
+                if (!(sampler.next1D() < survive)) break;
+                beta /= survive;
+            }
         }
         o = nextOrigin;
         d = nextDir;
@@ -182,9 +185,8 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
 
 }  // namespace
 
-SampleResult shadeSample(const ShadingContext& ctx, const Vec3f& origin, const Vec3f& dir,
+SampleResult shadeSample(const ShadingContext& ctx, const Vec3f& origin, const Vec3f& dir, const SceneHit& hit,
                          sampling::PixelSampler& sampler) {
-    const SceneHit hit = ctx.scene.intersect(origin, dir, 0.f, kInf);
     SampleResult r;
     if (hit.kind == SceneHit::Kind::None) {
         r.radiance = r.diffuse = ctx.view.environment;

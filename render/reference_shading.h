@@ -28,8 +28,9 @@ struct SampleResult {
     uint32_t rays = 0;
 };
 
-/// Traces the camera ray (origin, unit dir) and shades it with the context's mode.
-SampleResult shadeSample(const ShadingContext& ctx, const Vec3f& origin, const Vec3f& dir,
+/// Shades the camera ray (origin, unit dir) whose first hit is `hit`, with
+/// the context's mode; further random numbers come from `sampler`.
+SampleResult shadeSample(const ShadingContext& ctx, const Vec3f& origin, const Vec3f& dir, const SceneHit& hit,
                          sampling::PixelSampler& sampler);
 
 }  // namespace hp
