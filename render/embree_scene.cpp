@@ -72,8 +72,10 @@ namespace {
 /// Hits on the query's own strand within one segment of its start are the
 /// fibre's own surface.
 bool ownSurface(const EmbreeScene::Impl& s, const RayStart& start, unsigned prim) {
-    if (start.strand == kNoStrand || s.segmentStrand[prim] != start.strand) return false;
-    return prim + 1 >= start.segment && prim <= start.segment + 1;
+    // A strand's segments are consecutive primitives: compare indices first
+    // and touch the (large, cache-cold) strand table only for neighbours.
+    if (start.strand == kNoStrand || prim + 1 < start.segment || prim > start.segment + 1) return false;
+    return s.segmentStrand[prim] == start.strand;
 }
 
 struct IntersectQuery {

@@ -10,7 +10,8 @@
 //
 //   bench_reference [--strands 10000,100000] [--modes physical,kajiya-kay]
 //                   [--width 1920] [--height 1080] [--spp 16] [--bounces 4]
-//                   [--repeat 1] [--threads 2] [--out DIR] [--no-head]
+//                   [--repeat 1] [--threads 2] [--out DIR] [--no-head] [--no-shadows]
+//                   [--melanin 1.3]
 #include "render/reference.h"
 #include "sim/head.h"
 #include "sim/synthetic.h"
@@ -55,7 +56,8 @@ double median(std::vector<double> v) {
 int main(int argc, char** argv) {
     std::vector<std::string> strandCounts{"10000", "100000"}, modes{"physical", "kajiya-kay"};
     int width = 1920, height = 1080, spp = 16, bounces = 4, repeat = 1, threads = 2;
-    bool withHead = true;
+    bool withHead = true, shadows = true;
+    float melanin = 1.3f;
     std::string out;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -76,6 +78,8 @@ int main(int argc, char** argv) {
         else if (a == "--threads") threads = std::stoi(next());
         else if (a == "--out") out = next();
         else if (a == "--no-head") withHead = false;
+        else if (a == "--no-shadows") shadows = false;
+        else if (a == "--melanin") melanin = std::stof(next());
         else {
             std::fprintf(stderr, "unknown option %s (see the comment at the top of bench_reference.cpp)\n", a.c_str());
             return 1;
@@ -114,6 +118,8 @@ int main(int argc, char** argv) {
             s.bounces = bounces;
             s.seed = 1;
             s.frame = 1;
+            s.shadows = shadows;
+            s.fiber.sigmaA = hairAbsorptionFromMelanin(melanin, 0.f);
             std::vector<double> frame, build, render, bcpu, rcpu;
             ReferenceStats st;
             Image image;
