@@ -68,8 +68,9 @@ struct ReferenceStats {
 
 /// Channel names of the output image, in order: R G B A Z, then diffuse.R/G/B
 /// and specular.R/G/B if asked for, then strand_id. Colour is linear and
-/// premultiplied by A (coverage); Z is the view-space depth of the nearest
-/// sample, camera.farClip where nothing was hit.
+/// premultiplied by A (coverage), plus the environment seen where nothing is
+/// hit (zero with the default black environment); Z is the view-space depth
+/// of the nearest sample, camera.farClip where nothing was hit.
 std::vector<std::string> referenceChannels(const ReferenceSettings& settings);
 
 /// Renders frames; keeps one Embree device alive across them. Each render
