@@ -11,6 +11,7 @@ void addSceneKeys(SchemaBuilder& b) {
     addFollowerKeys(b);
     addRenderKeys(b);
     addPreviewKeys(b);
+    addReferenceKeys(b);
     addCompareKeys(b);
 }
 

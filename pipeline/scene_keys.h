@@ -16,5 +16,6 @@ void addFollowerKeys(SchemaBuilder& b);  // hair.followers: follower modes (scen
 void addPreviewKeys(SchemaBuilder& b); // preview: the GL preview pass (scene_keys_preview.cpp)
 void addHeadKeys(SchemaBuilder& b);    // head: import, clip, scalp, collider (scene_keys_head.cpp)
 void addHairKeys(SchemaBuilder& b);    // hair: root counts and placement (scene_keys_hair.cpp)
+void addReferenceKeys(SchemaBuilder& b);  // reference: Embree reference renderer (scene_keys_reference.cpp)
 
 }  // namespace hp

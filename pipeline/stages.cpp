@@ -36,6 +36,7 @@ std::vector<StagePtr> makeStages(const Scene& scene, const ShotSettings& shot, c
         if (stage && (only.empty() || only.count(stage->name()))) stages.push_back(std::move(stage));
     };
     add(makePreviewStage(scene, shot));
+    add(makeReferenceStage(scene, shot));
     add(makeCompareStage(scene, shot));  // last: reads the other stages' files
     return stages;
 }

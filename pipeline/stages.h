@@ -11,5 +11,7 @@ namespace hp {
 StagePtr makeCompareStage(const Scene& scene, const ShotSettings& shot);
 /// The GL preview (stage_preview.cpp); null unless preview.enabled.
 StagePtr makePreviewStage(const Scene& scene, const ShotSettings& shot);
+/// The Embree reference renderer (stage_reference.cpp); null unless reference.enabled.
+StagePtr makeReferenceStage(const Scene& scene, const ShotSettings& shot);
 
 }  // namespace hp

@@ -1,0 +1,281 @@
+#include "render/hair_bsdf.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hp {
+
+namespace {
+
+constexpr float kPi = float(M_PI);
+
+float safeSqrt(float x) { return std::sqrt(std::max(0.f, x)); }
+float safeAsin(float x) { return std::asin(std::clamp(x, -1.f, 1.f)); }
+
+/// log I0(x), I0 the modified Bessel function of the first kind of order 0.
+/// Series Σ (x²/4)^k / (k!)² below 12, the asymptotic expansion
+/// e^x / sqrt(2πx) (1 + 1/(8x) + 9/(128x²) + 225/(3072x³)) above (relative
+/// error < 1e-5 there). Working in logs keeps Mp finite for tiny variances.
+double logI0(double x) {
+    if (x > 12.0) {
+        const double r = 1.0 / x;
+        return x - 0.5 * std::log(2.0 * M_PI * x) + std::log1p(r * (1.0 / 8 + r * (9.0 / 128 + r * 225.0 / 3072)));
+    }
+    const double q = 0.25 * x * x;
+    double term = 1.0, sum = 1.0;
+    for (int k = 1; k < 64; ++k) {
+        term *= q / double(k * k);
+        sum += term;
+        if (term < 1e-12 * sum) break;
+    }
+    return std::log(sum);
+}
+
+/// d'Eon et al. 2011 longitudinal scattering, normalised so that
+/// ∫ Mp cos θi dθi = 1:
+///   Mp = csch(1/v) / (2v) · exp(−sin θi sin θo / v) · I0(cos θi cos θo / v),
+/// evaluated in logs: csch(1/v)/(2v) = e^(−1/v) / (v (1 − e^(−2/v))).
+float Mp(float cosThetaI, float cosThetaO, float sinThetaI, float sinThetaO, float v) {
+    const double a = double(cosThetaI) * cosThetaO / v;
+    const double b = double(sinThetaI) * sinThetaO / v;
+    const double logMp = logI0(a) - b - 1.0 / v - std::log(double(v)) - std::log1p(-std::exp(-2.0 / v));
+    return float(std::exp(logMp));
+}
+
+/// Unpolarised Fresnel reflectance of a dielectric of relative index `eta`
+/// for incidence cosine `cosI` from outside.
+float fresnelDielectric(float cosI, float eta) {
+    cosI = std::clamp(cosI, 0.f, 1.f);
+    const float sin2T = (1.f - cosI * cosI) / (eta * eta);
+    if (sin2T >= 1.f) return 1.f;
+    const float cosT = std::sqrt(1.f - sin2T);
+    const float rPar = (eta * cosI - cosT) / (eta * cosI + cosT);
+    const float rPerp = (cosI - eta * cosT) / (cosI + eta * cosT);
+    return 0.5f * (rPar * rPar + rPerp * rPerp);
+}
+
+/// Attenuation of the lobes (Chiang eq. 3-5): A0 = f, A1 = (1 − f)² T,
+/// A2 = A1 T f, residual A3 = A2 f T / (1 − f T) (the geometric sum of all
+/// longer paths). `cosTheta` is the longitudinal cosine used for Fresnel.
+void attenuation(float cosTheta, float eta, float h, const Vec3f& T, Vec3f ap[HairModel::kLobes]) {
+    const float cosGammaO = safeSqrt(1.f - h * h);
+    const float f = fresnelDielectric(cosTheta * cosGammaO, eta);
+    ap[0] = Vec3f::Constant(f);
+    ap[1] = (1.f - f) * (1.f - f) * T;
+    ap[2] = ap[1].cwiseProduct(T) * f;
+    const Eigen::Array3f fT = f * T.array();
+    ap[3] = (ap[2].array() * fT / (1.f - fT).max(1e-6f)).matrix();
+}
+
+float logistic(float x, float s) {
+    x = std::abs(x);
+    const float e = std::exp(-x / s);
+    return e / (s * (1.f + e) * (1.f + e));
+}
+float logisticCdf(float x, float s) { return 1.f / (1.f + std::exp(-x / s)); }
+float trimmedLogistic(float x, float s, float a, float b) {
+    return logistic(x, s) / (logisticCdf(b, s) - logisticCdf(a, s));
+}
+float sampleTrimmedLogistic(float u, float s, float a, float b) {
+    const float k = logisticCdf(b, s) - logisticCdf(a, s);
+    const float x = -s * std::log(1.f / (u * k + logisticCdf(a, s)) - 1.f);
+    return std::clamp(x, a, b);
+}
+
+/// Azimuthal deflection of lobe p for an entry offset γo and refracted γt:
+/// Φ = 2pγt − 2γo + pπ (exact for a smooth cylinder).
+float Phi(int p, float gammaO, float gammaT) { return 2.f * p * gammaT - 2.f * gammaO + p * kPi; }
+
+/// Near-field azimuthal lobe: a logistic of scale s around Φ, trimmed to
+/// [−π, π] so that it integrates to one over the circle.
+float Np(float phi, int p, float s, float gammaO, float gammaT) {
+    const float dphi = float(std::remainder(double(phi) - Phi(p, gammaO, gammaT), 2.0 * M_PI));
+    return trimmedLogistic(dphi, s, -kPi, kPi);
+}
+
+/// Absorption along one internal chord: T = exp(−σa · 2 cos γt / cos θt).
+Vec3f transmittance(const Vec3f& sigmaA, float cosGammaT, float cosThetaT) {
+    return (-sigmaA.array() * (2.f * cosGammaT / std::max(cosThetaT, 1e-4f))).exp().matrix();
+}
+
+}  // namespace
+
+Vec3f hairAbsorptionFromMelanin(float eumelanin, float pheomelanin) {
+    const Vec3f eu(0.419f, 0.697f, 1.37f);
+    const Vec3f pheo(0.187f, 0.4f, 1.05f);
+    return eumelanin * eu + pheomelanin * pheo;
+}
+
+Vec3f hairAbsorptionFromColor(const Vec3f& color, float betaN) {
+    const float b = betaN;
+    const float d = 5.969f - 0.215f * b + 2.532f * b * b - 10.73f * b * b * b + 5.574f * b * b * b * b +
+                    0.245f * b * b * b * b * b;
+    Vec3f sigma;
+    for (int c = 0; c < 3; ++c) {
+        const float l = std::log(std::clamp(color[c], 1e-4f, 1.f)) / d;
+        sigma[c] = l * l;
+    }
+    return sigma;
+}
+
+HairModel::HairModel(const HairFiberParams& params) : params_(params) {
+    const float bm = std::clamp(params.longitudinalRoughness, 0.01f, 1.f);
+    const float bn = std::clamp(params.azimuthalRoughness, 0.01f, 1.f);
+    // Chiang eq. 7 and 8: perceptually linear roughness to lobe variance and
+    // logistic scale.
+    const float sm = 0.726f * bm + 0.812f * bm * bm + 3.7f * std::pow(bm, 20.f);
+    v_[0] = sm * sm;
+    v_[1] = 0.25f * v_[0];
+    v_[2] = 4.f * v_[0];
+    v_[3] = v_[2];
+    s_ = std::sqrt(kPi / 8.f) * (0.265f * bn + 1.194f * bn * bn + 5.372f * std::pow(bn, 22.f));
+    sin2kAlpha_[0] = std::sin(params.cuticleTiltDegrees * kPi / 180.f);
+    cos2kAlpha_[0] = safeSqrt(1.f - sin2kAlpha_[0] * sin2kAlpha_[0]);
+    for (int k = 1; k < 3; ++k) {
+        sin2kAlpha_[k] = 2.f * cos2kAlpha_[k - 1] * sin2kAlpha_[k - 1];
+        cos2kAlpha_[k] = cos2kAlpha_[k - 1] * cos2kAlpha_[k - 1] - sin2kAlpha_[k - 1] * sin2kAlpha_[k - 1];
+    }
+}
+
+struct HairBsdf::Angles {
+    float sinThetaO, cosThetaO, phiO;
+    float sinThetaI, cosThetaI, phiI;
+    float gammaT;  ///< refracted azimuthal offset
+    Vec3f T;       ///< transmittance of one internal chord
+};
+
+HairBsdf::HairBsdf(const HairModel& model, float h)
+    : model_(model), h_(std::clamp(h, -1.f, 1.f)), gammaO_(safeAsin(h_)) {}
+
+HairBsdf::Angles HairBsdf::angles(const Vec3f& wo, const Vec3f& wi) const {
+    Angles a;
+    a.sinThetaO = std::clamp(wo.x(), -1.f, 1.f);
+    a.cosThetaO = safeSqrt(1.f - a.sinThetaO * a.sinThetaO);
+    a.phiO = std::atan2(wo.z(), wo.y());
+    a.sinThetaI = std::clamp(wi.x(), -1.f, 1.f);
+    a.cosThetaI = safeSqrt(1.f - a.sinThetaI * a.sinThetaI);
+    a.phiI = std::atan2(wi.z(), wi.y());
+    a.gammaT = refractedOffset(a.sinThetaO, a.cosThetaO, &a.T);
+    return a;
+}
+
+float HairBsdf::refractedOffset(float sinThetaO, float cosThetaO, Vec3f* T) const {
+    const float eta = model_.params().ior;
+    // Bravais index: refraction projected into the normal plane.
+    const float etap = std::sqrt(eta * eta - sinThetaO * sinThetaO) / std::max(cosThetaO, 1e-4f);
+    const float sinThetaT = sinThetaO / eta;
+    const float sinGammaT = h_ / etap;
+    *T = transmittance(model_.params().sigmaA, safeSqrt(1.f - sinGammaT * sinGammaT),
+                       safeSqrt(1.f - sinThetaT * sinThetaT));
+    return safeAsin(sinGammaT);
+}
+
+void HairBsdf::tilt(int p, float sinThetaO, float cosThetaO, float* sinOp, float* cosOp) const {
+    // The cuticle scales rotate the reflection cones: R by −2α, TT by α,
+    // TRT by 4α (Chiang §4.1, after Marschner).
+    const HairModel& m = model_;
+    if (p == 0) {
+        *sinOp = sinThetaO * m.cos2kAlpha(1) - cosThetaO * m.sin2kAlpha(1);
+        *cosOp = cosThetaO * m.cos2kAlpha(1) + sinThetaO * m.sin2kAlpha(1);
+    } else if (p == 1) {
+        *sinOp = sinThetaO * m.cos2kAlpha(0) + cosThetaO * m.sin2kAlpha(0);
+        *cosOp = cosThetaO * m.cos2kAlpha(0) - sinThetaO * m.sin2kAlpha(0);
+    } else {
+        *sinOp = sinThetaO * m.cos2kAlpha(2) + cosThetaO * m.sin2kAlpha(2);
+        *cosOp = cosThetaO * m.cos2kAlpha(2) - sinThetaO * m.sin2kAlpha(2);
+    }
+    *cosOp = std::abs(*cosOp);
+}
+
+Vec3f HairBsdf::eval(const Vec3f& wo, const Vec3f& wi, Vec3f* lobes) const {
+    const Angles a = angles(wo, wi);
+    const HairFiberParams& prm = model_.params();
+    Vec3f ap[HairModel::kLobes];
+    attenuation(a.cosThetaO, prm.ior, h_, a.T, ap);
+    const float phi = a.phiI - a.phiO;
+    Vec3f sum = Vec3f::Zero();
+    for (int p = 0; p < 3; ++p) {
+        float sinOp, cosOp;
+        tilt(p, a.sinThetaO, a.cosThetaO, &sinOp, &cosOp);
+        const Vec3f lobe = Mp(a.cosThetaI, cosOp, a.sinThetaI, sinOp, model_.variance(p)) *
+                           Np(phi, p, model_.logisticScale(), gammaO_, a.gammaT) * ap[p];
+        if (lobes) lobes[p] = lobe;
+        sum += lobe;
+    }
+    // Residual: all longer paths, azimuthally uniform, untilted.
+    const Vec3f residual =
+        Mp(a.cosThetaI, a.cosThetaO, a.sinThetaI, a.sinThetaO, model_.variance(3)) / (2.f * kPi) * ap[3];
+    if (lobes) lobes[3] = residual;
+    return sum + residual;
+}
+
+void HairBsdf::lobePdf(float sinThetaO, float cosThetaO, float out[HairModel::kLobes]) const {
+    // The lobes' attenuations averaged over the colour channels.
+    Vec3f T;
+    refractedOffset(sinThetaO, cosThetaO, &T);
+    Vec3f ap[HairModel::kLobes];
+    attenuation(cosThetaO, model_.params().ior, h_, T, ap);
+    float total = 0.f;
+    for (int p = 0; p < HairModel::kLobes; ++p) total += (out[p] = ap[p].mean());
+    for (int p = 0; p < HairModel::kLobes; ++p) out[p] = total > 0.f ? out[p] / total : 0.25f;
+}
+
+float HairBsdf::pdf(const Vec3f& wo, const Vec3f& wi) const {
+    const Angles a = angles(wo, wi);
+    float apPdf[HairModel::kLobes];
+    lobePdf(a.sinThetaO, a.cosThetaO, apPdf);
+    const float phi = a.phiI - a.phiO;
+    float pdf = 0.f;
+    for (int p = 0; p < 3; ++p) {
+        float sinOp, cosOp;
+        tilt(p, a.sinThetaO, a.cosThetaO, &sinOp, &cosOp);
+        pdf += apPdf[p] * Mp(a.cosThetaI, cosOp, a.sinThetaI, sinOp, model_.variance(p)) *
+               Np(phi, p, model_.logisticScale(), gammaO_, a.gammaT);
+    }
+    pdf += apPdf[3] * Mp(a.cosThetaI, a.cosThetaO, a.sinThetaI, a.sinThetaO, model_.variance(3)) / (2.f * kPi);
+    return pdf;
+}
+
+HairSample HairBsdf::sample(const Vec3f& wo, const Vec2f& u0, const Vec2f& u1) const {
+    HairSample out;
+    const float sinThetaO = std::clamp(wo.x(), -1.f, 1.f);
+    const float cosThetaO = safeSqrt(1.f - sinThetaO * sinThetaO);
+    const float phiO = std::atan2(wo.z(), wo.y());
+
+    float apPdf[HairModel::kLobes];
+    lobePdf(sinThetaO, cosThetaO, apPdf);
+    int p = 0;
+    float u = u0.x();
+    for (; p < 3; ++p) {
+        if (u < apPdf[p]) break;
+        u -= apPdf[p];
+    }
+
+    // Longitudinal: sample the von Mises-Fisher lobe around the (tilted)
+    // mirror direction on the sphere; its θ has density Mp cos θ (d'Eon 2013).
+    float sinOp = sinThetaO, cosOp = cosThetaO;
+    if (p < 3) tilt(p, sinThetaO, cosThetaO, &sinOp, &cosOp);
+    const float v = model_.variance(p);
+    const float um = std::max(u1.x(), 1e-5f);
+    const float cosTheta = 1.f + v * std::log(um + (1.f - um) * std::exp(-2.f / v));
+    const float sinTheta = safeSqrt(1.f - cosTheta * cosTheta);
+    const float cosPhi = std::cos(2.f * kPi * u1.y());
+    const float sinThetaI = std::clamp(-cosTheta * sinOp + sinTheta * cosPhi * cosOp, -1.f, 1.f);
+    const float cosThetaI = safeSqrt(1.f - sinThetaI * sinThetaI);
+
+    // Azimuthal: the logistic around the lobe's deflection Φ.
+    Vec3f T;
+    const float gammaT = refractedOffset(sinThetaO, cosThetaO, &T);
+    const float dphi = p < 3 ? Phi(p, gammaO_, gammaT) + sampleTrimmedLogistic(u0.y(), model_.logisticScale(), -kPi, kPi)
+                             : 2.f * kPi * u0.y();
+    const float phiI = phiO + dphi;
+    out.wi = Vec3f(sinThetaI, cosThetaI * std::cos(phiI), cosThetaI * std::sin(phiI));
+    out.lobe = p;
+    out.pdf = pdf(wo, out.wi);
+    if (!(out.pdf > 0.f) || !std::isfinite(out.pdf)) return out;
+    out.weight = eval(wo, out.wi) / out.pdf;
+    out.valid = out.weight.allFinite();
+    return out;
+}
+
+}  // namespace hp

@@ -1,0 +1,344 @@
+// The Embree reference renderer (render/reference.h, render/embree_scene.h)
+// and its pipeline stage: Kajiya-Kay pixels against the formula, coverage
+// against projected width, shadow transmittance, determinism across thread
+// counts, no memory growth across frames, clear errors.
+#include "test_support.h"
+
+#include "core/errors.h"
+#include "pipeline/scene.h"
+#include "pipeline/stages.h"
+#include "render/embree_scene.h"
+#include "render/reference.h"
+#include "sim/synthetic.h"
+
+#include <tbb/task_arena.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+using namespace hp;
+using namespace hp::test;
+
+namespace {
+
+/// Camera at (0, 0, 1) looking at the origin, one directional light.
+View testView(int width, int height, const Vec3f& lightDirection) {
+    View v;
+    v.camera.position = Vec3f(0.f, 0.f, 1.f);
+    v.camera.target = Vec3f::Zero();
+    v.camera.fovY = 40.f;
+    v.camera.width = width;
+    v.camera.height = height;
+    v.lights = {Light{}};
+    v.lights[0].direction = lightDirection;
+    v.lights[0].intensity = 2.f;
+    v.lights[0].color = Vec3f(1.f, 0.9f, 0.8f);
+    v.environment = Vec3f::Zero();
+    return v;
+}
+
+/// One straight strand from a to b with n vertices of constant radius.
+void addLine(StrandFrame& f, uint32_t id, const Vec3f& a, const Vec3f& b, int n, float radius) {
+    std::vector<Vec3f> p(n);
+    std::vector<float> r(n, radius);
+    for (int i = 0; i < n; ++i) p[i] = a + (b - a) * (float(i) / float(n - 1));
+    f.addStrand(id, p.data(), r.data(), size_t(n));
+}
+
+float pixelsPerUnitAtDepthOne(const Camera& c) { return float(c.height) / (2.f * std::tan(c.fovY * float(M_PI) / 360.f)); }
+
+}  // namespace
+
+TEST(Reference, KajiyaKayPixelsMatchTheFormula) {
+    // A thick straight strand along x fills the middle rows; every covered
+    // pixel must be kajiyaKay(tangent, light, view) times the light.
+    const Vec3f lightDir = -Vec3f(0.3f, 0.6f, 0.8f).normalized();  // light from up-front-right
+    View view = testView(96, 64, lightDir);
+    StrandFrame strands;
+    addLine(strands, 7, Vec3f(-1.f, 0.f, 0.f), Vec3f(1.f, 0.f, 0.f), 9, 0.02f);
+    ReferenceSettings s;
+    s.samplesPerPixel = 16;
+    for (bool twoLobes : {false, true}) {
+        view.hair.twoLobes = twoLobes;
+        view.hair.primaryShift = twoLobes ? 0.05f : 0.f;
+        ReferenceRenderer renderer;
+        const Image img = renderer.render(view, &strands, nullptr, s);
+        const Vec3f t = Vec3f::UnitX(), l = -lightDir;
+        const Vec3f radiance = view.lights[0].color * view.lights[0].intensity;
+        int compared = 0;
+        float maxSpecular = 0.f, minSpecular = 1e9f;
+        for (int y : {31, 32}) {
+            for (int x = 2; x < 94; x += 3) {
+                ASSERT_FLOAT_EQ(img.at(x, y, 3), 1.f) << "pixel " << x << "," << y << " not fully covered";
+                const Vec3f v = -view.camera.rayDirection(x + 0.5f, y + 0.5f);
+                const Vec3f n = (v - v.dot(t) * t).normalized();  // the renderer's view-facing normal
+                Vec3f spec;
+                const Vec3f expected = kajiyaKay(view.hair, t, n, l, v, nullptr, &spec).cwiseProduct(radiance);
+                maxSpecular = std::max(maxSpecular, spec.x()), minSpecular = std::min(minSpecular, spec.x());
+                for (int c = 0; c < 3; ++c)
+                    EXPECT_NEAR(img.at(x, y, c), expected[c], 0.01f * expected[c] + 1e-4f)
+                        << "pixel " << x << "," << y << " channel " << c << " two lobes " << twoLobes;
+                ++compared;
+            }
+        }
+        EXPECT_EQ(compared, 62);
+        // The highlight moves across the strand with the view: the test
+        // really exercises the view dependence.
+        EXPECT_GT(maxSpecular, 4.f * minSpecular);
+        // Depth of the strand's front at the image centre: 1 − radius.
+        EXPECT_NEAR(img.at(48, 32, 4), 0.98f, 2e-3f);
+        EXPECT_FLOAT_EQ(img.at(48, 2, 3), 0.f);                    // background: no coverage
+        EXPECT_FLOAT_EQ(img.at(48, 2, 4), view.camera.farClip);    // ... and far depth
+    }
+}
+
+TEST(Reference, AlphaCoverageMatchesProjectedWidth) {
+    // A strand narrower than a pixel: the alpha summed down a column is its
+    // projected width in pixels (box filter), 2 r · f / depth.
+    View view = testView(128, 96, Vec3f(0.f, -1.f, 0.f));
+    for (float radius : {0.0015f, 0.003f}) {
+        StrandFrame strands;
+        addLine(strands, 0, Vec3f(-1.f, 0.01f, 0.f), Vec3f(1.f, 0.01f, 0.f), 12, radius);
+        ReferenceSettings s;
+        s.samplesPerPixel = 64;
+        s.shadows = false;
+        const Image img = ReferenceRenderer().render(view, &strands, nullptr, s);
+        const double expected = 2.0 * radius * pixelsPerUnitAtDepthOne(view.camera);
+        double sum = 0.0;
+        int columns = 0;
+        for (int x = 8; x < 120; ++x, ++columns)
+            for (int y = 0; y < img.height; ++y) sum += img.at(x, y, 3);
+        EXPECT_NEAR(sum / columns, expected, 0.02 * expected) << "radius " << radius;
+    }
+}
+
+TEST(Reference, ShadowRaysCountEachStrandCrossingOnce) {
+    // Entry and exit of a tube, and the overlapping ends of two segments at a
+    // vertex, are one crossing of that strand.
+    EmbreeDevice device;
+    StrandFrame strands;
+    addLine(strands, 0, Vec3f(-0.5f, 0.f, 0.f), Vec3f(0.5f, 0.f, 0.f), 11, 0.01f);   // vertex every 0.1
+    addLine(strands, 1, Vec3f(-0.5f, 0.1f, 0.f), Vec3f(0.5f, 0.1f, 0.f), 11, 0.01f);
+    const TriangleMesh head = makeSphereMesh(Vec3f(0.f, 1.f, 0.f), 0.6f, 16, 32);  // above both
+    const EmbreeScene scene(device, &strands, &head);
+    const Vec3f up = Vec3f::UnitY();
+    const float inf = std::numeric_limits<float>::infinity();
+    for (float x : {0.05f, 0.1f, 0.2001f, -0.3f}) {  // mid-segment and exactly at vertices
+        const Vec3f o(x, -0.5f, 0.f);
+        EXPECT_FLOAT_EQ(scene.transmittance(o, up, 0.f, 0.05f + 0.5f, 0.5f), 0.5f) << "x " << x;  // first strand only
+        EXPECT_FLOAT_EQ(scene.transmittance(o, up, 0.f, 0.7f, 0.5f), 0.25f) << "x " << x;         // both strands
+        EXPECT_FLOAT_EQ(scene.transmittance(o, up, 0.f, inf, 0.5f), 0.f) << "x " << x;            // the head
+        EXPECT_FLOAT_EQ(scene.transmittance(o, up, 0.f, 0.7f, 0.f), 0.f) << "x " << x;            // opaque hair
+        EXPECT_FLOAT_EQ(scene.transmittance(o, up, 0.f, 0.7f, 1.f), 1.f) << "x " << x;            // no hair shadow
+    }
+    // A ray leaving strand 0's surface through its own tube skips it.
+    const SceneHit h = scene.intersect(Vec3f(0.05f, -0.5f, 0.f), up, 0.f, inf);
+    ASSERT_EQ(h.kind, SceneHit::Kind::Hair);
+    EXPECT_EQ(h.strand, 0u);
+    EXPECT_NEAR(h.t, 0.49f, 1e-4f);
+    const Vec3f p = Vec3f(0.05f, -0.5f, 0.f) + h.t * up;
+    EXPECT_FLOAT_EQ(scene.transmittance(p, up, 0.f, 0.05f, 0.5f, RayStart{h.strand, h.segment}), 1.f);
+    const SceneHit next = scene.intersect(p, up, 0.f, inf, RayStart{h.strand, h.segment});
+    EXPECT_EQ(next.strand, 1u);
+}
+
+TEST(Reference, SameBitsForOneAndTwoThreads) {
+    SyntheticHairSettings hs;
+    hs.strands = 3000;
+    const StrandFrame strands = makeSyntheticHair(hs);
+    const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
+    View view = testView(80, 60, Vec3f(-1.f, -1.f, -1.f));
+    view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
+    view.environment = Vec3f(0.1f, 0.1f, 0.12f);
+    for (ReferenceMode mode : {ReferenceMode::KajiyaKay, ReferenceMode::Physical}) {
+        ReferenceSettings s;
+        s.mode = mode;
+        s.samplesPerPixel = 4;
+        s.bounces = 3;
+        s.tileSize = 8;
+        s.diffuseSpecularLayers = true;
+        s.strandIdLayer = true;
+        Image one, two;
+        tbb::task_arena(1).execute([&] { one = ReferenceRenderer().render(view, &strands, &head, s); });
+        tbb::task_arena(2).execute([&] { two = ReferenceRenderer().render(view, &strands, &head, s); });
+        ASSERT_EQ(one.pixels.size(), two.pixels.size());
+        EXPECT_EQ(0, std::memcmp(one.pixels.data(), two.pixels.data(), one.pixels.size() * sizeof(float)))
+            << referenceModeName(mode);
+        double coverage = 0.0;
+        for (int y = 0; y < one.height; ++y)
+            for (int x = 0; x < one.width; ++x) coverage += one.at(x, y, 3);
+        EXPECT_GT(coverage, 0.05 * one.width * one.height);  // hair and head are in the picture
+        // A different frame draws different samples.
+        s.frame = 2;
+        const Image other = ReferenceRenderer().render(view, &strands, &head, s);
+        EXPECT_NE(0, std::memcmp(one.pixels.data(), other.pixels.data(), one.pixels.size() * sizeof(float)));
+    }
+}
+
+TEST(Reference, NoEmbreeMemoryGrowthAcrossFrames) {
+    ReferenceRenderer renderer;
+    const int64_t idle = renderer.embreeBytesInUse();
+    const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
+    View view = testView(32, 24, Vec3f(-1.f, -1.f, -1.f));
+    ReferenceSettings s;
+    s.samplesPerPixel = 1;
+    int64_t firstScene = -1;
+    for (int frame = 0; frame < 5; ++frame) {
+        SyntheticHairSettings hs;
+        hs.strands = 2000;
+        hs.droop = 0.2f * frame;  // the hair moves from frame to frame
+        const StrandFrame strands = makeSyntheticHair(hs);
+        ReferenceStats stats;
+        s.frame = frame;
+        renderer.render(view, &strands, &head, s, &stats);
+        EXPECT_GT(stats.sceneBytes, int64_t(2000 * 23 * 4));  // the monitor sees at least the index buffer
+        if (firstScene < 0) firstScene = stats.sceneBytes;
+        EXPECT_EQ(stats.sceneBytes, firstScene) << "frame " << frame;
+        EXPECT_EQ(renderer.embreeBytesInUse(), idle) << "frame " << frame << " left Embree memory behind";
+    }
+}
+
+TEST(Reference, PhysicalWhiteFibreUnderWhiteSkyIsWhite) {
+    // The furnace through the whole integrator: a non-absorbing fibre in a
+    // uniform environment neither gains nor loses light.
+    View view = testView(64, 48, Vec3f(0.f, -1.f, 0.f));
+    view.lights.clear();
+    view.environment = Vec3f::Ones();
+    StrandFrame strands;
+    addLine(strands, 0, Vec3f(-1.f, 0.f, 0.f), Vec3f(1.f, 0.f, 0.f), 9, 0.03f);
+    ReferenceSettings s;
+    s.mode = ReferenceMode::Physical;
+    s.samplesPerPixel = 32;
+    s.fiber.sigmaA = Vec3f::Zero();
+    for (int bounces : {0, 2}) {
+        s.bounces = bounces;
+        const Image img = ReferenceRenderer().render(view, &strands, nullptr, s);
+        double sum = 0.0;
+        int n = 0;
+        for (int y = 21; y <= 26; ++y)
+            for (int x = 4; x < 60; ++x)
+                if (img.at(x, y, 3) == 1.f) sum += img.at(x, y, 1), ++n;
+        ASSERT_GT(n, 100);
+        EXPECT_NEAR(sum / n, 1.0, 0.03) << "bounces " << bounces;
+    }
+}
+
+TEST(Reference, NanVertexIsAClearFrameError) {
+    SyntheticHairSettings hs;
+    hs.strands = 10;
+    StrandFrame strands = makeSyntheticHair(hs);
+    strands.positions[strands.first(2) + 5].y() = std::numeric_limits<float>::quiet_NaN();
+    try {
+        ReferenceRenderer().render(testView(16, 16, Vec3f(0.f, -1.f, 0.f)), &strands, nullptr, ReferenceSettings{});
+        FAIL() << "no error";
+    } catch (const FrameError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("strand 2 (id 2) vertex 5"), std::string::npos) << m;
+        EXPECT_NE(m.find("not finite"), std::string::npos) << m;
+    }
+    strands = makeSyntheticHair(hs);
+    strands.radii[3] = -1.f;
+    EXPECT_THROW(ReferenceRenderer().render(testView(16, 16, Vec3f(0.f, -1.f, 0.f)), &strands, nullptr, {}),
+                 FrameError);
+}
+
+// ------------------------------------------------------------------ stage --
+
+namespace {
+
+Scene referenceScene(const std::string& extra = "") {
+    return Scene::parse("frames: 1-2\n"
+                        "render:\n  camera: {width: 64, height: 48}\n"
+                        "reference:\n  enabled: true\n  samples: 2\n"
+                        "  layers: {diffuse_specular: true, strand_id: true}\n" +
+                            extra,
+                        "test.yaml", std::filesystem::current_path());
+}
+
+}  // namespace
+
+TEST(ReferenceStage, WritesExrWithLayersAndPng) {
+    TempDir dir;
+    const Scene scene = referenceScene();
+    ShotSettings shot;
+    shot.outputDir = dir.path();
+    shot.frames = {1, 2};
+    const StagePtr stage = makeReferenceStage(scene, shot);
+    ASSERT_TRUE(stage);
+    EXPECT_EQ(stage->name(), "reference");
+    const auto outputs = stage->outputs(2);
+    ASSERT_EQ(outputs.size(), 2u);
+    EXPECT_EQ(outputs[0], dir / "reference/reference.0002.exr");
+    EXPECT_EQ(outputs[1], dir / "reference/reference.0002.png");
+
+    SyntheticHairSettings hs;
+    hs.strands = 500;
+    const StrandFrame strands = makeSyntheticHair(hs);
+    HeadPose pose;
+    pose.mesh = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
+    FrameData data;
+    data.frame = 2;
+    data.head = &pose;
+    data.strands = &strands;
+    stage->run(data);
+
+    const Image exr = readImage(outputs[0].string());
+    EXPECT_EQ(exr.width, 64);
+    for (const char* c : {"R", "G", "B", "A", "Z", "diffuse.R", "specular.B", "strand_id"})
+        EXPECT_GE(exr.channelIndex(c), 0) << c;
+    // The layers add up to the colour (half-float precision), and the head
+    // in the middle has a depth and no strand id where hair does not cover it.
+    const int r = exr.channelIndex("R"), d = exr.channelIndex("diffuse.R"), s = exr.channelIndex("specular.R");
+    double worst = 0.0, idMax = -1.0;
+    for (int y = 0; y < exr.height; ++y)
+        for (int x = 0; x < exr.width; ++x) {
+            const float sum = exr.at(x, y, d) + exr.at(x, y, s);
+            worst = std::max(worst, double(std::abs(sum - exr.at(x, y, r))) / (1e-2 + exr.at(x, y, r)));
+            idMax = std::max(idMax, double(exr.at(x, y, exr.channelIndex("strand_id"))));
+        }
+    EXPECT_LT(worst, 0.01);
+    EXPECT_GE(idMax, 0.0);
+    EXPECT_LT(idMax, 500.0);
+    EXPECT_NEAR(exr.at(32, 24, exr.channelIndex("Z")), 0.8f, 0.05f);  // sphere front at 0.9 − 0.1, or hair just in front
+    const Image png = readImage(outputs[1].string());
+    EXPECT_EQ(png.channelCount(), 4);
+}
+
+TEST(ReferenceStage, HeadAloneWithoutStrandsAndNothingIsAnError) {
+    TempDir dir;
+    ShotSettings shot;
+    shot.outputDir = dir.path();
+    const StagePtr stage = makeReferenceStage(referenceScene("  png: \"\"\n"), shot);
+    ASSERT_EQ(stage->outputs(1).size(), 1u);  // empty png template writes no PNG
+    HeadPose pose;
+    pose.mesh = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
+    FrameData data;
+    data.frame = 1;
+    data.head = &pose;
+    stage->run(data);
+    const Image img = readImage(stage->outputs(1)[0].string());
+    EXPECT_FLOAT_EQ(img.at(32, 24, img.channelIndex("A")), 1.f);
+
+    data.head = nullptr;
+    try {
+        stage->run(data);
+        FAIL() << "no error";
+    } catch (const FrameError& e) {
+        EXPECT_NE(std::string(e.what()).find("neither strands nor a head"), std::string::npos) << e.what();
+    }
+}
+
+TEST(ReferenceStage, DisabledOrBadTemplates) {
+    ShotSettings shot;
+    shot.outputDir = std::filesystem::temp_directory_path();
+    EXPECT_FALSE(makeReferenceStage(Scene::parse("frames: 1\n", "t.yaml", "."), shot));
+    try {
+        makeReferenceStage(referenceScene("  exr: reference.exr\n"), shot);
+        FAIL() << "no error";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(e.key(), "reference.exr");
+        EXPECT_NE(std::string(e.what()).find("frame token"), std::string::npos) << e.what();
+    }
+}

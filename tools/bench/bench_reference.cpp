@@ -1,0 +1,152 @@
+// B-render, reference part (BENCHMARKS.md): seconds per 1920×1080 frame at
+// 16 spp of the Embree reference, physical mode (4 bounces) and Kajiya-Kay,
+// for 10k and 100k strands × 24 vertices with shadows; Embree scene memory
+// (device memory monitor) and peak RSS.
+//
+// Until the simulation exists the strands are makeSyntheticHair's (roots on a
+// Fibonacci cap of the upper hemisphere, hanging down; root radius 0.04 mm to
+// 0.01 mm at the tip) around the benchmark sphere head (r = 0.1 m), which is
+// rendered too.
+//
+//   bench_reference [--strands 10000,100000] [--modes physical,kajiya-kay]
+//                   [--width 1920] [--height 1080] [--spp 16] [--bounces 4]
+//                   [--repeat 1] [--threads 2] [--out DIR] [--no-head] [--no-shadows]
+//                   [--melanin 1.3]
+#include "render/reference.h"
+#include "sim/head.h"
+#include "sim/synthetic.h"
+
+#include <tbb/global_control.h>
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace hp;
+
+namespace {
+
+std::vector<std::string> split(const std::string& s) {
+    std::vector<std::string> out;
+    std::stringstream in(s);
+    for (std::string item; std::getline(in, item, ',');)
+        if (!item.empty()) out.push_back(item);
+    return out;
+}
+
+double peakRssMiB() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_maxrss) / 1024.0;  // kilobytes on Linux
+}
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::vector<std::string> strandCounts{"10000", "100000"}, modes{"physical", "kajiya-kay"};
+    int width = 1920, height = 1080, spp = 16, bounces = 4, repeat = 1, threads = 2;
+    bool withHead = true, shadows = true;
+    float melanin = 1.3f;
+    std::string out;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto next = [&]() -> std::string {
+            if (i + 1 >= argc) {
+                std::fprintf(stderr, "missing value after %s\n", a.c_str());
+                std::exit(1);
+            }
+            return argv[++i];
+        };
+        if (a == "--strands") strandCounts = split(next());
+        else if (a == "--modes") modes = split(next());
+        else if (a == "--width") width = std::stoi(next());
+        else if (a == "--height") height = std::stoi(next());
+        else if (a == "--spp") spp = std::stoi(next());
+        else if (a == "--bounces") bounces = std::stoi(next());
+        else if (a == "--repeat") repeat = std::max(1, std::stoi(next()));
+        else if (a == "--threads") threads = std::stoi(next());
+        else if (a == "--out") out = next();
+        else if (a == "--no-head") withHead = false;
+        else if (a == "--no-shadows") shadows = false;
+        else if (a == "--melanin") melanin = std::stof(next());
+        else {
+            std::fprintf(stderr, "unknown option %s (see the comment at the top of bench_reference.cpp)\n", a.c_str());
+            return 1;
+        }
+    }
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+
+    // BENCHMARKS.md B-render camera and light.
+    View view;
+    view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
+    view.camera.target = Vec3f::Zero();
+    view.camera.fovY = 40.f;
+    view.camera.width = width;
+    view.camera.height = height;
+    view.lights = {Light{}};
+    view.lights[0].type = LightType::Directional;
+    view.lights[0].direction = Vec3f(-1.f, -1.f, -1.f).normalized();
+    view.lights[0].intensity = 3.f;
+    view.environment = Vec3f::Zero();
+    const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 32, 64);
+
+    std::printf("# bench_reference: %dx%d, %d spp, %d bounces (physical), %d threads, head %s, synthetic hair\n",
+                width, height, spp, bounces, threads, withHead ? "on" : "off");
+    std::printf("%-8s %-11s %8s %9s %9s %9s %8s %8s %8s %10s %10s %9s\n", "strands", "mode", "build_s", "render_s",
+                "frame_s", "spread_s", "bcpu_s", "rcpu_s", "rays/spl", "embree_MB", "emb_peakMB", "rss_MB");
+    ReferenceRenderer renderer;
+    for (const std::string& count : strandCounts) {
+        SyntheticHairSettings hs;
+        hs.strands = size_t(std::stoul(count));
+        hs.vertices = 24;
+        const StrandFrame strands = makeSyntheticHair(hs);
+        for (const std::string& modeName : modes) {
+            ReferenceSettings s;
+            s.mode = modeName == "physical" ? ReferenceMode::Physical : ReferenceMode::KajiyaKay;
+            s.samplesPerPixel = spp;
+            s.bounces = bounces;
+            s.seed = 1;
+            s.frame = 1;
+            s.shadows = shadows;
+            s.fiber.sigmaA = hairAbsorptionFromMelanin(melanin, 0.f);
+            std::vector<double> frame, build, render, bcpu, rcpu;
+            ReferenceStats st;
+            Image image;
+            for (int r = 0; r < repeat; ++r) {
+                image = renderer.render(view, &strands, withHead ? &head : nullptr, s, &st);
+                bcpu.push_back(st.buildCpuSeconds);
+                rcpu.push_back(st.renderCpuSeconds);
+                build.push_back(st.buildSeconds);
+                render.push_back(st.renderSeconds);
+                frame.push_back(st.buildSeconds + st.renderSeconds);
+            }
+            const double spread = *std::max_element(frame.begin(), frame.end()) -
+                                  *std::min_element(frame.begin(), frame.end());
+            std::printf("%-8s %-11s %8.2f %9.2f %9.2f %9.2f %8.2f %8.2f %8.2f %10.1f %10.1f %9.0f\n", count.c_str(),
+                        modeName.c_str(), median(build), median(render), median(frame), spread, median(bcpu),
+                        median(rcpu),
+                        double(st.rays) / (double(width) * height * spp), double(st.sceneBytes) / (1 << 20),
+                        double(st.peakBytes) / (1 << 20), peakRssMiB());
+            std::fflush(stdout);
+            if (!out.empty()) {
+                std::filesystem::create_directories(out);
+                const std::string base = out + "/reference_" + count + "_" + modeName;
+                writeImage(base + ".png", image);
+                writeImage(base + ".exr", image);
+            }
+        }
+    }
+    std::printf("# embree bytes after all renders: %lld (scenes released)\n", (long long)renderer.embreeBytesInUse());
+    return 0;
+}
