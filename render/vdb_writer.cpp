@@ -1,0 +1,273 @@
+// The one translation unit that includes OpenVDB (see render/vdb_writer.h).
+#include "render/vdb_writer.h"
+
+#include "core/errors.h"
+
+#include <Eigen/LU>
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Prune.h>
+
+#include <tbb/parallel_for.h>
+
+#include <cstring>
+#include <fstream>
+#include <mutex>
+
+namespace hp {
+
+namespace {
+
+void initializeOpenVdb() {
+    static std::once_flag once;
+    std::call_once(once, [] { openvdb::initialize(); });
+}
+
+/// OpenVDB's Mat4 is row-vector (p' = p · M, translation in the last row).
+openvdb::math::Mat4d toVdbMatrix(const GridTransform& t) {
+    const Eigen::Matrix3d a = t.indexToWorld();
+    const Vec3d translation = -(a * t.offset);
+    openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) m(r, c) = a(c, r);
+    for (int c = 0; c < 3; ++c) m(3, c) = translation[c];
+    return m;
+}
+
+openvdb::math::Transform::Ptr toVdbTransform(const GridTransform& t) {
+    const double h = t.uniformVoxelSize();
+    if (h > 0 && t.offset.isZero(0.0)) return openvdb::math::Transform::createLinearTransform(h);
+    return openvdb::math::Transform::createLinearTransform(toVdbMatrix(t));
+}
+
+/// Fills `tree` from the grid's blocks (blocks and OpenVDB leaves are both
+/// 8³ in x-major order): leaves are created serially (topology changes are
+/// not thread-safe), then filled in parallel.
+template <typename TreeT, typename ValueOf>
+void fillTree(TreeT& tree, const DensityGrid& grid, ValueOf valueOf) {
+    using LeafT = typename TreeT::LeafNodeType;
+    static_assert(LeafT::DIM == DensityGrid::kBlockSize, "DensityGrid blocks must match OpenVDB leaves");
+    std::vector<LeafT*> leaves(grid.blockCount());
+    for (size_t b = 0; b < grid.blockCount(); ++b) {
+        const Vec3i& o = grid.blockOrigin(b);
+        leaves[b] = tree.touchLeaf(openvdb::Coord(o.x(), o.y(), o.z()));
+    }
+    tbb::parallel_for(size_t(0), grid.blockCount(), [&](size_t b) {
+        const float* density = grid.blockDensity(b);
+        for (openvdb::Index i = 0; i < openvdb::Index(DensityGrid::kBlockVoxels); ++i)
+            if (density[i] > 0.f) leaves[b]->setValueOn(i, valueOf(b, i));
+    });
+    openvdb::tools::pruneInactive(tree);
+}
+
+/// 128 bits of a fast non-cryptographic hash (two multiply-xor lanes over
+/// 8-byte words): identifies file contents, nothing more.
+std::string contentUuid(const char* data, size_t size) {
+    uint64_t h1 = 0x9E3779B97F4A7C15ull, h2 = 0xC2B2AE3D27D4EB4Full;
+    size_t i = 0;
+    for (; i + 8 <= size; i += 8) {
+        uint64_t w;
+        std::memcpy(&w, data + i, 8);
+        h1 = (h1 ^ w) * 0x100000001B3ull;
+        h1 ^= h1 >> 29;
+        h2 = (h2 ^ (w + 0x632BE59BD9B4E019ull)) * 0xFF51AFD7ED558CCDull;
+        h2 ^= h2 >> 32;
+    }
+    for (; i < size; ++i) {
+        h1 = (h1 ^ uint8_t(data[i])) * 0x100000001B3ull;
+        h2 = (h2 ^ uint8_t(data[i])) * 0xFF51AFD7ED558CCDull;
+    }
+    h1 ^= size;
+    h2 ^= h1 >> 17;
+    // RFC 9562 layout with version 8 (custom) and the RFC variant bits.
+    h1 = (h1 & ~(0xFull << 12)) | (0x8ull << 12);
+    h2 = (h2 & ~(0x3ull << 62)) | (0x2ull << 62);
+    char text[37];
+    std::snprintf(text, sizeof text, "%08x-%04x-%04x-%04x-%012llx", unsigned(h1 >> 32), unsigned((h1 >> 16) & 0xFFFF),
+                  unsigned(h1 & 0xFFFF), unsigned(h2 >> 48), (unsigned long long)(h2 & 0xFFFFFFFFFFFFull));
+    return text;
+}
+
+/// OpenVDB writes a random UUID into the file header (36 ASCII characters
+/// after magic, format version, library version and a flag: bytes 21..56).
+/// Replace it by a hash of everything after the header, so identical grids
+/// make identical files.
+void makeHeaderDeterministic(const std::filesystem::path& file) {
+    constexpr size_t kUuidOffset = 8 + 4 + 4 + 4 + 1, kUuidSize = 36;
+    std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(file, ec);
+    if (!io || ec) throw IoError(file.string(), "cannot reopen the written VDB file");
+    std::vector<char> bytes(static_cast<size_t>(size));
+    io.read(bytes.data(), std::streamsize(bytes.size()));
+    if (!io) throw IoError(file.string(), "cannot read back the written VDB file");
+    int64_t magic = 0;
+    if (bytes.size() >= sizeof magic) std::memcpy(&magic, bytes.data(), sizeof magic);
+    if (bytes.size() < kUuidOffset + kUuidSize || magic != openvdb::OPENVDB_MAGIC || bytes[kUuidOffset + 8] != '-')
+        throw IoError(file.string(), "unexpected VDB header layout (OpenVDB version changed?)");
+    const std::string uuid =
+        contentUuid(bytes.data() + kUuidOffset + kUuidSize, bytes.size() - kUuidOffset - kUuidSize);
+    io.clear();
+    io.seekp(std::streamoff(kUuidOffset));
+    io.write(uuid.data(), std::streamsize(kUuidSize));
+    io.flush();
+    if (!io) throw IoError(file.string(), "cannot rewrite the VDB header");
+}
+
+}  // namespace
+
+void writeDensityVdb(const std::filesystem::path& file, const DensityGrid& grid, const VdbFrameInfo& info,
+                     const VdbWriteSettings& settings) {
+    initializeOpenVdb();
+    const openvdb::math::Transform::Ptr transform = toVdbTransform(grid.transform());
+    const float scale = float(settings.densityScale);
+
+    openvdb::FloatGrid::Ptr density = openvdb::FloatGrid::create(0.f);
+    density->setName("density");
+    density->setGridClass(openvdb::GRID_FOG_VOLUME);
+    density->setTransform(transform);
+    density->setSaveFloatAsHalf(settings.halfFloat);
+    density->setCreator("hairpipe");
+    fillTree(density->tree(), grid, [&](size_t b, openvdb::Index i) { return grid.blockDensity(b)[i] * scale; });
+
+    const double h = grid.transform().uniformVoxelSize();
+    density->insertMeta("frame", openvdb::Int32Metadata(info.frame));
+    density->insertMeta("time", openvdb::DoubleMetadata(info.time));
+    density->insertMeta("fps", openvdb::DoubleMetadata(info.fps));
+    density->insertMeta("scene", openvdb::StringMetadata(info.scene));
+    density->insertMeta("units", openvdb::StringMetadata(
+                                     "density: hair volume fraction (m^3 of hair per m^3) x density_scale; "
+                                     "lengths: metres; world space, Y up"));
+    density->insertMeta("voxel_size", openvdb::DoubleMetadata(h > 0 ? h : std::cbrt(grid.transform().voxelVolume())));
+    density->insertMeta("strand_count", openvdb::Int64Metadata(int64_t(info.strandCount)));
+    density->insertMeta("hair_volume", openvdb::DoubleMetadata(info.hairVolume));
+    density->insertMeta("filter", openvdb::StringMetadata(info.filter));
+    density->insertMeta("density_scale", openvdb::DoubleMetadata(settings.densityScale));
+
+    openvdb::GridPtrVec grids{density};
+    if (settings.velocity && grid.hasVelocity()) {
+        openvdb::Vec3SGrid::Ptr velocity = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.f));
+        velocity->setName("velocity");
+        velocity->setTransform(transform);
+        velocity->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+        velocity->setSaveFloatAsHalf(settings.halfFloat);
+        velocity->setCreator("hairpipe");
+        velocity->insertMeta("units", openvdb::StringMetadata("m/s, density-weighted mean velocity of the hair"));
+        velocity->insertMeta("frame", openvdb::Int32Metadata(info.frame));
+        fillTree(velocity->tree(), grid, [&](size_t b, openvdb::Index i) {
+            const Vec3f& v = grid.blockVelocity(b)[i];
+            return openvdb::Vec3s(v.x(), v.y(), v.z());
+        });
+        grids.push_back(velocity);
+    }
+
+    try {
+        openvdb::io::File out(file.string());
+        uint32_t flags = openvdb::io::COMPRESS_ACTIVE_MASK;
+        if (settings.compression == VdbCompression::Blosc) {
+            if (!openvdb::io::Archive::hasBloscCompression())
+                throw IoError(file.string(), "this OpenVDB library was built without Blosc; use compression: none");
+            flags |= openvdb::io::COMPRESS_BLOSC;
+        }
+        out.setCompression(flags);
+        out.write(grids);
+        out.close();
+    } catch (const openvdb::Exception& e) {
+        throw IoError(file.string(), std::string("OpenVDB: ") + e.what());
+    }
+    makeHeaderDeterministic(file);
+}
+
+// ---------------------------------------------------------------------------
+// Reader
+
+namespace {
+
+GridTransform fromVdbTransform(const openvdb::math::Transform& t) {
+    const openvdb::math::Mat4d m = t.baseMap()->getAffineMap()->getMat4();
+    Eigen::Matrix3d a;
+    Vec3d translation;
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) a(c, r) = m(r, c);
+    for (int c = 0; c < 3; ++c) translation[c] = m(3, c);
+    GridTransform g;
+    g.linear = a.inverse();
+    g.offset = -(g.linear * translation);
+    return g;
+}
+
+VdbGridInfo describe(const openvdb::GridBase& grid) {
+    VdbGridInfo info;
+    info.name = grid.getName();
+    info.valueType = grid.valueType();
+    info.gridClass = openvdb::GridBase::gridClassToString(grid.getGridClass());
+    info.vectorType = openvdb::GridBase::vecTypeToString(grid.getVectorType());
+    info.savedAsHalf = grid.saveFloatAsHalf();
+    const openvdb::math::Mat4d m = grid.transform().baseMap()->getAffineMap()->getMat4();
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) info.indexToWorld(c, r) = m(r, c);
+    if (grid.transform().hasUniformScale()) info.voxelSize = grid.transform().voxelSize()[0];
+    info.activeVoxels = size_t(grid.activeVoxelCount());
+    const openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
+    if (!box.empty()) {
+        info.activeMin = Vec3i(box.min().x(), box.min().y(), box.min().z());
+        info.activeMax = Vec3i(box.max().x(), box.max().y(), box.max().z());
+    }
+    for (auto it = grid.beginMeta(); it != grid.endMeta(); ++it) {
+        info.metadata[it->first] = it->second->str();
+        info.metadataType[it->first] = it->second->typeName();
+    }
+    return info;
+}
+
+}  // namespace
+
+VdbContents readDensityVdb(const std::filesystem::path& file) {
+    initializeOpenVdb();
+    VdbContents contents;
+    try {
+        openvdb::io::File in(file.string());
+        in.open(/*delayLoad=*/false);
+        openvdb::FloatGrid::Ptr density;
+        openvdb::Vec3SGrid::Ptr velocity;
+        for (auto name = in.beginName(); name != in.endName(); ++name) {
+            openvdb::GridBase::Ptr grid = in.readGrid(name.gridName());
+            VdbGridInfo info = describe(*grid);
+            if (auto g = openvdb::gridPtrCast<openvdb::FloatGrid>(grid)) {
+                info.background = g->background();
+                if (info.name == "density") density = g;
+            }
+            if (auto g = openvdb::gridPtrCast<openvdb::Vec3SGrid>(grid))
+                if (info.name == "velocity") velocity = g;
+            contents.grids.push_back(std::move(info));
+        }
+        in.close();
+        if (density) {
+            std::vector<Vec3i> origins;
+            std::vector<DensityGrid::DensityBlock> values;
+            std::vector<DensityGrid::VelocityBlock> velocities;
+            for (auto leaf = density->tree().cbeginLeaf(); leaf; ++leaf) {
+                const openvdb::Coord o = leaf->origin();
+                origins.emplace_back(o.x(), o.y(), o.z());
+                values.emplace_back();
+                values.back().fill(0.f);
+                for (auto v = leaf->cbeginValueOn(); v; ++v) values.back()[v.pos()] = *v;
+                if (velocity) {
+                    velocities.emplace_back();
+                    velocities.back().fill(Vec3f::Zero());
+                    if (const auto* vleaf = velocity->tree().probeConstLeaf(o))
+                        for (auto v = vleaf->cbeginValueOn(); v; ++v)
+                            velocities.back()[v.pos()] = Vec3f((*v)[0], (*v)[1], (*v)[2]);
+                }
+            }
+            contents.density = DensityGrid(fromVdbTransform(density->transform()), std::move(origins),
+                                           std::move(values), std::move(velocities));
+            contents.hasDensity = true;
+        }
+    } catch (const openvdb::Exception& e) {
+        throw AssetError(file.string(), std::string("cannot read VDB file: ") + e.what());
+    }
+    return contents;
+}
+
+}  // namespace hp
