@@ -17,6 +17,7 @@ const std::vector<CommandSpec>& commands() {
     static const std::vector<CommandSpec> list = {
         runCommandSpec(),
         renderCommandSpec(),
+        vdbCommandSpec(),
         validateCommandSpec(),
         infoCommandSpec(),
         helpCommandSpec(),

@@ -31,7 +31,7 @@ std::vector<StagePtr> makeStages(const Scene& scene, const ShotSettings& shot, c
     auto add = [&](StagePtr stage) {
         if (stage && (only.empty() || only.count(stage->name()))) stages.push_back(std::move(stage));
     };
-    (void)add;
+    add(makeVdbStage(scene, shot));
     return stages;
 }
 

@@ -7,4 +7,7 @@
 
 namespace hp {
 
+/// OpenVDB density caches (stage_vdb.cpp); null unless vdb.enabled.
+StagePtr makeVdbStage(const Scene& scene, const ShotSettings& shot);
+
 }  // namespace hp

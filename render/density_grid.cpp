@@ -76,11 +76,13 @@ Vec3i blockCoordOfKey(uint64_t key) {
 // ---------------------------------------------------------------------------
 // DensityGrid
 
-DensityGrid::DensityGrid(const GridTransform& transform, std::vector<Vec3i> origins, std::vector<DensityBlock> density,
-                         std::vector<VelocityBlock> velocity)
+DensityGrid::DensityGrid(const GridTransform& transform, std::vector<Vec3i> origins,
+                         std::vector<DensityBlockPtr> density, std::vector<VelocityBlockPtr> velocity)
     : transform_(transform), origins_(std::move(origins)), density_(std::move(density)), velocity_(std::move(velocity)) {
     if (density_.size() != origins_.size() || (!velocity_.empty() && velocity_.size() != origins_.size()))
         throw Error("density grid: block arrays differ in size");
+    for (size_t b = 0; b < density_.size(); ++b)
+        if (!density_[b] || (!velocity_.empty() && !velocity_[b])) throw Error("density grid: missing block");
     lookup_.reserve(origins_.size());
     for (size_t b = 0; b < origins_.size(); ++b) {
         const Vec3i& origin = origins_[b];
@@ -103,12 +105,24 @@ void DensityGrid::addBlock(const Vec3i& origin, const float* density, const Vec3
     if (!lookup_.emplace(key, uint32_t(origins_.size())).second)
         throw Error(cat("density grid: duplicate block at (", origin.transpose(), ")"));
     origins_.push_back(origin);
-    density_.emplace_back();
-    std::copy(density, density + kBlockVoxels, density_.back().begin());
+    density_.push_back(std::make_unique<DensityBlock>());
+    std::copy(density, density + kBlockVoxels, density_.back()->begin());
     if (velocity) {
-        velocity_.emplace_back();
-        std::copy(velocity, velocity + kBlockVoxels, velocity_.back().begin());
+        velocity_.push_back(std::make_unique<VelocityBlock>());
+        std::copy(velocity, velocity + kBlockVoxels, velocity_.back()->begin());
     }
+}
+
+void DensityGrid::releaseBlock(size_t b) {
+    density_[b].reset();
+    if (!velocity_.empty()) velocity_[b].reset();
+}
+
+void DensityGrid::clear() {
+    origins_.clear();
+    density_.clear();
+    velocity_.clear();
+    lookup_.clear();
 }
 
 long DensityGrid::findBlock(const Vec3i& voxel, int* offset) const {
@@ -124,13 +138,13 @@ long DensityGrid::findBlock(const Vec3i& voxel, int* offset) const {
 float DensityGrid::density(const Vec3i& voxel) const {
     int offset = 0;
     const long b = findBlock(voxel, &offset);
-    return b < 0 ? 0.f : density_[size_t(b)][size_t(offset)];
+    return b < 0 ? 0.f : (*density_[size_t(b)])[size_t(offset)];
 }
 
 Vec3f DensityGrid::velocity(const Vec3i& voxel) const {
     int offset = 0;
     const long b = hasVelocity() ? findBlock(voxel, &offset) : -1;
-    return b < 0 ? Vec3f::Zero() : velocity_[size_t(b)][size_t(offset)];
+    return b < 0 ? Vec3f::Zero() : (*velocity_[size_t(b)])[size_t(offset)];
 }
 
 namespace {
@@ -205,13 +219,14 @@ double DensityGrid::transmittance(const Vec3f& from, const Vec3f& to, double sig
 double DensityGrid::totalVolume() const {
     double sum = 0;
     for (const auto& block : density_)
-        for (float v : block) sum += v;
+        for (float v : *block) sum += v;
     return sum * transform_.voxelVolume();
 }
 
 size_t DensityGrid::activeVoxelCount() const {
     size_t n = 0;
-    for (const auto& block : density_) n += size_t(std::count_if(block.begin(), block.end(), [](float v) { return v > 0; }));
+    for (const auto& block : density_)
+        n += size_t(std::count_if(block->begin(), block->end(), [](float v) { return v > 0; }));
     return n;
 }
 
@@ -220,7 +235,7 @@ bool DensityGrid::activeBounds(Vec3i* min, Vec3i* max) const {
     Vec3i lo = Vec3i::Constant(kMaxIndex), hi = Vec3i::Constant(-kMaxIndex);
     for (size_t b = 0; b < origins_.size(); ++b)
         for (int i = 0; i < kBlockVoxels; ++i)
-            if (density_[b][size_t(i)] > 0) {
+            if ((*density_[b])[size_t(i)] > 0) {
                 const Vec3i v = origins_[b] + Vec3i(i >> 6, (i >> 3) & 7, i & 7);
                 lo = lo.cwiseMin(v);
                 hi = hi.cwiseMax(v);
@@ -236,7 +251,7 @@ bool DensityGrid::activeBounds(Vec3i* min, Vec3i* max) const {
 float DensityGrid::maxDensity() const {
     float m = 0.f;
     for (const auto& block : density_)
-        for (float v : block) m = std::max(m, v);
+        for (float v : *block) m = std::max(m, v);
     return m;
 }
 

@@ -23,6 +23,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <unordered_map>
 #include <vector>
 
@@ -81,13 +82,17 @@ class DensityGrid {
 
     using DensityBlock = std::array<float, kBlockVoxels>;
     using VelocityBlock = std::array<Vec3f, kBlockVoxels>;
+    /// Blocks are allocated one by one, so building a grid from pieces made
+    /// in parallel moves pointers instead of copying voxels.
+    using DensityBlockPtr = std::unique_ptr<DensityBlock>;
+    using VelocityBlockPtr = std::unique_ptr<VelocityBlock>;
 
     DensityGrid() = default;
     explicit DensityGrid(const GridTransform& transform) : transform_(transform) {}
     /// Takes whole blocks at once (the voxelizer's fast path); `velocity` is
     /// empty or one block per origin. Same checks as addBlock.
-    DensityGrid(const GridTransform& transform, std::vector<Vec3i> origins, std::vector<DensityBlock> density,
-                std::vector<VelocityBlock> velocity);
+    DensityGrid(const GridTransform& transform, std::vector<Vec3i> origins, std::vector<DensityBlockPtr> density,
+                std::vector<VelocityBlockPtr> velocity);
 
     const GridTransform& transform() const { return transform_; }
 
@@ -96,11 +101,17 @@ class DensityGrid {
     /// blocks or none. Throws hp::Error on a duplicate or misaligned origin.
     void addBlock(const Vec3i& origin, const float* density, const Vec3f* velocity = nullptr);
 
+    /// Frees block b's values (blockDensity(b) becomes null): for writers
+    /// that consume the grid block by block. Safe in parallel for distinct b.
+    void releaseBlock(size_t b);
+    /// Removes every block, keeping the transform.
+    void clear();
+
     size_t blockCount() const { return origins_.size(); }
     const Vec3i& blockOrigin(size_t b) const { return origins_[b]; }
-    const float* blockDensity(size_t b) const { return density_[b].data(); }
+    const float* blockDensity(size_t b) const { return density_[b]->data(); }
     /// Null when the grid carries no velocity.
-    const Vec3f* blockVelocity(size_t b) const { return velocity_.empty() ? nullptr : velocity_[b].data(); }
+    const Vec3f* blockVelocity(size_t b) const { return velocity_.empty() ? nullptr : velocity_[b]->data(); }
     bool hasVelocity() const { return !velocity_.empty(); }
     /// Offset of voxel `local` (each component in [0, 8)) inside a block.
     static int voxelOffset(int x, int y, int z) { return (x << 6) | (y << 3) | z; }
@@ -137,8 +148,8 @@ class DensityGrid {
 
     GridTransform transform_;
     std::vector<Vec3i> origins_;
-    std::vector<DensityBlock> density_;
-    std::vector<VelocityBlock> velocity_;
+    std::vector<DensityBlockPtr> density_;
+    std::vector<VelocityBlockPtr> velocity_;
     std::unordered_map<uint64_t, uint32_t> lookup_;  // packed block coordinate → block
 };
 

@@ -10,6 +10,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <mutex>
@@ -40,24 +41,46 @@ openvdb::math::Transform::Ptr toVdbTransform(const GridTransform& t) {
     return openvdb::math::Transform::createLinearTransform(toVdbMatrix(t));
 }
 
-/// Fills `tree` from the grid's blocks (blocks and OpenVDB leaves are both
-/// 8³ in x-major order): leaves are created serially (topology changes are
-/// not thread-safe), then filled in parallel.
-template <typename TreeT, typename ValueOf>
-void fillTree(TreeT& tree, const DensityGrid& grid, ValueOf valueOf) {
-    using LeafT = typename TreeT::LeafNodeType;
-    static_assert(LeafT::DIM == DensityGrid::kBlockSize, "DensityGrid blocks must match OpenVDB leaves");
-    std::vector<LeafT*> leaves(grid.blockCount());
-    for (size_t b = 0; b < grid.blockCount(); ++b) {
-        const Vec3i& o = grid.blockOrigin(b);
-        leaves[b] = tree.touchLeaf(openvdb::Coord(o.x(), o.y(), o.z()));
+/// Fills the density tree (values × scale) and, if given, the velocity tree
+/// from the grid's blocks. Blocks and OpenVDB leaves are both 8³ in x-major
+/// order, so each block becomes one leaf: created serially (topology
+/// changes are not thread-safe), filled in parallel. With `consume`, each
+/// block is freed once copied, so the grid and the trees are not both whole
+/// in memory.
+void fillTrees(openvdb::FloatTree& densityTree, openvdb::Vec3STree* velocityTree, const DensityGrid& grid,
+               float scale, DensityGrid* consume) {
+    static_assert(openvdb::FloatTree::LeafNodeType::DIM == DensityGrid::kBlockSize,
+                  "DensityGrid blocks must match OpenVDB leaves");
+    // In batches, so that with `consume` the memory freed by one batch's
+    // blocks holds the next batch's leaves.
+    constexpr size_t kBatch = 4096;
+    std::vector<openvdb::FloatTree::LeafNodeType*> densityLeaves(kBatch);
+    std::vector<openvdb::Vec3STree::LeafNodeType*> velocityLeaves(kBatch);
+    for (size_t first = 0; first < grid.blockCount(); first += kBatch) {
+        const size_t count = std::min(kBatch, grid.blockCount() - first);
+        for (size_t i = 0; i < count; ++i) {
+            const Vec3i& o = grid.blockOrigin(first + i);
+            densityLeaves[i] = densityTree.touchLeaf(openvdb::Coord(o.x(), o.y(), o.z()));
+            if (velocityTree) velocityLeaves[i] = velocityTree->touchLeaf(openvdb::Coord(o.x(), o.y(), o.z()));
+        }
+        tbb::parallel_for(size_t(0), count, [&](size_t i) {
+            const size_t b = first + i;
+            const float* density = grid.blockDensity(b);
+            auto* leaf = densityLeaves[i];
+            for (openvdb::Index v = 0; v < openvdb::Index(DensityGrid::kBlockVoxels); ++v)
+                if (density[v] > 0.f) leaf->setValueOn(v, density[v] * scale);
+            if (velocityTree) {
+                const Vec3f* velocity = grid.blockVelocity(b);
+                auto* vleaf = velocityLeaves[i];
+                for (openvdb::Index v = 0; v < openvdb::Index(DensityGrid::kBlockVoxels); ++v)
+                    if (density[v] > 0.f)
+                        vleaf->setValueOn(v, openvdb::Vec3s(velocity[v].x(), velocity[v].y(), velocity[v].z()));
+            }
+            if (consume) consume->releaseBlock(b);
+        });
     }
-    tbb::parallel_for(size_t(0), grid.blockCount(), [&](size_t b) {
-        const float* density = grid.blockDensity(b);
-        for (openvdb::Index i = 0; i < openvdb::Index(DensityGrid::kBlockVoxels); ++i)
-            if (density[i] > 0.f) leaves[b]->setValueOn(i, valueOf(b, i));
-    });
-    openvdb::tools::pruneInactive(tree);
+    openvdb::tools::pruneInactive(densityTree);
+    if (velocityTree) openvdb::tools::pruneInactive(*velocityTree);
 }
 
 /// 128 bits of a fast non-cryptographic hash (two multiply-xor lanes over
@@ -116,8 +139,10 @@ void makeHeaderDeterministic(const std::filesystem::path& file) {
 
 }  // namespace
 
-void writeDensityVdb(const std::filesystem::path& file, const DensityGrid& grid, const VdbFrameInfo& info,
-                     const VdbWriteSettings& settings) {
+namespace {
+
+void writeGrids(const std::filesystem::path& file, const DensityGrid& grid, const VdbFrameInfo& info,
+                const VdbWriteSettings& settings, DensityGrid* consume) {
     initializeOpenVdb();
     const openvdb::math::Transform::Ptr transform = toVdbTransform(grid.transform());
     const float scale = float(settings.densityScale);
@@ -128,7 +153,6 @@ void writeDensityVdb(const std::filesystem::path& file, const DensityGrid& grid,
     density->setTransform(transform);
     density->setSaveFloatAsHalf(settings.halfFloat);
     density->setCreator("hairpipe");
-    fillTree(density->tree(), grid, [&](size_t b, openvdb::Index i) { return grid.blockDensity(b)[i] * scale; });
 
     const double h = grid.transform().uniformVoxelSize();
     density->insertMeta("frame", openvdb::Int32Metadata(info.frame));
@@ -145,8 +169,9 @@ void writeDensityVdb(const std::filesystem::path& file, const DensityGrid& grid,
     density->insertMeta("density_scale", openvdb::DoubleMetadata(settings.densityScale));
 
     openvdb::GridPtrVec grids{density};
+    openvdb::Vec3SGrid::Ptr velocity;
     if (settings.velocity && grid.hasVelocity()) {
-        openvdb::Vec3SGrid::Ptr velocity = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.f));
+        velocity = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.f));
         velocity->setName("velocity");
         velocity->setTransform(transform);
         velocity->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
@@ -154,12 +179,10 @@ void writeDensityVdb(const std::filesystem::path& file, const DensityGrid& grid,
         velocity->setCreator("hairpipe");
         velocity->insertMeta("units", openvdb::StringMetadata("m/s, density-weighted mean velocity of the hair"));
         velocity->insertMeta("frame", openvdb::Int32Metadata(info.frame));
-        fillTree(velocity->tree(), grid, [&](size_t b, openvdb::Index i) {
-            const Vec3f& v = grid.blockVelocity(b)[i];
-            return openvdb::Vec3s(v.x(), v.y(), v.z());
-        });
         grids.push_back(velocity);
     }
+    fillTrees(density->tree(), velocity ? &velocity->tree() : nullptr, grid, scale, consume);
+    if (consume) consume->clear();
 
     try {
         openvdb::io::File out(file.string());
@@ -176,6 +199,18 @@ void writeDensityVdb(const std::filesystem::path& file, const DensityGrid& grid,
         throw IoError(file.string(), std::string("OpenVDB: ") + e.what());
     }
     makeHeaderDeterministic(file);
+}
+
+}  // namespace
+
+void writeDensityVdb(const std::filesystem::path& file, const DensityGrid& grid, const VdbFrameInfo& info,
+                     const VdbWriteSettings& settings) {
+    writeGrids(file, grid, info, settings, nullptr);
+}
+
+void writeDensityVdb(const std::filesystem::path& file, DensityGrid&& grid, const VdbFrameInfo& info,
+                     const VdbWriteSettings& settings) {
+    writeGrids(file, grid, info, settings, &grid);
 }
 
 // ---------------------------------------------------------------------------
@@ -206,7 +241,9 @@ VdbGridInfo describe(const openvdb::GridBase& grid) {
     const openvdb::math::Mat4d m = grid.transform().baseMap()->getAffineMap()->getMat4();
     for (int r = 0; r < 4; ++r)
         for (int c = 0; c < 4; ++c) info.indexToWorld(c, r) = m(r, c);
-    if (grid.transform().hasUniformScale()) info.voxelSize = grid.transform().voxelSize()[0];
+    const openvdb::Vec3d size = grid.transform().voxelSize();
+    if (std::abs(size[0] - size[1]) <= 1e-9 * size[0] && std::abs(size[0] - size[2]) <= 1e-9 * size[0])
+        info.voxelSize = size[0];
     info.activeVoxels = size_t(grid.activeVoxelCount());
     const openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
     if (!box.empty()) {
@@ -244,20 +281,20 @@ VdbContents readDensityVdb(const std::filesystem::path& file) {
         in.close();
         if (density) {
             std::vector<Vec3i> origins;
-            std::vector<DensityGrid::DensityBlock> values;
-            std::vector<DensityGrid::VelocityBlock> velocities;
+            std::vector<DensityGrid::DensityBlockPtr> values;
+            std::vector<DensityGrid::VelocityBlockPtr> velocities;
             for (auto leaf = density->tree().cbeginLeaf(); leaf; ++leaf) {
                 const openvdb::Coord o = leaf->origin();
                 origins.emplace_back(o.x(), o.y(), o.z());
-                values.emplace_back();
-                values.back().fill(0.f);
-                for (auto v = leaf->cbeginValueOn(); v; ++v) values.back()[v.pos()] = *v;
+                values.push_back(std::make_unique<DensityGrid::DensityBlock>());
+                values.back()->fill(0.f);
+                for (auto v = leaf->cbeginValueOn(); v; ++v) (*values.back())[v.pos()] = *v;
                 if (velocity) {
-                    velocities.emplace_back();
-                    velocities.back().fill(Vec3f::Zero());
+                    velocities.push_back(std::make_unique<DensityGrid::VelocityBlock>());
+                    velocities.back()->fill(Vec3f::Zero());
                     if (const auto* vleaf = velocity->tree().probeConstLeaf(o))
                         for (auto v = vleaf->cbeginValueOn(); v; ++v)
-                            velocities.back()[v.pos()] = Vec3f((*v)[0], (*v)[1], (*v)[2]);
+                            (*velocities.back())[v.pos()] = Vec3f((*v)[0], (*v)[1], (*v)[2]);
                 }
             }
             contents.density = DensityGrid(fromVdbTransform(density->transform()), std::move(origins),

@@ -55,6 +55,11 @@ struct VdbWriteSettings {
 /// @throws IoError naming the file when OpenVDB cannot write it.
 void writeDensityVdb(const std::filesystem::path& file, const DensityGrid& grid, const VdbFrameInfo& info,
                      const VdbWriteSettings& settings = {});
+/// Same, consuming the grid: each block is freed as soon as OpenVDB holds a
+/// copy, so peak memory is about one grid instead of two (the grid is left
+/// empty).
+void writeDensityVdb(const std::filesystem::path& file, DensityGrid&& grid, const VdbFrameInfo& info,
+                     const VdbWriteSettings& settings = {});
 
 /// One grid of a VDB file as read back.
 struct VdbGridInfo {
@@ -65,7 +70,7 @@ struct VdbGridInfo {
     bool savedAsHalf = false;
     double background = 0.0; ///< scalar grids
     Eigen::Matrix4d indexToWorld = Eigen::Matrix4d::Identity();  ///< column-vector convention
-    double voxelSize = 0.0;  ///< uniform scale, or 0 when not uniform
+    double voxelSize = 0.0;  ///< voxel edge when all three index axes have that length, else 0
     size_t activeVoxels = 0;
     Vec3i activeMin = Vec3i::Zero(), activeMax = Vec3i::Zero();  ///< inclusive index bounds (if any active)
     /// Every grid metadata item as text (OpenVDB's str()), keyed by name.

@@ -6,96 +6,39 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <iterator>
 #include <memory>
-#include <unordered_map>
 
 namespace hp {
 
 namespace {
 
-constexpr int kBlockVoxels = DensityGrid::kBlockVoxels;
-constexpr int kMask = DensityGrid::kBlockSize - 1;
-constexpr int kLog2 = DensityGrid::kBlockLog2;
-
-/// Fixed-point unit of accumulation: 2^-40 of one unit of density. Integer
-/// sums do not depend on the order of additions (the thread-count
-/// independence rests on this); the largest representable voxel density is
-/// 2^23 ≈ 8e6 (real hair stays ≤ 1), the smallest step ≈ 1e-12.
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kFixed = 1099511627776.0;  // 2^40
-constexpr double kMaxDeposit = 4.6e18;       // < 2^62: a single segment may not come near overflow
+constexpr int kBlock = DensityGrid::kBlockSize;
+constexpr int kBlockVoxels = DensityGrid::kBlockVoxels;
+
+/// Tiles of 32³ voxels (4³ blocks) are the unit of parallel work: one task
+/// owns a tile, accumulates every segment touching it into a dense buffer
+/// that stays in cache (256 KiB of doubles), in a fixed segment order. So
+/// each voxel's sum is formed in the same order whatever the thread count,
+/// and no per-thread copies of the grid need merging.
+constexpr int kTileLog2 = 5;
+constexpr int kTile = 1 << kTileLog2;
+constexpr int kTileVoxels = kTile * kTile * kTile;
+constexpr int kBlocksPerTile = kTile / kBlock;
 
 /// Three-point Gauss-Legendre on [-1, 1]: exact for polynomials of degree 5,
 /// i.e. r(t)² (degree 2) times the trilinear weights (degree 3) along a line.
 constexpr double kGaussX[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
 constexpr double kGaussW[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
 
-/// One thread's sparse accumulation blocks. Channels per voxel: density, or
-/// density and three momentum components (density × velocity).
-class Accumulator {
-  public:
-    Accumulator(int channels, std::atomic<size_t>* bytes, size_t limit)
-        : channels_(channels), bytes_(bytes), limit_(limit) {
-        std::fill(std::begin(cacheKey_), std::end(cacheKey_), ~uint64_t(0));
-    }
-
-    /// The block at block coordinate `c`, created zeroed on first use.
-    int64_t* block(const Vec3i& c) {
-        // A direct-mapped cache on the coordinates' low bits holds a whole
-        // 2×2×2 neighbourhood of blocks, so a dual cell straddling block
-        // faces does not thrash it; strands are spatially coherent.
-        const int slot = ((c.x() & 1) << 2) | ((c.y() & 1) << 1) | (c.z() & 1);
-        const uint64_t key = blockKey(c);
-        if (cacheKey_[slot] == key) return cache_[slot];
-        auto [it, inserted] = blocks_.try_emplace(key, nullptr);
-        if (inserted) {
-            const size_t n = size_t(kBlockVoxels) * size_t(channels_);
-            if (bytes_->fetch_add(n * sizeof(int64_t)) + n * sizeof(int64_t) > limit_) {
-                blocks_.erase(it);
-                throw Error(cat("voxelize: the density grid needs more than ", double(limit_) / double(1u << 30),
-                                " GiB of accumulation memory; use a larger voxel size"));
-            }
-            storage_.emplace_back(new int64_t[n]());
-            it->second = storage_.back().get();
-        }
-        cacheKey_[slot] = key;
-        cache_[slot] = it->second;
-        return it->second;
-    }
-
-    /// The block at `key`, or null when this thread never touched it.
-    const int64_t* find(uint64_t key) const {
-        const auto it = blocks_.find(key);
-        return it == blocks_.end() ? nullptr : it->second;
-    }
-
-    void appendKeys(std::vector<uint64_t>* keys) const {
-        for (const auto& kv : blocks_) keys->push_back(kv.first);
-    }
-
-  private:
-    int channels_;
-    std::atomic<size_t>* bytes_;
-    size_t limit_;
-    std::unordered_map<uint64_t, int64_t*> blocks_;
-    std::vector<std::unique_ptr<int64_t[]>> storage_;
-    uint64_t cacheKey_[8];
-    int64_t* cache_[8] = {};
-};
-
-Vec3i blockOfVoxel(const Vec3i& v) { return Vec3i(v.x() >> kLog2, v.y() >> kLog2, v.z() >> kLog2); }
-int offsetOfVoxel(const Vec3i& v) { return DensityGrid::voxelOffset(v.x() & kMask, v.y() & kMask, v.z() & kMask); }
-
-/// Round to the nearest fixed-point step (half away from zero). Deposits
-/// are rounded one by one, so the sum does not depend on how they are grouped.
-inline int64_t fixedPoint(double x) { return int64_t(x < 0 ? x - 0.5 : x + 0.5); }
-
-/// A segment prepared for deposit: end points in index space, radii, and the
-/// factor turning r² · dt into fixed-point density (π · L / voxel volume · 2^40).
+/// A segment prepared for deposit: end points in index space, radii,
+/// velocities, and k = π · L / voxel volume, which turns ∫ r² dt into density.
 struct Segment {
     Vec3d a, b;
     double r0, r1;
@@ -103,19 +46,44 @@ struct Segment {
     double k;
 };
 
-/// Adds C channels of `value` at `voxel`.
+/// A tile's dense accumulator: C channels per voxel (density, or density and
+/// momentum = density × velocity). Stored block by block in OpenVDB's leaf
+/// order, so a block is extracted and cleared as one contiguous run.
 template <int C>
-inline void add(Accumulator& acc, const Vec3i& voxel, const double* value) {
-    int64_t* block = acc.block(blockOfVoxel(voxel)) + size_t(offsetOfVoxel(voxel)) * C;
-    for (int c = 0; c < C; ++c) block[c] += fixedPoint(value[c]);
-}
+struct TileBuffer {
+    Vec3i origin;  // first voxel of the tile
+    std::vector<double> values = std::vector<double>(size_t(kTileVoxels) * C, 0.0);
+    uint64_t touched = 0;  // bit b: block b received deposits (sparse hair touches few)
+
+    static int block(int x, int y, int z) { return ((x >> 3) * kBlocksPerTile + (y >> 3)) * kBlocksPerTile + (z >> 3); }
+    /// Position of tile-local voxel (x, y, z) in `values`, in voxels.
+    static int index(int x, int y, int z) {
+        return block(x, y, z) * kBlockVoxels + DensityGrid::voxelOffset(x & 7, y & 7, z & 7);
+    }
+    static int index(const Vec3i& v) { return index(v.x(), v.y(), v.z()); }
+    /// Voxel `local`'s C channels, marking its block touched.
+    double* at(const Vec3i& local) {
+        touched |= uint64_t(1) << block(local.x(), local.y(), local.z());
+        return &values[size_t(index(local)) * C];
+    }
+    bool inside(const Vec3i& local) const {
+        return unsigned(local.x()) < unsigned(kTile) && unsigned(local.y()) < unsigned(kTile) &&
+               unsigned(local.z()) < unsigned(kTile);
+    }
+    void add(const Vec3i& local, const double* q) {
+        double* v = at(local);
+        for (int c = 0; c < C; ++c) v[c] += q[c];
+    }
+};
 
 /// Box filter: the segment's centre line cut at voxel faces; each piece's
-/// exact volume goes to the voxel containing it. C = 1 (density) or 4 (+ momentum).
+/// exact volume goes to the voxel containing it (if that voxel is in the tile).
 template <int C>
-void depositBox(Accumulator& acc, const Segment& s) {
+void depositBox(TileBuffer<C>& tile, const Segment& s) {
     const Vec3d half = Vec3d::Constant(0.5);
     walkCells(s.a + half, s.b + half, [&](const Vec3i& voxel, double t0, double t1) {
+        const Vec3i local = voxel - tile.origin;
+        if (!tile.inside(local)) return;
         const double mid = 0.5 * (t0 + t1), h = 0.5 * (t1 - t0);
         double q[C] = {};
         for (int g = 0; g < 3; ++g) {
@@ -128,17 +96,21 @@ void depositBox(Accumulator& acc, const Segment& s) {
                 for (int c = 0; c < 3; ++c) q[1 + c] += w * v[c];
             }
         }
-        add<C>(acc, voxel, q);
+        tile.add(local, q);
     });
 }
 
-/// Trilinear filter: the centre line cut at the planes through voxel
-/// centres (dual cells); within a dual cell each point spreads its volume over
-/// the cell's 8 corner voxels with trilinear weights (which sum to 1).
+/// Trilinear filter: the centre line cut at the planes through voxel centres
+/// (dual cells); within a dual cell every point spreads its volume over the
+/// cell's 8 corner voxels with trilinear weights, which sum to 1. The tile
+/// keeps the corners it owns; the tiles owning the other corners compute the
+/// same pieces (same walk over the whole segment) and keep theirs.
 template <int C>
-void depositTrilinear(Accumulator& acc, const Segment& s) {
+void depositTrilinear(TileBuffer<C>& tile, const Segment& s) {
     const Vec3d d = s.b - s.a;
     walkCells(s.a, s.b, [&](const Vec3i& cell, double t0, double t1) {
+        const Vec3i local = cell - tile.origin;  // corner (0,0,0) of the dual cell
+        if (local.minCoeff() < -1 || local.maxCoeff() >= kTile) return;
         const double mid = 0.5 * (t0 + t1), h = 0.5 * (t1 - t0);
         const Vec3d base = s.a - cell.cast<double>();
         double q[8][C] = {};  // corner (x-major: ix·4 + iy·2 + iz) × channel
@@ -157,58 +129,64 @@ void depositTrilinear(Accumulator& acc, const Segment& s) {
                     for (int k = 0; k < 3; ++k) q[i][1 + k] += c * v[k];
             }
         }
-        if ((cell.x() & kMask) != kMask && (cell.y() & kMask) != kMask && (cell.z() & kMask) != kMask) {
+        if (tile.inside(local) && (local.x() & 7) != 7 && (local.y() & 7) != 7 && (local.z() & 7) != 7) {
             // All 8 corners in one block (7 cells in 8 along each axis).
-            int64_t* block = acc.block(blockOfVoxel(cell)) + size_t(offsetOfVoxel(cell)) * C;
+            double* v = tile.at(local);
             for (int i = 0; i < 8; ++i) {
-                int64_t* voxel = block + DensityGrid::voxelOffset(i >> 2, (i >> 1) & 1, i & 1) * C;
-                for (int c = 0; c < C; ++c) voxel[c] += fixedPoint(q[i][c]);
+                double* corner = v + DensityGrid::voxelOffset(i >> 2, (i >> 1) & 1, i & 1) * C;
+                for (int c = 0; c < C; ++c) corner[c] += q[i][c];
             }
         } else {
-            for (int i = 0; i < 8; ++i) add<C>(acc, cell + Vec3i(i >> 2, (i >> 1) & 1, i & 1), q[i]);
+            for (int i = 0; i < 8; ++i) {
+                const Vec3i corner = local + Vec3i(i >> 2, (i >> 1) & 1, i & 1);
+                if (tile.inside(corner)) tile.add(corner, q[i]);
+            }
         }
     });
 }
 
-/// Interleaves the low 21 bits of x, y, z (Morton order).
-uint64_t morton(uint32_t x, uint32_t y, uint32_t z) {
-    auto spread = [](uint64_t v) {
-        v &= 0x1FFFFF;
-        v = (v | v << 32) & 0x1F00000000FFFFull;
-        v = (v | v << 16) & 0x1F0000FF0000FFull;
-        v = (v | v << 8) & 0x100F00F00F00F00Full;
-        v = (v | v << 4) & 0x10C30C30C30C30C3ull;
-        v = (v | v << 2) & 0x1249249249249249ull;
-        return v;
-    };
-    return spread(x) << 2 | spread(y) << 1 | spread(z);
-}
+/// A tile's non-empty blocks, converted to floats.
+struct TileBlocks {
+    std::vector<Vec3i> origins;
+    std::vector<DensityGrid::DensityBlockPtr> density;
+    std::vector<DensityGrid::VelocityBlockPtr> velocity;
+};
 
-/// Strand indices in Morton order of their middle vertex's block. Neighbouring
-/// strands then fill the same blocks while they are in cache (the file order
-/// of a Fibonacci lattice jumps around the head). The order does not change
-/// the result: accumulation is in integers.
-std::vector<uint32_t> spatialOrder(const StrandFrame& strands, const GridTransform& transform) {
-    const size_t n = strands.strandCount();
-    std::vector<std::pair<uint64_t, uint32_t>> keyed(n);
-    for (size_t s = 0; s < n; ++s) {
-        const uint32_t count = strands.vertexCount(s);
-        uint64_t code = 0;
-        if (count > 0) {
-            const Vec3d p = transform.toIndex(strands.positions[strands.first(s) + count / 2].cast<double>());
-            const auto q = [](double v) { return uint32_t(int64_t(std::floor(v / DensityGrid::kBlockSize)) + (1 << 20)); };
-            code = morton(q(p.x()), q(p.y()), q(p.z()));
+/// Moves the tile's non-empty blocks into `out` as floats and clears them,
+/// leaving the buffer zeroed for the next tile.
+template <int C>
+void extractBlocks(TileBuffer<C>& tile, TileBlocks* out) {
+    for (int b = 0; b < kBlocksPerTile * kBlocksPerTile * kBlocksPerTile; ++b) {
+        if (!(tile.touched >> b & 1)) continue;
+        double* v = &tile.values[size_t(b) * kBlockVoxels * C];
+        bool any = false;
+        for (int i = 0; i < kBlockVoxels; ++i) any |= v[i * C] > 0;
+        if (!any) {  // only zero deposits (e.g. exactly on a voxel plane): nothing active
+            std::fill(v, v + size_t(kBlockVoxels) * C, 0.0);
+            continue;
         }
-        keyed[s] = {code, uint32_t(s)};
+        const Vec3i local(b / (kBlocksPerTile * kBlocksPerTile), (b / kBlocksPerTile) % kBlocksPerTile,
+                          b % kBlocksPerTile);
+        out->origins.push_back(tile.origin + local * kBlock);
+        out->density.push_back(std::make_unique<DensityGrid::DensityBlock>());
+        DensityGrid::DensityBlock& density = *out->density.back();
+        for (int i = 0; i < kBlockVoxels; ++i) density[size_t(i)] = float(v[i * C]);
+        if constexpr (C == 4) {
+            out->velocity.push_back(std::make_unique<DensityGrid::VelocityBlock>());
+            DensityGrid::VelocityBlock& velocity = *out->velocity.back();
+            for (int i = 0; i < kBlockVoxels; ++i) {
+                const double* m = v + i * C;
+                const double w = m[0] > 0 ? 1.0 / m[0] : 0.0;
+                velocity[size_t(i)] = Vec3f(float(m[1] * w), float(m[2] * w), float(m[3] * w));
+            }
+        }
+        std::fill(v, v + size_t(kBlockVoxels) * C, 0.0);
     }
-    std::sort(keyed.begin(), keyed.end());
-    std::vector<uint32_t> order(n);
-    for (size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
-    return order;
+    tile.touched = 0;
 }
 
 void checkRange(const StrandFrame& strands, const GridTransform& transform) {
-    const double limit = double(DensityGrid::kMaxIndex) - 2 * DensityGrid::kBlockSize;
+    const double limit = double(DensityGrid::kMaxIndex) - 2 * kTile;
     for (const Vec3f& p : strands.positions) {
         const Vec3d i = transform.toIndex(p.cast<double>());
         if (!(i.cwiseAbs().maxCoeff() <= limit))
@@ -216,6 +194,101 @@ void checkRange(const StrandFrame& strands, const GridTransform& transform) {
                             " voxels from the grid origin, beyond the limit of ", limit,
                             " (is the voxel size far too small?)"));
     }
+}
+
+Vec3i floorVec(const Vec3d& p) { return Vec3i(int(std::floor(p.x())), int(std::floor(p.y())), int(std::floor(p.z()))); }
+
+/// (tile key, segment) pairs: every tile a segment may deposit into. A
+/// segment is named by the index of its second vertex.
+std::vector<std::pair<uint64_t, uint32_t>> binSegments(const StrandFrame& strands, const GridTransform& transform,
+                                                       VoxelFilter filter) {
+    tbb::enumerable_thread_specific<std::vector<std::pair<uint64_t, uint32_t>>> parts;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, strands.strandCount(), 256), [&](const auto& range) {
+        auto& out = parts.local();
+        for (size_t s = range.begin(); s != range.end(); ++s)
+            for (uint32_t v = strands.first(s) + 1; v < strands.offsets[s + 1]; ++v) {
+                if (strands.radii[v - 1] == 0 && strands.radii[v] == 0) continue;
+                const Vec3d a = transform.toIndex(strands.positions[v - 1].cast<double>());
+                const Vec3d b = transform.toIndex(strands.positions[v].cast<double>());
+                // Voxels reached: the box filter rounds to the nearest centre,
+                // the trilinear one reaches floor .. floor + 1.
+                const double shift = filter == VoxelFilter::Box ? 0.5 : 0.0;
+                const Vec3i lo = floorVec(a.cwiseMin(b) + Vec3d::Constant(shift));
+                const Vec3i hi = floorVec(a.cwiseMax(b) + Vec3d::Constant(shift)) +
+                                 Vec3i::Constant(filter == VoxelFilter::Box ? 0 : 1);
+                for (int x = lo.x() >> kTileLog2; x <= hi.x() >> kTileLog2; ++x)
+                    for (int y = lo.y() >> kTileLog2; y <= hi.y() >> kTileLog2; ++y)
+                        for (int z = lo.z() >> kTileLog2; z <= hi.z() >> kTileLog2; ++z)
+                            out.emplace_back(blockKey(Vec3i(x, y, z)), v);
+            }
+    });
+    std::vector<std::pair<uint64_t, uint32_t>> pairs;
+    for (const auto& part : parts) pairs.insert(pairs.end(), part.begin(), part.end());
+    // Unique pairs: the sorted order is the same whichever thread made which.
+    tbb::parallel_sort(pairs.begin(), pairs.end());
+    return pairs;
+}
+
+template <int C>
+DensityGrid voxelizeTiles(const StrandFrame& strands, const GridTransform& transform,
+                          const VoxelizeSettings& settings) {
+    const double voxelVolume = transform.voxelVolume();
+    const std::vector<std::pair<uint64_t, uint32_t>> pairs = binSegments(strands, transform, settings.filter);
+    std::vector<size_t> starts;  // first pair of each tile
+    for (size_t i = 0; i < pairs.size(); ++i)
+        if (i == 0 || pairs[i].first != pairs[i - 1].first) starts.push_back(i);
+    starts.push_back(pairs.size());
+    const size_t tiles = starts.size() - 1;
+
+    const bool hasVelocities = !strands.velocities.empty();
+    const size_t limit = size_t(std::max(0.0, settings.maxMemoryGiB) * double(size_t(1) << 30));
+    const size_t blockBytes = sizeof(DensityGrid::DensityBlock) + (C == 4 ? sizeof(DensityGrid::VelocityBlock) : 0);
+    std::atomic<size_t> bytes{pairs.size() * sizeof(pairs[0])};
+    std::vector<TileBlocks> results(tiles);
+    tbb::enumerable_thread_specific<TileBuffer<C>> buffers;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& range) {
+        TileBuffer<C>& tile = buffers.local();
+        for (size_t t = range.begin(); t != range.end(); ++t) {
+            tile.origin = blockCoordOfKey(pairs[starts[t]].first) * kTile;
+            for (size_t i = starts[t]; i < starts[t + 1]; ++i) {
+                const uint32_t v = pairs[i].second;
+                const Vec3d p0 = strands.positions[v - 1].cast<double>(), p1 = strands.positions[v].cast<double>();
+                Segment seg;
+                seg.a = transform.toIndex(p0);
+                seg.b = transform.toIndex(p1);
+                seg.r0 = strands.radii[v - 1];
+                seg.r1 = strands.radii[v];
+                seg.v0 = hasVelocities ? Vec3d(strands.velocities[v - 1].cast<double>()) : Vec3d::Zero();
+                seg.v1 = hasVelocities ? Vec3d(strands.velocities[v].cast<double>()) : Vec3d::Zero();
+                seg.k = kPi * (p1 - p0).norm() / voxelVolume;
+                if (settings.filter == VoxelFilter::Box)
+                    depositBox(tile, seg);
+                else
+                    depositTrilinear(tile, seg);
+            }
+            extractBlocks(tile, &results[t]);
+            if (bytes.fetch_add(results[t].origins.size() * blockBytes) > limit)
+                throw Error(cat("voxelize: the density grid needs more than ", settings.maxMemoryGiB,
+                                " GiB; use a larger voxel size"));
+        }
+    });
+
+    // Concatenate in tile order (sorted keys), independent of scheduling.
+    size_t total = 0;
+    for (const TileBlocks& r : results) total += r.origins.size();
+    std::vector<Vec3i> origins;
+    std::vector<DensityGrid::DensityBlockPtr> density;
+    std::vector<DensityGrid::VelocityBlockPtr> velocity;
+    origins.reserve(total);
+    density.reserve(total);
+    if (C == 4) velocity.reserve(total);
+    for (TileBlocks& r : results) {
+        origins.insert(origins.end(), r.origins.begin(), r.origins.end());
+        std::move(r.density.begin(), r.density.end(), std::back_inserter(density));
+        std::move(r.velocity.begin(), r.velocity.end(), std::back_inserter(velocity));
+        r = TileBlocks();
+    }
+    return DensityGrid(transform, std::move(origins), std::move(density), std::move(velocity));
 }
 
 }  // namespace
@@ -233,97 +306,12 @@ double hairVolume(const StrandFrame& strands) {
 
 DensityGrid voxelize(const StrandFrame& strands, const GridTransform& transform, const VoxelizeSettings& settings) {
     strands.validate();
-    checkRange(strands, transform);
-    const bool velocity = settings.velocity;
-    const int channels = velocity ? 4 : 1;
     const double voxelVolume = transform.voxelVolume();
-    if (!(voxelVolume > 0) || !std::isfinite(voxelVolume)) throw Error("voxelize: the grid transform is degenerate");
-
-    std::atomic<size_t> bytes{0};
-    const size_t limit = size_t(std::max(0.0, settings.maxMemoryGiB) * double(size_t(1) << 30));
-    tbb::enumerable_thread_specific<Accumulator> accumulators([&] { return Accumulator(channels, &bytes, limit); });
-    const bool hasVelocities = !strands.velocities.empty();
-
-    const std::vector<uint32_t> order = spatialOrder(strands, transform);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, order.size(), 64), [&](const tbb::blocked_range<size_t>& range) {
-        Accumulator& acc = accumulators.local();
-        for (size_t i = range.begin(); i != range.end(); ++i) {
-            const size_t s = order[i];
-            for (uint32_t v = strands.first(s) + 1; v < strands.offsets[s + 1]; ++v) {
-                const Vec3d p0 = strands.positions[v - 1].cast<double>(), p1 = strands.positions[v].cast<double>();
-                Segment seg;
-                seg.a = transform.toIndex(p0);
-                seg.b = transform.toIndex(p1);
-                seg.r0 = strands.radii[v - 1];
-                seg.r1 = strands.radii[v];
-                seg.v0 = hasVelocities ? Vec3d(strands.velocities[v - 1].cast<double>()) : Vec3d::Zero();
-                seg.v1 = hasVelocities ? Vec3d(strands.velocities[v].cast<double>()) : Vec3d::Zero();
-                seg.k = kPi * (p1 - p0).norm() / voxelVolume * kFixed;
-                const double rMax = std::max(std::abs(seg.r0), std::abs(seg.r1));
-                if (seg.k * rMax * rMax == 0) continue;  // no volume to deposit
-                if (!(seg.k * rMax * rMax < kMaxDeposit))
-                    throw Error(cat("voxelize: strand ", strands.ids.empty() ? s : strands.ids[s], " radius ", rMax,
-                                    " m is too thick for voxels of ", std::cbrt(voxelVolume),
-                                    " m (density would overflow)"));
-                const bool box = settings.filter == VoxelFilter::Box;
-                if (velocity)
-                    box ? depositBox<4>(acc, seg) : depositTrilinear<4>(acc, seg);
-                else
-                    box ? depositBox<1>(acc, seg) : depositTrilinear<1>(acc, seg);
-            }
-        }
-    });
-
-    // Merge: the union of touched blocks in sorted order, each summed over
-    // the threads (integers: the order of threads does not matter).
-    std::vector<const Accumulator*> parts;
-    std::vector<uint64_t> keys;
-    for (const Accumulator& acc : accumulators) {
-        parts.push_back(&acc);
-        acc.appendKeys(&keys);
-    }
-    std::sort(keys.begin(), keys.end());
-    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-
-    std::vector<DensityGrid::DensityBlock> density(keys.size());
-    std::vector<DensityGrid::VelocityBlock> momentum(velocity ? keys.size() : 0);
-    std::vector<char> keep(keys.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, keys.size(), 16), [&](const tbb::blocked_range<size_t>& range) {
-        std::vector<int64_t> sum(size_t(kBlockVoxels) * size_t(channels));
-        for (size_t b = range.begin(); b != range.end(); ++b) {
-            std::fill(sum.begin(), sum.end(), 0);
-            for (const Accumulator* part : parts)
-                if (const int64_t* block = part->find(keys[b]))
-                    for (size_t i = 0; i < sum.size(); ++i) sum[i] += block[i];
-            for (int i = 0; i < kBlockVoxels; ++i) {
-                const int64_t* voxel = &sum[size_t(i) * size_t(channels)];
-                density[b][size_t(i)] = float(double(voxel[0]) / kFixed);
-                if (voxel[0] > 0) keep[b] = 1;
-                if (velocity) {
-                    const double w = voxel[0] > 0 ? 1.0 / double(voxel[0]) : 0.0;
-                    momentum[b][size_t(i)] =
-                        Vec3f(float(double(voxel[1]) * w), float(double(voxel[2]) * w), float(double(voxel[3]) * w));
-                }
-            }
-        }
-    });
-    accumulators.clear();
-
-    // Drop blocks whose deposits all rounded to zero, keeping the sorted order.
-    std::vector<Vec3i> origins;
-    size_t n = 0;
-    for (size_t b = 0; b < keys.size(); ++b) {
-        if (!keep[b]) continue;
-        origins.push_back(blockCoordOfKey(keys[b]) * DensityGrid::kBlockSize);
-        if (n != b) {
-            density[n] = density[b];
-            if (velocity) momentum[n] = momentum[b];
-        }
-        ++n;
-    }
-    density.resize(n);
-    if (velocity) momentum.resize(n);
-    return DensityGrid(transform, std::move(origins), std::move(density), std::move(momentum));
+    if (!(voxelVolume > 0) || !std::isfinite(voxelVolume) || !transform.offset.allFinite())
+        throw Error("voxelize: the grid transform is degenerate");
+    checkRange(strands, transform);
+    return settings.velocity ? voxelizeTiles<4>(strands, transform, settings)
+                             : voxelizeTiles<1>(strands, transform, settings);
 }
 
 }  // namespace hp

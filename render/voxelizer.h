@@ -9,10 +9,11 @@
 // grid). Strands are treated as lines: the radius sets how much they deposit,
 // not where (hair is far thinner than a voxel).
 //
-// Parallel over strands (TBB); each thread accumulates into its own sparse
-// blocks in 64-bit fixed point (2^-40 density units), which makes the sum
-// independent of the order of additions: the result is bit-identical for any
-// thread count.
+// Parallel over space (TBB): segments are binned into tiles of 32³ voxels;
+// one task owns a tile and adds every segment touching it, in segment order,
+// into a dense buffer. Each voxel's sum is therefore formed in the same order
+// whatever the thread count: the result is bit-identical for 1 or N threads,
+// and no per-thread copies of the grid are merged.
 #pragma once
 
 #include "render/density_grid.h"
