@@ -23,15 +23,16 @@ void walkCells(const Eigen::Vector3d& a, const Eigen::Vector3d& b, Visit&& visit
     const Eigen::Vector3d d = b - a;
     Eigen::Vector3i cell(int(std::floor(a.x())), int(std::floor(a.y())), int(std::floor(a.z())));
     int step[3];
-    double tMax[3];
+    double tMax[3], inv[3];
     constexpr double kInf = std::numeric_limits<double>::infinity();
     for (int k = 0; k < 3; ++k) {
+        inv[k] = d[k] != 0 ? 1.0 / d[k] : 0.0;
         if (d[k] > 0) {
             step[k] = 1;
-            tMax[k] = (cell[k] + 1 - a[k]) / d[k];
+            tMax[k] = (cell[k] + 1 - a[k]) * inv[k];
         } else if (d[k] < 0) {
             step[k] = -1;
-            tMax[k] = (cell[k] - a[k]) / d[k];
+            tMax[k] = (cell[k] - a[k]) * inv[k];
         } else {
             step[k] = 0;
             tMax[k] = kInf;
@@ -51,7 +52,7 @@ void walkCells(const Eigen::Vector3d& a, const Eigen::Vector3d& b, Visit&& visit
         // Recomputed from the plane rather than accumulated, so long segments
         // do not drift off the grid planes.
         cell[k] += step[k];
-        tMax[k] = (cell[k] + (step[k] > 0 ? 1 : 0) - a[k]) / d[k];
+        tMax[k] = (cell[k] + (step[k] > 0 ? 1 : 0) - a[k]) * inv[k];
     }
 }
 

@@ -37,13 +37,17 @@ constexpr int kBlocksPerTile = kTile / kBlock;
 constexpr double kGaussX[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
 constexpr double kGaussW[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
 
-/// A segment prepared for deposit: end points in index space, radii,
-/// velocities, and k = π · L / voxel volume, which turns ∫ r² dt into density.
+/// A segment prepared for deposit: end points in index space, radii, and
+/// k = π · L / voxel volume, which turns ∫ r² dt into density. 64 bytes.
 struct Segment {
     Vec3d a, b;
-    double r0, r1;
-    Vec3d v0, v1;
     double k;
+    float r0, r1;
+};
+
+/// End-point velocities of a segment (only when the velocity channel is on).
+struct SegmentVelocity {
+    Vec3f v0, v1;
 };
 
 /// A tile's dense accumulator: C channels per voxel (density, or density and
@@ -53,7 +57,8 @@ template <int C>
 struct TileBuffer {
     Vec3i origin;  // first voxel of the tile
     std::vector<double> values = std::vector<double>(size_t(kTileVoxels) * C, 0.0);
-    uint64_t touched = 0;  // bit b: block b received deposits (sparse hair touches few)
+    static constexpr int kBlocks = kBlocksPerTile * kBlocksPerTile * kBlocksPerTile;
+    uint64_t touched[(kBlocks + 63) / 64] = {};  // bit b: block b received deposits (sparse hair touches few)
 
     static int block(int x, int y, int z) { return ((x >> 3) * kBlocksPerTile + (y >> 3)) * kBlocksPerTile + (z >> 3); }
     /// Position of tile-local voxel (x, y, z) in `values`, in voxels.
@@ -63,7 +68,8 @@ struct TileBuffer {
     static int index(const Vec3i& v) { return index(v.x(), v.y(), v.z()); }
     /// Voxel `local`'s C channels, marking its block touched.
     double* at(const Vec3i& local) {
-        touched |= uint64_t(1) << block(local.x(), local.y(), local.z());
+        const int b = block(local.x(), local.y(), local.z());
+        touched[b >> 6] |= uint64_t(1) << (b & 63);
         return &values[size_t(index(local)) * C];
     }
     bool inside(const Vec3i& local) const {
@@ -79,7 +85,7 @@ struct TileBuffer {
 /// Box filter: the segment's centre line cut at voxel faces; each piece's
 /// exact volume goes to the voxel containing it (if that voxel is in the tile).
 template <int C>
-void depositBox(TileBuffer<C>& tile, const Segment& s) {
+void depositBox(TileBuffer<C>& tile, const Segment& s, const SegmentVelocity* sv) {
     const Vec3d half = Vec3d::Constant(0.5);
     walkCells(s.a + half, s.b + half, [&](const Vec3i& voxel, double t0, double t1) {
         const Vec3i local = voxel - tile.origin;
@@ -88,11 +94,11 @@ void depositBox(TileBuffer<C>& tile, const Segment& s) {
         double q[C] = {};
         for (int g = 0; g < 3; ++g) {
             const double t = mid + h * kGaussX[g];
-            const double r = s.r0 + (s.r1 - s.r0) * t;
+            const double r = double(s.r0) + double(s.r1 - s.r0) * t;
             const double w = s.k * h * kGaussW[g] * r * r;
             q[0] += w;
             if constexpr (C == 4) {
-                const Vec3d v = s.v0 + (s.v1 - s.v0) * t;
+                const Vec3d v = sv->v0.cast<double>() + (sv->v1 - sv->v0).cast<double>() * t;
                 for (int c = 0; c < 3; ++c) q[1 + c] += w * v[c];
             }
         }
@@ -106,7 +112,7 @@ void depositBox(TileBuffer<C>& tile, const Segment& s) {
 /// keeps the corners it owns; the tiles owning the other corners compute the
 /// same pieces (same walk over the whole segment) and keep theirs.
 template <int C>
-void depositTrilinear(TileBuffer<C>& tile, const Segment& s) {
+void depositTrilinear(TileBuffer<C>& tile, const Segment& s, const SegmentVelocity* sv) {
     const Vec3d d = s.b - s.a;
     walkCells(s.a, s.b, [&](const Vec3i& cell, double t0, double t1) {
         const Vec3i local = cell - tile.origin;  // corner (0,0,0) of the dual cell
@@ -116,12 +122,12 @@ void depositTrilinear(TileBuffer<C>& tile, const Segment& s) {
         double q[8][C] = {};  // corner (x-major: ix·4 + iy·2 + iz) × channel
         for (int g = 0; g < 3; ++g) {
             const double t = mid + h * kGaussX[g];
-            const double r = s.r0 + (s.r1 - s.r0) * t;
+            const double r = double(s.r0) + double(s.r1 - s.r0) * t;
             const double w = s.k * h * kGaussW[g] * r * r;
             const Vec3d f = (base + d * t).cwiseMax(0.0).cwiseMin(1.0);
             const double wx[2] = {1 - f.x(), f.x()}, wy[2] = {1 - f.y(), f.y()}, wz[2] = {1 - f.z(), f.z()};
             Vec3d v;
-            if constexpr (C == 4) v = s.v0 + (s.v1 - s.v0) * t;
+            if constexpr (C == 4) v = sv->v0.cast<double>() + (sv->v1 - sv->v0).cast<double>() * t;
             for (int i = 0; i < 8; ++i) {
                 const double c = w * wx[i >> 2] * wy[(i >> 1) & 1] * wz[i & 1];
                 q[i][0] += c;
@@ -157,7 +163,7 @@ struct TileBlocks {
 template <int C>
 void extractBlocks(TileBuffer<C>& tile, TileBlocks* out) {
     for (int b = 0; b < kBlocksPerTile * kBlocksPerTile * kBlocksPerTile; ++b) {
-        if (!(tile.touched >> b & 1)) continue;
+        if (!(tile.touched[b >> 6] >> (b & 63) & 1)) continue;
         double* v = &tile.values[size_t(b) * kBlockVoxels * C];
         bool any = false;
         for (int i = 0; i < kBlockVoxels; ++i) any |= v[i * C] > 0;
@@ -168,11 +174,11 @@ void extractBlocks(TileBuffer<C>& tile, TileBlocks* out) {
         const Vec3i local(b / (kBlocksPerTile * kBlocksPerTile), (b / kBlocksPerTile) % kBlocksPerTile,
                           b % kBlocksPerTile);
         out->origins.push_back(tile.origin + local * kBlock);
-        out->density.push_back(std::make_unique<DensityGrid::DensityBlock>());
+        out->density.emplace_back(new DensityGrid::DensityBlock);  // every voxel written below
         DensityGrid::DensityBlock& density = *out->density.back();
         for (int i = 0; i < kBlockVoxels; ++i) density[size_t(i)] = float(v[i * C]);
         if constexpr (C == 4) {
-            out->velocity.push_back(std::make_unique<DensityGrid::VelocityBlock>());
+            out->velocity.emplace_back(new DensityGrid::VelocityBlock);
             DensityGrid::VelocityBlock& velocity = *out->velocity.back();
             for (int i = 0; i < kBlockVoxels; ++i) {
                 const double* m = v + i * C;
@@ -182,7 +188,7 @@ void extractBlocks(TileBuffer<C>& tile, TileBlocks* out) {
         }
         std::fill(v, v + size_t(kBlockVoxels) * C, 0.0);
     }
-    tile.touched = 0;
+    std::fill(std::begin(tile.touched), std::end(tile.touched), 0);
 }
 
 void checkRange(const StrandFrame& strands, const GridTransform& transform) {
@@ -198,33 +204,92 @@ void checkRange(const StrandFrame& strands, const GridTransform& transform) {
 
 Vec3i floorVec(const Vec3d& p) { return Vec3i(int(std::floor(p.x())), int(std::floor(p.y())), int(std::floor(p.z()))); }
 
-/// (tile key, segment) pairs: every tile a segment may deposit into. A
-/// segment is named by the index of its second vertex.
-std::vector<std::pair<uint64_t, uint32_t>> binSegments(const StrandFrame& strands, const GridTransform& transform,
-                                                       VoxelFilter filter) {
-    tbb::enumerable_thread_specific<std::vector<std::pair<uint64_t, uint32_t>>> parts;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, strands.strandCount(), 256), [&](const auto& range) {
-        auto& out = parts.local();
-        for (size_t s = range.begin(); s != range.end(); ++s)
-            for (uint32_t v = strands.first(s) + 1; v < strands.offsets[s + 1]; ++v) {
-                if (strands.radii[v - 1] == 0 && strands.radii[v] == 0) continue;
-                const Vec3d a = transform.toIndex(strands.positions[v - 1].cast<double>());
-                const Vec3d b = transform.toIndex(strands.positions[v].cast<double>());
-                // Voxels reached: the box filter rounds to the nearest centre,
-                // the trilinear one reaches floor .. floor + 1.
-                const double shift = filter == VoxelFilter::Box ? 0.5 : 0.0;
-                const Vec3i lo = floorVec(a.cwiseMin(b) + Vec3d::Constant(shift));
-                const Vec3i hi = floorVec(a.cwiseMax(b) + Vec3d::Constant(shift)) +
-                                 Vec3i::Constant(filter == VoxelFilter::Box ? 0 : 1);
-                for (int x = lo.x() >> kTileLog2; x <= hi.x() >> kTileLog2; ++x)
-                    for (int y = lo.y() >> kTileLog2; y <= hi.y() >> kTileLog2; ++y)
-                        for (int z = lo.z() >> kTileLog2; z <= hi.z() >> kTileLog2; ++z)
-                            out.emplace_back(blockKey(Vec3i(x, y, z)), v);
-            }
+Vec3i tileOf(const Vec3i& voxel) { return Vec3i(voxel.x() >> kTileLog2, voxel.y() >> kTileLog2, voxel.z() >> kTileLog2); }
+
+/// Interleaves the low 21 bits of x, y and z (Morton order).
+uint64_t morton(uint32_t x, uint32_t y, uint32_t z) {
+    auto spread = [](uint64_t v) {
+        v &= 0x1FFFFF;
+        v = (v | v << 32) & 0x1F00000000FFFFull;
+        v = (v | v << 16) & 0x1F0000FF0000FFull;
+        v = (v | v << 8) & 0x100F00F00F00F00Full;
+        v = (v | v << 4) & 0x10C30C30C30C30C3ull;
+        v = (v | v << 2) & 0x1249249249249249ull;
+        return v;
+    };
+    return spread(x) << 2 | spread(y) << 1 | spread(z);
+}
+
+/// All segments with volume, prepared in index space, strands in Morton
+/// order of their middle vertex: the segments one tile needs then lie close
+/// together in memory (a Fibonacci lattice's strand order jumps around the
+/// head, which made every tile's segment loads cache misses).
+std::vector<Segment> prepareSegments(const StrandFrame& strands, const GridTransform& transform,
+                                     std::vector<SegmentVelocity>* velocities) {
+    const size_t n = strands.strandCount();
+    std::vector<std::pair<uint64_t, uint32_t>> order(n);
+    tbb::parallel_for(size_t(0), n, [&](size_t s) {
+        const uint32_t count = strands.vertexCount(s);
+        uint64_t code = 0;
+        if (count > 0) {
+            const Vec3d p = transform.toIndex(strands.positions[strands.first(s) + count / 2].cast<double>());
+            auto q = [](double v) { return uint32_t(int64_t(std::floor(v)) >> kTileLog2) & 0x1FFFFF; };
+            code = morton(q(p.x()), q(p.y()), q(p.z()));
+        }
+        order[s] = {code, uint32_t(s)};
     });
-    std::vector<std::pair<uint64_t, uint32_t>> pairs;
-    for (const auto& part : parts) pairs.insert(pairs.end(), part.begin(), part.end());
-    // Unique pairs: the sorted order is the same whichever thread made which.
+    tbb::parallel_sort(order.begin(), order.end());  // unique pairs: a deterministic order
+    std::vector<size_t> first(n + 1, 0);  // first segment of the i-th strand in that order
+    for (size_t i = 0; i < n; ++i) first[i + 1] = first[i] + std::max<uint32_t>(strands.vertexCount(order[i].second), 1) - 1;
+    std::vector<Segment> segments(first[n]);
+    if (velocities) velocities->assign(first[n], SegmentVelocity{Vec3f::Zero(), Vec3f::Zero()});
+    const bool hasVelocities = velocities && !strands.velocities.empty();
+    const double voxelVolume = transform.voxelVolume();
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+        const size_t s = order[i].second;
+        Segment* out = &segments[first[i]];
+        for (uint32_t v = strands.first(s) + 1; v < strands.offsets[s + 1]; ++v, ++out) {
+            const Vec3d p0 = strands.positions[v - 1].cast<double>(), p1 = strands.positions[v].cast<double>();
+            out->a = transform.toIndex(p0);
+            out->b = transform.toIndex(p1);
+            out->r0 = strands.radii[v - 1];
+            out->r1 = strands.radii[v];
+            out->k = kPi * (p1 - p0).norm() / voxelVolume;
+            if (hasVelocities)
+                (*velocities)[size_t(out - segments.data())] = {strands.velocities[v - 1], strands.velocities[v]};
+        }
+    });
+    return segments;
+}
+
+/// (tile key, segment) pairs, sorted: every tile a segment may deposit into.
+std::vector<std::pair<uint64_t, uint32_t>> binSegments(const std::vector<Segment>& segments, VoxelFilter filter) {
+    // Voxels reached: the box filter rounds to the nearest centre, the
+    // trilinear one reaches floor .. floor + 1.
+    const double shift = filter == VoxelFilter::Box ? 0.5 : 0.0;
+    const int reach = filter == VoxelFilter::Box ? 0 : 1;
+    auto tiles = [&](const Segment& g, Vec3i* lo, Vec3i* hi) {
+        *lo = tileOf(floorVec(g.a.cwiseMin(g.b) + Vec3d::Constant(shift)));
+        *hi = tileOf(floorVec(g.a.cwiseMax(g.b) + Vec3d::Constant(shift)) + Vec3i::Constant(reach));
+        const bool empty = g.k == 0 || (g.r0 == 0 && g.r1 == 0);
+        return empty ? 0 : size_t((*hi - *lo + Vec3i::Ones()).prod());
+    };
+    // Count, scan, fill: the pairs come out in segment order without locks.
+    std::vector<size_t> start(segments.size() + 1, 0);
+    tbb::parallel_for(size_t(0), segments.size(), [&](size_t i) {
+        Vec3i lo, hi;
+        start[i + 1] = tiles(segments[i], &lo, &hi);
+    });
+    for (size_t i = 0; i < segments.size(); ++i) start[i + 1] += start[i];
+    std::vector<std::pair<uint64_t, uint32_t>> pairs(start.back());
+    tbb::parallel_for(size_t(0), segments.size(), [&](size_t i) {
+        Vec3i lo, hi;
+        if (tiles(segments[i], &lo, &hi) == 0) return;
+        auto* out = &pairs[start[i]];
+        for (int x = lo.x(); x <= hi.x(); ++x)
+            for (int y = lo.y(); y <= hi.y(); ++y)
+                for (int z = lo.z(); z <= hi.z(); ++z) *out++ = {blockKey(Vec3i(x, y, z)), uint32_t(i)};
+    });
     tbb::parallel_sort(pairs.begin(), pairs.end());
     return pairs;
 }
@@ -232,18 +297,25 @@ std::vector<std::pair<uint64_t, uint32_t>> binSegments(const StrandFrame& strand
 template <int C>
 DensityGrid voxelizeTiles(const StrandFrame& strands, const GridTransform& transform,
                           const VoxelizeSettings& settings) {
-    const double voxelVolume = transform.voxelVolume();
-    const std::vector<std::pair<uint64_t, uint32_t>> pairs = binSegments(strands, transform, settings.filter);
+    std::vector<SegmentVelocity> velocities;
+    const std::vector<Segment> segments = prepareSegments(strands, transform, C == 4 ? &velocities : nullptr);
+    for (const Segment& g : segments) {
+        const double rMax = std::max(std::abs(g.r0), std::abs(g.r1));
+        if (!(g.k * rMax * rMax < 1e30))
+            throw Error(cat("voxelize: a strand radius of ", rMax, " m is absurd for voxels of ",
+                            std::cbrt(transform.voxelVolume()), " m"));
+    }
+    const std::vector<std::pair<uint64_t, uint32_t>> pairs = binSegments(segments, settings.filter);
     std::vector<size_t> starts;  // first pair of each tile
     for (size_t i = 0; i < pairs.size(); ++i)
         if (i == 0 || pairs[i].first != pairs[i - 1].first) starts.push_back(i);
     starts.push_back(pairs.size());
     const size_t tiles = starts.size() - 1;
 
-    const bool hasVelocities = !strands.velocities.empty();
     const size_t limit = size_t(std::max(0.0, settings.maxMemoryGiB) * double(size_t(1) << 30));
     const size_t blockBytes = sizeof(DensityGrid::DensityBlock) + (C == 4 ? sizeof(DensityGrid::VelocityBlock) : 0);
-    std::atomic<size_t> bytes{pairs.size() * sizeof(pairs[0])};
+    std::atomic<size_t> bytes{pairs.size() * sizeof(pairs[0]) + segments.size() * sizeof(Segment) +
+                              velocities.size() * sizeof(SegmentVelocity)};
     std::vector<TileBlocks> results(tiles);
     tbb::enumerable_thread_specific<TileBuffer<C>> buffers;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& range) {
@@ -251,20 +323,12 @@ DensityGrid voxelizeTiles(const StrandFrame& strands, const GridTransform& trans
         for (size_t t = range.begin(); t != range.end(); ++t) {
             tile.origin = blockCoordOfKey(pairs[starts[t]].first) * kTile;
             for (size_t i = starts[t]; i < starts[t + 1]; ++i) {
-                const uint32_t v = pairs[i].second;
-                const Vec3d p0 = strands.positions[v - 1].cast<double>(), p1 = strands.positions[v].cast<double>();
-                Segment seg;
-                seg.a = transform.toIndex(p0);
-                seg.b = transform.toIndex(p1);
-                seg.r0 = strands.radii[v - 1];
-                seg.r1 = strands.radii[v];
-                seg.v0 = hasVelocities ? Vec3d(strands.velocities[v - 1].cast<double>()) : Vec3d::Zero();
-                seg.v1 = hasVelocities ? Vec3d(strands.velocities[v].cast<double>()) : Vec3d::Zero();
-                seg.k = kPi * (p1 - p0).norm() / voxelVolume;
+                const uint32_t g = pairs[i].second;
+                const SegmentVelocity* v = C == 4 ? &velocities[g] : nullptr;
                 if (settings.filter == VoxelFilter::Box)
-                    depositBox(tile, seg);
+                    depositBox(tile, segments[g], v);
                 else
-                    depositTrilinear(tile, seg);
+                    depositTrilinear(tile, segments[g], v);
             }
             extractBlocks(tile, &results[t]);
             if (bytes.fetch_add(results[t].origins.size() * blockBytes) > limit)
