@@ -71,7 +71,7 @@ enum class Reconstruction {
 /// @brief Sparse density (and optional density-weighted velocity) per voxel.
 ///
 /// Absent voxels are 0. Blocks are kept in the order they were added (the
-/// voxelizer adds them sorted by origin, x then y then z).
+/// voxelizer's order is deterministic: by 32³ tile, then x, y, z within it).
 class DensityGrid {
   public:
     static constexpr int kBlockLog2 = 3;

@@ -38,12 +38,18 @@ constexpr double kGaussX[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
 constexpr double kGaussW[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
 
 /// A segment prepared for deposit: end points in index space, radii, and
-/// k = π · L / voxel volume, which turns ∫ r² dt into density. 64 bytes.
+/// k = π · L / voxel volume, which turns ∫ r² dt into density.
 struct Segment {
     Vec3d a, b;
     double k;
-    float r0, r1;
+    double r0, r1;
 };
+
+/// Segments longer than this (in voxels) are split into equal parts, so a
+/// part's bounding box spans at most 2 tiles per axis: small voxels do not
+/// make a diagonal segment claim (and re-walk) a whole cube of tiles. The
+/// split conserves volume exactly (the radius is linear along the segment).
+constexpr double kMaxPartVoxels = kTile / 2;
 
 /// End-point velocities of a segment (only when the velocity channel is on).
 struct SegmentVelocity {
@@ -94,7 +100,7 @@ void depositBox(TileBuffer<C>& tile, const Segment& s, const SegmentVelocity* sv
         double q[C] = {};
         for (int g = 0; g < 3; ++g) {
             const double t = mid + h * kGaussX[g];
-            const double r = double(s.r0) + double(s.r1 - s.r0) * t;
+            const double r = s.r0 + (s.r1 - s.r0) * t;
             const double w = s.k * h * kGaussW[g] * r * r;
             q[0] += w;
             if constexpr (C == 4) {
@@ -122,7 +128,7 @@ void depositTrilinear(TileBuffer<C>& tile, const Segment& s, const SegmentVeloci
         double q[8][C] = {};  // corner (x-major: ix·4 + iy·2 + iz) × channel
         for (int g = 0; g < 3; ++g) {
             const double t = mid + h * kGaussX[g];
-            const double r = double(s.r0) + double(s.r1 - s.r0) * t;
+            const double r = s.r0 + (s.r1 - s.r0) * t;
             const double w = s.k * h * kGaussW[g] * r * r;
             const Vec3d f = (base + d * t).cwiseMax(0.0).cwiseMin(1.0);
             const double wx[2] = {1 - f.x(), f.x()}, wy[2] = {1 - f.y(), f.y()}, wz[2] = {1 - f.z(), f.z()};
@@ -239,31 +245,59 @@ std::vector<Segment> prepareSegments(const StrandFrame& strands, const GridTrans
         order[s] = {code, uint32_t(s)};
     });
     tbb::parallel_sort(order.begin(), order.end());  // unique pairs: a deterministic order
-    std::vector<size_t> first(n + 1, 0);  // first segment of the i-th strand in that order
-    for (size_t i = 0; i < n; ++i) first[i + 1] = first[i] + std::max<uint32_t>(strands.vertexCount(order[i].second), 1) - 1;
+
+    // Parts per segment (long segments split), then each strand's first part.
+    auto partsOf = [&](uint32_t v) {
+        const double length = (transform.toIndex(strands.positions[v].cast<double>()) -
+                               transform.toIndex(strands.positions[v - 1].cast<double>()))
+                                  .cwiseAbs()
+                                  .maxCoeff();
+        return size_t(std::max(1.0, std::ceil(length / kMaxPartVoxels)));
+    };
+    std::vector<size_t> first(n + 1, 0);
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+        const size_t s = order[i].second;
+        size_t parts = 0;
+        for (uint32_t v = strands.first(s) + 1; v < strands.offsets[s + 1]; ++v) parts += partsOf(v);
+        first[i + 1] = parts;
+    });
+    for (size_t i = 0; i < n; ++i) first[i + 1] += first[i];
+
     std::vector<Segment> segments(first[n]);
     if (velocities) velocities->assign(first[n], SegmentVelocity{Vec3f::Zero(), Vec3f::Zero()});
     const bool hasVelocities = velocities && !strands.velocities.empty();
     const double voxelVolume = transform.voxelVolume();
     tbb::parallel_for(size_t(0), n, [&](size_t i) {
         const size_t s = order[i].second;
-        Segment* out = &segments[first[i]];
-        for (uint32_t v = strands.first(s) + 1; v < strands.offsets[s + 1]; ++v, ++out) {
+        size_t out = first[i];
+        for (uint32_t v = strands.first(s) + 1; v < strands.offsets[s + 1]; ++v) {
             const Vec3d p0 = strands.positions[v - 1].cast<double>(), p1 = strands.positions[v].cast<double>();
-            out->a = transform.toIndex(p0);
-            out->b = transform.toIndex(p1);
-            out->r0 = strands.radii[v - 1];
-            out->r1 = strands.radii[v];
-            out->k = kPi * (p1 - p0).norm() / voxelVolume;
-            if (hasVelocities)
-                (*velocities)[size_t(out - segments.data())] = {strands.velocities[v - 1], strands.velocities[v]};
+            const Vec3d a = transform.toIndex(p0), d = transform.toIndex(p1) - a;
+            const double r0 = strands.radii[v - 1], r1 = strands.radii[v];
+            const size_t parts = partsOf(v);
+            const double k = kPi * (p1 - p0).norm() / voxelVolume / double(parts);
+            for (size_t j = 0; j < parts; ++j, ++out) {
+                const double u0 = double(j) / double(parts), u1 = double(j + 1) / double(parts);
+                Segment& g = segments[out];
+                g.a = j == 0 ? a : Vec3d(a + d * u0);
+                g.b = j + 1 == parts ? Vec3d(a + d) : Vec3d(a + d * u1);
+                g.r0 = r0 + (r1 - r0) * u0;
+                g.r1 = r0 + (r1 - r0) * u1;
+                g.k = k;
+                if (hasVelocities) {
+                    const Vec3f& v0 = strands.velocities[v - 1];
+                    const Vec3f dv = strands.velocities[v] - v0;
+                    (*velocities)[out] = {v0 + dv * float(u0), v0 + dv * float(u1)};
+                }
+            }
         }
     });
     return segments;
 }
 
 /// (tile key, segment) pairs, sorted: every tile a segment may deposit into.
-std::vector<std::pair<uint64_t, uint32_t>> binSegments(const std::vector<Segment>& segments, VoxelFilter filter) {
+std::vector<std::pair<uint64_t, uint32_t>> binSegments(const std::vector<Segment>& segments, VoxelFilter filter,
+                                                       double maxBytes) {
     // Voxels reached: the box filter rounds to the nearest centre, the
     // trilinear one reaches floor .. floor + 1.
     const double shift = filter == VoxelFilter::Box ? 0.5 : 0.0;
@@ -281,6 +315,9 @@ std::vector<std::pair<uint64_t, uint32_t>> binSegments(const std::vector<Segment
         start[i + 1] = tiles(segments[i], &lo, &hi);
     });
     for (size_t i = 0; i < segments.size(); ++i) start[i + 1] += start[i];
+    if (double(start.back()) * 16.0 > maxBytes)
+        throw Error(cat("voxelize: binning needs more than the memory limit (", start.back(),
+                        " segment-tile pairs); use a larger voxel size"));
     std::vector<std::pair<uint64_t, uint32_t>> pairs(start.back());
     tbb::parallel_for(size_t(0), segments.size(), [&](size_t i) {
         Vec3i lo, hi;
@@ -299,13 +336,15 @@ DensityGrid voxelizeTiles(const StrandFrame& strands, const GridTransform& trans
                           const VoxelizeSettings& settings) {
     std::vector<SegmentVelocity> velocities;
     const std::vector<Segment> segments = prepareSegments(strands, transform, C == 4 ? &velocities : nullptr);
+    if (segments.size() > size_t(UINT32_MAX)) throw Error("voxelize: too many segments; use a larger voxel size");
     for (const Segment& g : segments) {
         const double rMax = std::max(std::abs(g.r0), std::abs(g.r1));
         if (!(g.k * rMax * rMax < 1e30))
             throw Error(cat("voxelize: a strand radius of ", rMax, " m is absurd for voxels of ",
                             std::cbrt(transform.voxelVolume()), " m"));
     }
-    const std::vector<std::pair<uint64_t, uint32_t>> pairs = binSegments(segments, settings.filter);
+    const std::vector<std::pair<uint64_t, uint32_t>> pairs =
+        binSegments(segments, settings.filter, settings.maxMemoryGiB * double(size_t(1) << 30));
     std::vector<size_t> starts;  // first pair of each tile
     for (size_t i = 0; i < pairs.size(); ++i)
         if (i == 0 || pairs[i].first != pairs[i - 1].first) starts.push_back(i);

@@ -38,8 +38,9 @@ struct VoxelizeSettings {
     /// Also accumulate vertex velocities (linear along each segment) weighted
     /// by the deposited volume, giving each voxel its hair's mean velocity.
     bool velocity = false;
-    /// Accumulation memory above which voxelize() refuses (throws hp::Error)
-    /// rather than exhausting the machine: a voxel size far too small.
+    /// Memory (segments, binning, the grid's blocks) above which voxelize()
+    /// stops with hp::Error rather than exhausting the machine: a voxel size
+    /// far too small. The VDB export needs about as much again.
     double maxMemoryGiB = 8.0;
 };
 

@@ -105,6 +105,19 @@ TEST(Voxelizer, ConservesHairVolumeForRandomStrands) {
         }
 }
 
+TEST(Voxelizer, ConservesHairVolumeWithVoxelsMuchSmallerThanSegments) {
+    // Segments up to 100 voxels long are split into parts internally; the
+    // parts must still add up to the whole tapered segments.
+    const StrandFrame strands = randomStrands(12, 19);
+    const double volume = hairVolume(strands);
+    for (VoxelFilter f : {VoxelFilter::Trilinear, VoxelFilter::Box}) {
+        VoxelizeSettings s;
+        s.filter = f;
+        const DensityGrid grid = voxelize(strands, GridTransform::uniform(0.00006), s);
+        EXPECT_LT(std::abs(grid.totalVolume() - volume) / volume, 1e-6) << "filter " << int(f);
+    }
+}
+
 TEST(Voxelizer, HairVolumeIsTheSumOfTruncatedCones) {
     // A 4 cm strand tapering 50 → 10 µm: π L (r0² + r0 r1 + r1²) / 3.
     const StrandFrame s = straightStrand(Vec3f(0, 0, 0), Vec3f(0, 0.04f, 0), 9, 50e-6f, 10e-6f);
