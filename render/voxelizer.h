@@ -40,7 +40,7 @@ struct VoxelizeSettings {
     bool velocity = false;
     /// Memory (segments, binning, the grid's blocks) above which voxelize()
     /// stops with hp::Error rather than exhausting the machine: a voxel size
-    /// far too small. The VDB export needs about as much again.
+    /// far too small. (Writing with the consuming writeDensityVdb adds little.)
     double maxMemoryGiB = 8.0;
 };
 
