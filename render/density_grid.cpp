@@ -30,6 +30,17 @@ GridTransform GridTransform::fromAxes(const Eigen::Matrix3d& axes, const Vec3d& 
     return t;
 }
 
+GridTransform GridTransform::fromMatrix(const Eigen::Matrix4d& m) {
+    if (!m.allFinite() || m(3, 0) != 0 || m(3, 1) != 0 || m(3, 2) != 0 || m(3, 3) != 1)
+        throw Error("grid transform: the world-to-index matrix must be affine (last row 0 0 0 1) and finite");
+    GridTransform t;
+    t.linear = m.topLeftCorner<3, 3>();
+    t.offset = m.topRightCorner<3, 1>();
+    const double det = t.linear.determinant();
+    if (!(std::abs(det) > 0)) throw Error("grid transform: the world-to-index matrix is singular");
+    return t;
+}
+
 Eigen::Matrix3d GridTransform::indexToWorld() const { return linear.inverse(); }
 
 Vec3d GridTransform::toWorld(const Vec3d& index) const { return linear.inverse() * (index - offset); }
@@ -154,11 +165,13 @@ void gatherCorners(const DensityGrid& g, const Vec3i& c, double v[8]) {
     for (int i = 0; i < 8; ++i) v[i] = g.density(c + Vec3i(i >> 2, (i >> 1) & 1, i & 1));
 }
 
+/// Trilinear interpolation of gatherCorners' values at fractions f ∈ [0, 1]³.
 double trilinear(const double v[8], const Vec3d& f) {
-    const double x0 = v[0] + (v[1] - v[0]) * f.z(), x1 = v[2] + (v[3] - v[2]) * f.z();
-    const double x2 = v[4] + (v[5] - v[4]) * f.z(), x3 = v[6] + (v[7] - v[6]) * f.z();
-    const double y0 = x0 + (x1 - x0) * f.y(), y1 = x2 + (x3 - x2) * f.y();
-    return y0 + (y1 - y0) * f.x();
+    // Along z (corner pairs differing in the last index bit), then y, then x.
+    const double x0y0 = v[0] + (v[1] - v[0]) * f.z(), x0y1 = v[2] + (v[3] - v[2]) * f.z();
+    const double x1y0 = v[4] + (v[5] - v[4]) * f.z(), x1y1 = v[6] + (v[7] - v[6]) * f.z();
+    const double x0 = x0y0 + (x0y1 - x0y0) * f.y(), x1 = x1y0 + (x1y1 - x1y0) * f.y();
+    return x0 + (x1 - x0) * f.x();
 }
 
 Vec3i floorVec(const Vec3d& p) { return Vec3i(int(std::floor(p.x())), int(std::floor(p.y())), int(std::floor(p.z()))); }

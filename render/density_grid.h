@@ -51,6 +51,11 @@ struct GridTransform {
     /// `axes` (metres). E.g. axes = [right·h, up·h, lightDirection·h] makes
     /// index z run along a directional light. Throws hp::Error if singular.
     static GridTransform fromAxes(const Eigen::Matrix3d& axes, const Vec3d& origin);
+    /// From an affine world → index matrix (last row 0 0 0 1), e.g. a light's
+    /// view-projection mapped to texels: for a GL 3D texture of N texels per
+    /// axis addressed by texture coordinates u ∈ [0, 1], index = u·N − ½.
+    /// Throws hp::Error if the matrix is not affine or is singular.
+    static GridTransform fromMatrix(const Eigen::Matrix4d& worldToIndex);
 
     Vec3d toIndex(const Vec3d& world) const { return linear * world + offset; }
     Vec3d toWorld(const Vec3d& index) const;

@@ -11,6 +11,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <mutex>
@@ -22,6 +24,70 @@ namespace {
 void initializeOpenVdb() {
     static std::once_flag once;
     std::call_once(once, [] { openvdb::initialize(); });
+}
+
+/// A 128-bit digest of what a file holds, independent of the order its parts
+/// are added in (parts are hashed on their own and summed per lane), so
+/// blocks hashed in parallel combine deterministically. Non-cryptographic:
+/// it identifies contents, nothing more.
+class Digest {
+  public:
+    void add(const void* data, size_t size, uint64_t seed) {
+        uint64_t h1 = 0x9E3779B97F4A7C15ull ^ seed, h2 = 0xC2B2AE3D27D4EB4Full + seed;
+        const auto* bytes = static_cast<const unsigned char*>(data);
+        size_t i = 0;
+        for (; i + 8 <= size; i += 8) {
+            uint64_t w;
+            std::memcpy(&w, bytes + i, 8);
+            h1 = (h1 ^ w) * 0x100000001B3ull;
+            h1 ^= h1 >> 29;
+            h2 = (h2 ^ (w + 0x632BE59BD9B4E019ull)) * 0xFF51AFD7ED558CCDull;
+            h2 ^= h2 >> 32;
+        }
+        for (; i < size; ++i) {
+            h1 = (h1 ^ bytes[i]) * 0x100000001B3ull;
+            h2 = (h2 ^ bytes[i]) * 0xFF51AFD7ED558CCDull;
+        }
+        h1 = (h1 ^ size) * 0xC4CEB9FE1A85EC53ull;
+        h2 = (h2 ^ (h1 >> 31)) * 0x9E3779B97F4A7C15ull;
+        lane1_.fetch_add(h1, std::memory_order_relaxed);
+        lane2_.fetch_add(h2 ^ (h2 >> 29), std::memory_order_relaxed);
+    }
+    void add(const std::string& text, uint64_t seed) { add(text.data(), text.size(), seed); }
+
+    /// As a UUID string (RFC 9562 layout, version 8 "custom", RFC variant).
+    std::string uuid() const {
+        uint64_t h1 = lane1_.load(), h2 = lane2_.load();
+        h1 = (h1 & ~(0xFull << 12)) | (0x8ull << 12);
+        h2 = (h2 & ~(0x3ull << 62)) | (0x2ull << 62);
+        char text[37];
+        std::snprintf(text, sizeof text, "%08x-%04x-%04x-%04x-%012llx", unsigned(h1 >> 32),
+                      unsigned((h1 >> 16) & 0xFFFF), unsigned(h1 & 0xFFFF), unsigned(h2 >> 48),
+                      (unsigned long long)(h2 & 0xFFFFFFFFFFFFull));
+        return text;
+    }
+
+  private:
+    std::atomic<uint64_t> lane1_{0}, lane2_{0};
+};
+
+/// OpenVDB writes a random UUID into the file header (36 ASCII characters
+/// after magic, format version, library version and a flag: bytes 21..56).
+/// Replace it by the digest of the file's contents, so the same grid makes
+/// the same bytes (resume checks, caches and diffs see no change).
+void writeHeaderUuid(const std::filesystem::path& file, const std::string& uuid) {
+    constexpr size_t kUuidOffset = 8 + 4 + 4 + 4 + 1, kUuidSize = 36;
+    std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
+    char header[kUuidOffset + kUuidSize];
+    if (!io || !io.read(header, sizeof header)) throw IoError(file.string(), "cannot reopen the written VDB file");
+    int64_t magic = 0;
+    std::memcpy(&magic, header, sizeof magic);
+    if (magic != openvdb::OPENVDB_MAGIC || header[kUuidOffset + 8] != '-' || uuid.size() != kUuidSize)
+        throw IoError(file.string(), "unexpected VDB header layout (OpenVDB version changed?)");
+    io.seekp(std::streamoff(kUuidOffset));
+    io.write(uuid.data(), std::streamsize(kUuidSize));
+    io.flush();
+    if (!io) throw IoError(file.string(), "cannot rewrite the VDB header");
 }
 
 /// OpenVDB's Mat4 is row-vector (p' = p · M, translation in the last row).
@@ -42,13 +108,14 @@ openvdb::math::Transform::Ptr toVdbTransform(const GridTransform& t) {
 }
 
 /// Fills the density tree (values × scale) and, if given, the velocity tree
-/// from the grid's blocks. Blocks and OpenVDB leaves are both 8³ in x-major
+/// from the grid's blocks, adding each block to `digest`. Blocks and OpenVDB
+/// leaves are both 8³ in x-major
 /// order, so each block becomes one leaf: created serially (topology
 /// changes are not thread-safe), filled in parallel. With `consume`, each
 /// block is freed once copied, so the grid and the trees are not both whole
 /// in memory.
 void fillTrees(openvdb::FloatTree& densityTree, openvdb::Vec3STree* velocityTree, const DensityGrid& grid,
-               float scale, DensityGrid* consume) {
+               float scale, DensityGrid* consume, Digest* digest) {
     static_assert(openvdb::FloatTree::LeafNodeType::DIM == DensityGrid::kBlockSize,
                   "DensityGrid blocks must match OpenVDB leaves");
     // In batches, so that with `consume` the memory freed by one batch's
@@ -76,65 +143,15 @@ void fillTrees(openvdb::FloatTree& densityTree, openvdb::Vec3STree* velocityTree
                     if (density[v] > 0.f)
                         vleaf->setValueOn(v, openvdb::Vec3s(velocity[v].x(), velocity[v].y(), velocity[v].z()));
             }
+            const Vec3i& o = grid.blockOrigin(b);
+            const uint64_t seed = (uint64_t(uint32_t(o.x())) << 42) ^ (uint64_t(uint32_t(o.y())) << 21) ^ uint32_t(o.z());
+            digest->add(density, sizeof(float) * DensityGrid::kBlockVoxels, seed);
+            if (velocityTree) digest->add(grid.blockVelocity(b), sizeof(Vec3f) * DensityGrid::kBlockVoxels, ~seed);
             if (consume) consume->releaseBlock(b);
         });
     }
     openvdb::tools::pruneInactive(densityTree);
     if (velocityTree) openvdb::tools::pruneInactive(*velocityTree);
-}
-
-/// 128 bits of a fast non-cryptographic hash (two multiply-xor lanes over
-/// 8-byte words): identifies file contents, nothing more.
-std::string contentUuid(const char* data, size_t size) {
-    uint64_t h1 = 0x9E3779B97F4A7C15ull, h2 = 0xC2B2AE3D27D4EB4Full;
-    size_t i = 0;
-    for (; i + 8 <= size; i += 8) {
-        uint64_t w;
-        std::memcpy(&w, data + i, 8);
-        h1 = (h1 ^ w) * 0x100000001B3ull;
-        h1 ^= h1 >> 29;
-        h2 = (h2 ^ (w + 0x632BE59BD9B4E019ull)) * 0xFF51AFD7ED558CCDull;
-        h2 ^= h2 >> 32;
-    }
-    for (; i < size; ++i) {
-        h1 = (h1 ^ uint8_t(data[i])) * 0x100000001B3ull;
-        h2 = (h2 ^ uint8_t(data[i])) * 0xFF51AFD7ED558CCDull;
-    }
-    h1 ^= size;
-    h2 ^= h1 >> 17;
-    // RFC 9562 layout with version 8 (custom) and the RFC variant bits.
-    h1 = (h1 & ~(0xFull << 12)) | (0x8ull << 12);
-    h2 = (h2 & ~(0x3ull << 62)) | (0x2ull << 62);
-    char text[37];
-    std::snprintf(text, sizeof text, "%08x-%04x-%04x-%04x-%012llx", unsigned(h1 >> 32), unsigned((h1 >> 16) & 0xFFFF),
-                  unsigned(h1 & 0xFFFF), unsigned(h2 >> 48), (unsigned long long)(h2 & 0xFFFFFFFFFFFFull));
-    return text;
-}
-
-/// OpenVDB writes a random UUID into the file header (36 ASCII characters
-/// after magic, format version, library version and a flag: bytes 21..56).
-/// Replace it by a hash of everything after the header, so identical grids
-/// make identical files.
-void makeHeaderDeterministic(const std::filesystem::path& file) {
-    constexpr size_t kUuidOffset = 8 + 4 + 4 + 4 + 1, kUuidSize = 36;
-    std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(file, ec);
-    if (!io || ec) throw IoError(file.string(), "cannot reopen the written VDB file");
-    std::vector<char> bytes(static_cast<size_t>(size));
-    io.read(bytes.data(), std::streamsize(bytes.size()));
-    if (!io) throw IoError(file.string(), "cannot read back the written VDB file");
-    int64_t magic = 0;
-    if (bytes.size() >= sizeof magic) std::memcpy(&magic, bytes.data(), sizeof magic);
-    if (bytes.size() < kUuidOffset + kUuidSize || magic != openvdb::OPENVDB_MAGIC || bytes[kUuidOffset + 8] != '-')
-        throw IoError(file.string(), "unexpected VDB header layout (OpenVDB version changed?)");
-    const std::string uuid =
-        contentUuid(bytes.data() + kUuidOffset + kUuidSize, bytes.size() - kUuidOffset - kUuidSize);
-    io.clear();
-    io.seekp(std::streamoff(kUuidOffset));
-    io.write(uuid.data(), std::streamsize(kUuidSize));
-    io.flush();
-    if (!io) throw IoError(file.string(), "cannot rewrite the VDB header");
 }
 
 }  // namespace
@@ -181,8 +198,16 @@ void writeGrids(const std::filesystem::path& file, const DensityGrid& grid, cons
         velocity->insertMeta("frame", openvdb::Int32Metadata(info.frame));
         grids.push_back(velocity);
     }
-    fillTrees(density->tree(), velocity ? &velocity->tree() : nullptr, grid, scale, consume);
+    Digest digest;
+    fillTrees(density->tree(), velocity ? &velocity->tree() : nullptr, grid, scale, consume, &digest);
     if (consume) consume->clear();
+    // Everything else that shapes the bytes: metadata, transform, options, library.
+    for (const openvdb::GridBase::Ptr& g : grids) digest.add(g->str() + g->transform().baseMap()->str(), 1);
+    digest.add(cat(settings.halfFloat, int(settings.compression), openvdb::getLibraryVersionString(),
+                   openvdb::OPENVDB_FILE_VERSION),
+               2);
+    const double exact[] = {info.time, info.fps, info.hairVolume, settings.densityScale};  // text rounds them
+    digest.add(exact, sizeof exact, 3);
 
     try {
         openvdb::io::File out(file.string());
@@ -198,7 +223,7 @@ void writeGrids(const std::filesystem::path& file, const DensityGrid& grid, cons
     } catch (const openvdb::Exception& e) {
         throw IoError(file.string(), std::string("OpenVDB: ") + e.what());
     }
-    makeHeaderDeterministic(file);
+    writeHeaderUuid(file, digest.uuid());
 }
 
 }  // namespace

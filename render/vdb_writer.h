@@ -15,8 +15,11 @@
 //   where density is.
 //
 // Deterministic bytes: OpenVDB stamps every file with a random UUID; the
-// writer replaces it by one derived from a hash of the rest of the file, so
-// the same grid gives a byte-identical file (resume checks, caches, diffs).
+// writer replaces it by a digest of what the file holds (voxel values,
+// metadata, transform, options, OpenVDB version), so the same grid gives a
+// byte-identical file (resume checks, caches, diffs). Nothing else in an
+// OpenVDB 10 file varies between runs (no time stamps); file_mem_bytes and
+// the other grid statistics follow from the tree.
 #pragma once
 
 #include "render/density_grid.h"

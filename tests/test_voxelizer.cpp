@@ -255,6 +255,22 @@ TEST(DensityGrid, SampleMatchesVoxelsAndInterpolates) {
     EXPECT_FLOAT_EQ(grid.sample(Vec3f(0.0006f, 0, 0), Reconstruction::Nearest), d1);
 }
 
+TEST(DensityGrid, MatrixAndAxesTransformsAgree) {
+    // A texel-style grid: 64 texels over [-0.05, 0.05]³, index = u·N − ½.
+    const double n = 64, lo = -0.05, size = 0.1;
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    m.topLeftCorner<3, 3>() *= n / size;
+    m.topRightCorner<3, 1>() = Vec3d::Constant(-lo * n / size - 0.5);
+    const GridTransform a = GridTransform::fromMatrix(m);
+    const GridTransform b = GridTransform::fromAxes(Eigen::Matrix3d::Identity() * (size / n),
+                                                    Vec3d::Constant(lo + 0.5 * size / n));
+    EXPECT_TRUE(a.linear.isApprox(b.linear, 1e-12));
+    EXPECT_TRUE(a.offset.isApprox(b.offset, 1e-12));
+    EXPECT_TRUE(a.toIndex(Vec3d::Constant(lo)).isApprox(Vec3d::Constant(-0.5), 1e-12));  // texel 0's corner
+    EXPECT_NEAR(a.voxelVolume(), std::pow(size / n, 3), 1e-18);
+    EXPECT_NEAR(a.uniformVoxelSize(), size / n, 1e-15);
+}
+
 TEST(DensityGrid, LightSpaceColumnsIntegrateToTheHairVolume) {
     // In a grid whose index z runs along the light, each column of voxels is
     // one light ray: Σ over columns of (∫ density ds) × voxel cross-section =
@@ -320,5 +336,8 @@ TEST(Voxelizer, ErrorsNameTheProblem) {
         EXPECT_NE(std::string(e.what()).find("use a larger voxel size"), std::string::npos) << e.what();
     }
     EXPECT_THROW(GridTransform::uniform(0.0), Error);
+    Eigen::Matrix4d projective = Eigen::Matrix4d::Identity();
+    projective(3, 2) = -1;
+    EXPECT_THROW(GridTransform::fromMatrix(projective), Error);
     EXPECT_THROW(GridTransform::fromAxes(Eigen::Matrix3d::Zero(), Vec3d::Zero()), Error);
 }
