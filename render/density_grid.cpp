@@ -74,12 +74,12 @@ bool aligned(const Vec3i& origin) {
 }
 }  // namespace
 
-uint64_t blockKey(const Vec3i& c) {
+uint64_t DensityGrid::blockKey(const Vec3i& c) {
     return (uint64_t(c.x() + kKeyBias) << (2 * kKeyBits)) | (uint64_t(c.y() + kKeyBias) << kKeyBits) |
            uint64_t(c.z() + kKeyBias);
 }
 
-Vec3i blockCoordOfKey(uint64_t key) {
+Vec3i DensityGrid::blockCoordOfKey(uint64_t key) {
     return Vec3i(int(int64_t((key >> (2 * kKeyBits)) & kKeyMask) - kKeyBias),
                  int(int64_t((key >> kKeyBits) & kKeyMask) - kKeyBias), int(int64_t(key & kKeyMask) - kKeyBias));
 }

@@ -120,6 +120,11 @@ class DensityGrid {
     bool hasVelocity() const { return !velocity_.empty(); }
     /// Offset of voxel `local` (each component in [0, 8)) inside a block.
     static int voxelOffset(int x, int y, int z) { return (x << 6) | (y << 3) | z; }
+    /// Packs a block coordinate (voxel >> 3, each within ±2^20) into a key;
+    /// sorting keys sorts by x, then y, then z.
+    static uint64_t blockKey(const Vec3i& blockCoord);
+    /// The block coordinate of a key.
+    static Vec3i blockCoordOfKey(uint64_t key);
 
     /// Density of one voxel (0 outside the stored blocks).
     float density(const Vec3i& voxel) const;
@@ -158,9 +163,5 @@ class DensityGrid {
     std::unordered_map<uint64_t, uint32_t> lookup_;  // packed block coordinate → block
 };
 
-/// Packs a block coordinate (voxel >> 3) into a key; sorting keys sorts by x, then y, then z.
-uint64_t blockKey(const Vec3i& blockCoord);
-/// The block coordinate of a key.
-Vec3i blockCoordOfKey(uint64_t key);
 
 }  // namespace hp

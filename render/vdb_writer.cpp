@@ -133,15 +133,25 @@ void fillTrees(openvdb::FloatTree& densityTree, openvdb::Vec3STree* velocityTree
         tbb::parallel_for(size_t(0), count, [&](size_t i) {
             const size_t b = first + i;
             const float* density = grid.blockDensity(b);
-            auto* leaf = densityLeaves[i];
-            for (openvdb::Index v = 0; v < openvdb::Index(DensityGrid::kBlockVoxels); ++v)
-                if (density[v] > 0.f) leaf->setValueOn(v, density[v] * scale);
+            // Whole buffers and 64-bit mask words: inactive voxels hold the
+            // background 0, as the block does.
+            float* values = densityLeaves[i]->buffer().data();
+            auto& mask = densityLeaves[i]->getValueMask();
+            for (openvdb::Index w = 0; w < openvdb::Index(DensityGrid::kBlockVoxels / 64); ++w) {
+                uint64_t bits = 0;
+                for (int j = 0; j < 64; ++j) {
+                    const float d = density[w * 64 + openvdb::Index(j)];
+                    values[w * 64 + openvdb::Index(j)] = d * scale;
+                    bits |= uint64_t(d > 0.f) << j;
+                }
+                mask.getWord<uint64_t>(w) = bits;
+            }
             if (velocityTree) {
                 const Vec3f* velocity = grid.blockVelocity(b);
-                auto* vleaf = velocityLeaves[i];
-                for (openvdb::Index v = 0; v < openvdb::Index(DensityGrid::kBlockVoxels); ++v)
-                    if (density[v] > 0.f)
-                        vleaf->setValueOn(v, openvdb::Vec3s(velocity[v].x(), velocity[v].y(), velocity[v].z()));
+                openvdb::Vec3s* vvalues = velocityLeaves[i]->buffer().data();
+                for (int v = 0; v < DensityGrid::kBlockVoxels; ++v)
+                    vvalues[v] = openvdb::Vec3s(velocity[v].x(), velocity[v].y(), velocity[v].z());
+                velocityLeaves[i]->getValueMask() = mask;
             }
             const Vec3i& o = grid.blockOrigin(b);
             const uint64_t seed = (uint64_t(uint32_t(o.x())) << 42) ^ (uint64_t(uint32_t(o.y())) << 21) ^ uint32_t(o.z());

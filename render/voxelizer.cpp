@@ -325,7 +325,7 @@ std::vector<std::pair<uint64_t, uint32_t>> binSegments(const std::vector<Segment
         auto* out = &pairs[start[i]];
         for (int x = lo.x(); x <= hi.x(); ++x)
             for (int y = lo.y(); y <= hi.y(); ++y)
-                for (int z = lo.z(); z <= hi.z(); ++z) *out++ = {blockKey(Vec3i(x, y, z)), uint32_t(i)};
+                for (int z = lo.z(); z <= hi.z(); ++z) *out++ = {DensityGrid::blockKey(Vec3i(x, y, z)), uint32_t(i)};
     });
     tbb::parallel_sort(pairs.begin(), pairs.end());
     return pairs;
@@ -360,7 +360,7 @@ DensityGrid voxelizeTiles(const StrandFrame& strands, const GridTransform& trans
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& range) {
         TileBuffer<C>& tile = buffers.local();
         for (size_t t = range.begin(); t != range.end(); ++t) {
-            tile.origin = blockCoordOfKey(pairs[starts[t]].first) * kTile;
+            tile.origin = DensityGrid::blockCoordOfKey(pairs[starts[t]].first) * kTile;
             for (size_t i = starts[t]; i < starts[t + 1]; ++i) {
                 const uint32_t g = pairs[i].second;
                 const SegmentVelocity* v = C == 4 ? &velocities[g] : nullptr;
