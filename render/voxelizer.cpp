@@ -13,6 +13,7 @@
 #include <cmath>
 #include <iterator>
 #include <memory>
+#include <unordered_map>
 
 namespace hp {
 
@@ -295,9 +296,15 @@ std::vector<Segment> prepareSegments(const StrandFrame& strands, const GridTrans
     return segments;
 }
 
-/// (tile key, segment) pairs, sorted: every tile a segment may deposit into.
-std::vector<std::pair<uint64_t, uint32_t>> binSegments(const std::vector<Segment>& segments, VoxelFilter filter,
-                                                       double maxBytes) {
+/// Segments grouped by the tiles they may deposit into: tile t (key
+/// keys[t], sorted) owns segments[start[t] .. start[t+1]), in segment order.
+struct TileBins {
+    std::vector<uint64_t> keys;
+    std::vector<size_t> start;
+    std::vector<uint32_t> segments;
+};
+
+TileBins binSegments(const std::vector<Segment>& segments, VoxelFilter filter, double maxBytes) {
     // Voxels reached: the box filter rounds to the nearest centre, the
     // trilinear one reaches floor .. floor + 1.
     const double shift = filter == VoxelFilter::Box ? 0.5 : 0.0;
@@ -308,27 +315,58 @@ std::vector<std::pair<uint64_t, uint32_t>> binSegments(const std::vector<Segment
         const bool empty = g.k == 0 || (g.r0 == 0 && g.r1 == 0);
         return empty ? 0 : size_t((*hi - *lo + Vec3i::Ones()).prod());
     };
-    // Count, scan, fill: the pairs come out in segment order without locks.
-    std::vector<size_t> start(segments.size() + 1, 0);
+    // (tile, segment) pairs in segment order: count, scan, fill.
+    std::vector<size_t> first(segments.size() + 1, 0);
     tbb::parallel_for(size_t(0), segments.size(), [&](size_t i) {
         Vec3i lo, hi;
-        start[i + 1] = tiles(segments[i], &lo, &hi);
+        first[i + 1] = tiles(segments[i], &lo, &hi);
     });
-    for (size_t i = 0; i < segments.size(); ++i) start[i + 1] += start[i];
-    if (double(start.back()) * 16.0 > maxBytes)
-        throw Error(cat("voxelize: binning needs more than the memory limit (", start.back(),
+    for (size_t i = 0; i < segments.size(); ++i) first[i + 1] += first[i];
+    const size_t count = first.back();
+    if (double(count) * 16.0 > maxBytes)
+        throw Error(cat("voxelize: binning needs more than the memory limit (", count,
                         " segment-tile pairs); use a larger voxel size"));
-    std::vector<std::pair<uint64_t, uint32_t>> pairs(start.back());
+    std::vector<uint64_t> pairKeys(count);
     tbb::parallel_for(size_t(0), segments.size(), [&](size_t i) {
         Vec3i lo, hi;
         if (tiles(segments[i], &lo, &hi) == 0) return;
-        auto* out = &pairs[start[i]];
+        uint64_t* out = &pairKeys[first[i]];
         for (int x = lo.x(); x <= hi.x(); ++x)
             for (int y = lo.y(); y <= hi.y(); ++y)
-                for (int z = lo.z(); z <= hi.z(); ++z) *out++ = {DensityGrid::blockKey(Vec3i(x, y, z)), uint32_t(i)};
+                for (int z = lo.z(); z <= hi.z(); ++z) *out++ = DensityGrid::blockKey(Vec3i(x, y, z));
     });
-    tbb::parallel_sort(pairs.begin(), pairs.end());
-    return pairs;
+    // Counting sort by tile (stable: segment order is kept within a tile).
+    // Segments come in spatial order, so consecutive pairs mostly share a
+    // tile and the hash lookups hit the one-entry cache.
+    std::unordered_map<uint64_t, uint32_t> tileOfKey;
+    std::vector<uint32_t> pairTile(count);
+    uint64_t lastKey = ~uint64_t(0);
+    uint32_t lastTile = 0;
+    for (size_t p = 0; p < count; ++p) {
+        if (pairKeys[p] != lastKey) {
+            lastKey = pairKeys[p];
+            lastTile = tileOfKey.emplace(lastKey, uint32_t(tileOfKey.size())).first->second;
+        }
+        pairTile[p] = lastTile;
+    }
+    TileBins bins;
+    std::vector<std::pair<uint64_t, uint32_t>> sorted;  // (key, tile id), sorted by key
+    for (const auto& kv : tileOfKey) sorted.emplace_back(kv.first, kv.second);
+    std::sort(sorted.begin(), sorted.end());
+    std::vector<size_t> rank(sorted.size()), sizes(sorted.size(), 0);
+    for (size_t r = 0; r < sorted.size(); ++r) rank[sorted[r].second] = r;
+    for (size_t p = 0; p < count; ++p) ++sizes[rank[pairTile[p]]];
+    bins.keys.resize(sorted.size());
+    bins.start.assign(sorted.size() + 1, 0);
+    for (size_t r = 0; r < sorted.size(); ++r) {
+        bins.keys[r] = sorted[r].first;
+        bins.start[r + 1] = bins.start[r] + sizes[r];
+    }
+    std::vector<size_t> next(bins.start.begin(), bins.start.end() - 1);
+    bins.segments.resize(count);
+    for (size_t i = 0; i < segments.size(); ++i)
+        for (size_t p = first[i]; p < first[i + 1]; ++p) bins.segments[next[rank[pairTile[p]]]++] = uint32_t(i);
+    return bins;
 }
 
 template <int C>
@@ -343,26 +381,21 @@ DensityGrid voxelizeTiles(const StrandFrame& strands, const GridTransform& trans
             throw Error(cat("voxelize: a strand radius of ", rMax, " m is absurd for voxels of ",
                             std::cbrt(transform.voxelVolume()), " m"));
     }
-    const std::vector<std::pair<uint64_t, uint32_t>> pairs =
-        binSegments(segments, settings.filter, settings.maxMemoryGiB * double(size_t(1) << 30));
-    std::vector<size_t> starts;  // first pair of each tile
-    for (size_t i = 0; i < pairs.size(); ++i)
-        if (i == 0 || pairs[i].first != pairs[i - 1].first) starts.push_back(i);
-    starts.push_back(pairs.size());
-    const size_t tiles = starts.size() - 1;
+    const TileBins bins = binSegments(segments, settings.filter, settings.maxMemoryGiB * double(size_t(1) << 30));
+    const size_t tiles = bins.keys.size();
 
     const size_t limit = size_t(std::max(0.0, settings.maxMemoryGiB) * double(size_t(1) << 30));
     const size_t blockBytes = sizeof(DensityGrid::DensityBlock) + (C == 4 ? sizeof(DensityGrid::VelocityBlock) : 0);
-    std::atomic<size_t> bytes{pairs.size() * sizeof(pairs[0]) + segments.size() * sizeof(Segment) +
+    std::atomic<size_t> bytes{bins.segments.size() * sizeof(uint32_t) + segments.size() * sizeof(Segment) +
                               velocities.size() * sizeof(SegmentVelocity)};
     std::vector<TileBlocks> results(tiles);
     tbb::enumerable_thread_specific<TileBuffer<C>> buffers;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& range) {
         TileBuffer<C>& tile = buffers.local();
         for (size_t t = range.begin(); t != range.end(); ++t) {
-            tile.origin = DensityGrid::blockCoordOfKey(pairs[starts[t]].first) * kTile;
-            for (size_t i = starts[t]; i < starts[t + 1]; ++i) {
-                const uint32_t g = pairs[i].second;
+            tile.origin = DensityGrid::blockCoordOfKey(bins.keys[t]) * kTile;
+            for (size_t i = bins.start[t]; i < bins.start[t + 1]; ++i) {
+                const uint32_t g = bins.segments[i];
                 const SegmentVelocity* v = C == 4 ? &velocities[g] : nullptr;
                 if (settings.filter == VoxelFilter::Box)
                     depositBox(tile, segments[g], v);
