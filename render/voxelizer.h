@@ -48,7 +48,7 @@ struct VoxelizeSettings {
 /// @param strands   one frame of strands (validated; velocities may be empty = at rest)
 /// @param transform world → index map of the grid (GridTransform::uniform(h) for VDB export)
 /// @param settings  filter, velocity channel, memory limit
-/// @return a DensityGrid whose stored voxels have density > 0 (hair volume
+/// @return a DensityGrid whose blocks hold every voxel with density > 0 (hair volume
 ///         fraction, see render/density_grid.h), with a velocity channel if asked.
 /// @throws hp::Error on invalid strands, strands beyond the grid's index range,
 ///         or a grid that would exceed the memory limit.
