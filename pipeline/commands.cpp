@@ -20,6 +20,7 @@ const std::vector<CommandSpec>& commands() {
         renderCommandSpec(),
         compareCommandSpec(),
         viewCommandSpec(),
+        vdbCommandSpec(),
         validateCommandSpec(),
         infoCommandSpec(),
         helpCommandSpec(),

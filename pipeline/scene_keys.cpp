@@ -12,6 +12,7 @@ void addSceneKeys(SchemaBuilder& b) {
     addRenderKeys(b);
     addPreviewKeys(b);
     addReferenceKeys(b);
+    addVdbKeys(b);
     addCompareKeys(b);
 }
 

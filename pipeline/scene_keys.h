@@ -17,5 +17,6 @@ void addPreviewKeys(SchemaBuilder& b); // preview: the GL preview pass (scene_ke
 void addHeadKeys(SchemaBuilder& b);    // head: import, clip, scalp, collider (scene_keys_head.cpp)
 void addHairKeys(SchemaBuilder& b);    // hair: root counts and placement (scene_keys_hair.cpp)
 void addReferenceKeys(SchemaBuilder& b);  // reference: Embree reference renderer (scene_keys_reference.cpp)
+void addVdbKeys(SchemaBuilder& b);     // vdb: OpenVDB density caches (scene_keys_vdb.cpp)
 
 }  // namespace hp

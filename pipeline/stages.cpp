@@ -37,6 +37,7 @@ std::vector<StagePtr> makeStages(const Scene& scene, const ShotSettings& shot, c
     };
     add(makePreviewStage(scene, shot));
     add(makeReferenceStage(scene, shot));
+    add(makeVdbStage(scene, shot));
     add(makeCompareStage(scene, shot));  // last: reads the other stages' files
     return stages;
 }

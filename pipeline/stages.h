@@ -13,5 +13,7 @@ StagePtr makeCompareStage(const Scene& scene, const ShotSettings& shot);
 StagePtr makePreviewStage(const Scene& scene, const ShotSettings& shot);
 /// The Embree reference renderer (stage_reference.cpp); null unless reference.enabled.
 StagePtr makeReferenceStage(const Scene& scene, const ShotSettings& shot);
+/// OpenVDB density caches (stage_vdb.cpp); null unless vdb.enabled.
+StagePtr makeVdbStage(const Scene& scene, const ShotSettings& shot);
 
 }  // namespace hp

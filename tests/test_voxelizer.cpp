@@ -1,0 +1,343 @@
+// Voxelizer and DensityGrid: volume conservation, analytic profiles of a
+// straight strand, ray integrals, affine (light-space) grids, velocity,
+// thread-count invariance and error messages.
+#include "core/errors.h"
+#include "render/voxelizer.h"
+#include "sim/synthetic.h"
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+
+using namespace hp;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// `count` random strands in a 4 cm box around `centre`: random walks of
+/// 2..30 vertices with steps from 0 to 6 mm (some shorter than a voxel, some
+/// crossing several, a few of zero length), radii tapering from 20-80 µm.
+StrandFrame randomStrands(size_t count, unsigned seed, const Vec3f& centre = Vec3f(0.01f, -0.02f, 0.005f)) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> unit(-1.f, 1.f), u01(0.f, 1.f);
+    StrandFrame frame;
+    for (size_t s = 0; s < count; ++s) {
+        const int n = 2 + int(u01(rng) * 28.f);
+        std::vector<Vec3f> p(static_cast<size_t>(n)), v(static_cast<size_t>(n));
+        std::vector<float> r(static_cast<size_t>(n));
+        p[0] = centre + 0.02f * Vec3f(unit(rng), unit(rng), unit(rng));
+        const float root = 20e-6f + 60e-6f * u01(rng), tip = root * u01(rng);
+        for (int k = 0; k < n; ++k) {
+            if (k > 0) {
+                const float step = u01(rng) < 0.05f ? 0.f : 0.006f * u01(rng);
+                p[size_t(k)] = p[size_t(k - 1)] + step * Vec3f(unit(rng), unit(rng), unit(rng)).normalized();
+            }
+            r[size_t(k)] = taperedRadius(root, tip, float(k) / float(n - 1));
+            v[size_t(k)] = Vec3f(unit(rng), unit(rng), unit(rng));
+        }
+        frame.addStrand(uint32_t(s), p.data(), r.data(), size_t(n), v.data());
+    }
+    return frame;
+}
+
+/// One straight strand from `a` to `b` with `n` vertices and radius r0 → r1.
+StrandFrame straightStrand(const Vec3f& a, const Vec3f& b, int n, float r0, float r1,
+                           const Vec3f& velocity = Vec3f::Zero()) {
+    std::vector<Vec3f> p(static_cast<size_t>(n)), v(size_t(n), velocity);
+    std::vector<float> r(static_cast<size_t>(n));
+    for (int k = 0; k < n; ++k) {
+        const float t = float(k) / float(n - 1);
+        p[size_t(k)] = a + t * (b - a);
+        r[size_t(k)] = taperedRadius(r0, r1, t);
+    }
+    StrandFrame frame;
+    frame.addStrand(0, p.data(), r.data(), size_t(n), v.data());
+    return frame;
+}
+
+/// A light-space grid: index z along `direction`, voxel edge h, rotated
+/// arbitrarily about it, origin off the lattice.
+GridTransform lightGrid(const Vec3d& direction, double h) {
+    const Vec3d z = direction.normalized();
+    const Vec3d x = z.unitOrthogonal();
+    const Vec3d y = z.cross(x);
+    Eigen::Matrix3d axes;
+    axes.col(0) = x * h;
+    axes.col(1) = y * h;
+    axes.col(2) = z * h;
+    return GridTransform::fromAxes(axes, Vec3d(0.0013, -0.0021, 0.0007));
+}
+
+bool identical(const DensityGrid& a, const DensityGrid& b) {
+    if (a.blockCount() != b.blockCount() || a.hasVelocity() != b.hasVelocity()) return false;
+    for (size_t i = 0; i < a.blockCount(); ++i) {
+        if (a.blockOrigin(i) != b.blockOrigin(i)) return false;
+        if (std::memcmp(a.blockDensity(i), b.blockDensity(i), sizeof(float) * DensityGrid::kBlockVoxels)) return false;
+        if (a.hasVelocity() &&
+            std::memcmp(a.blockVelocity(i), b.blockVelocity(i), sizeof(Vec3f) * DensityGrid::kBlockVoxels))
+            return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+TEST(Voxelizer, ConservesHairVolumeForRandomStrands) {
+    const StrandFrame strands = randomStrands(400, 7);
+    const double volume = hairVolume(strands);
+    ASSERT_GT(volume, 0);
+    const GridTransform grids[] = {GridTransform::uniform(0.001), GridTransform::uniform(0.00037),
+                                   lightGrid(Vec3d(-1, -1, -1), 0.0008)};
+    for (const GridTransform& t : grids)
+        for (VoxelFilter f : {VoxelFilter::Trilinear, VoxelFilter::Box}) {
+            VoxelizeSettings s;
+            s.filter = f;
+            const DensityGrid grid = voxelize(strands, t, s);
+            const double error = std::abs(grid.totalVolume() - volume) / volume;
+            EXPECT_LT(error, 1e-6) << "filter " << int(f) << ", voxel volume " << t.voxelVolume();
+            EXPECT_GT(grid.activeVoxelCount(), 1000u);
+        }
+}
+
+TEST(Voxelizer, ConservesHairVolumeWithVoxelsMuchSmallerThanSegments) {
+    // Segments up to 100 voxels long are split into parts internally; the
+    // parts must still add up to the whole tapered segments.
+    const StrandFrame strands = randomStrands(12, 19);
+    const double volume = hairVolume(strands);
+    for (VoxelFilter f : {VoxelFilter::Trilinear, VoxelFilter::Box}) {
+        VoxelizeSettings s;
+        s.filter = f;
+        const DensityGrid grid = voxelize(strands, GridTransform::uniform(0.00006), s);
+        EXPECT_LT(std::abs(grid.totalVolume() - volume) / volume, 1e-6) << "filter " << int(f);
+    }
+}
+
+TEST(Voxelizer, HairVolumeIsTheSumOfTruncatedCones) {
+    // A 4 cm strand tapering 50 → 10 µm: π L (r0² + r0 r1 + r1²) / 3.
+    const StrandFrame s = straightStrand(Vec3f(0, 0, 0), Vec3f(0, 0.04f, 0), 9, 50e-6f, 10e-6f);
+    const double r0 = 50e-6, r1 = 10e-6;
+    EXPECT_NEAR(hairVolume(s), kPi * 0.04 * (r0 * r0 + r0 * r1 + r1 * r1) / 3, 1e-15);
+}
+
+TEST(Voxelizer, StraightStrandCrossSectionTrilinear) {
+    // A strand along z through (0.3 h, -0.2 h): every interior slice holds the
+    // tent weights (0.7, 0.3) × (0.8, 0.2) of π r² / h², and nothing else.
+    const double h = 0.001, r = 40e-6;
+    const StrandFrame s = straightStrand(Vec3f(0.3f * 0.001f, -0.2f * 0.001f, -0.0102f),
+                                         Vec3f(0.3f * 0.001f, -0.2f * 0.001f, 0.0102f), 5, float(r), float(r));
+    const DensityGrid grid = voxelize(s, GridTransform::uniform(h));
+    const double full = kPi * r * r / (h * h);
+    const double wx[2] = {0.7, 0.3}, wy[2] = {0.2, 0.8};  // x voxels 0, 1; y voxels -1, 0
+    for (int k = -8; k <= 8; ++k) {
+        double slice = 0;
+        for (int i = -2; i <= 3; ++i)
+            for (int j = -3; j <= 2; ++j) {
+                const double d = grid.density(Vec3i(i, j, k));
+                slice += d;
+                const bool inside = (i == 0 || i == 1) && (j == -1 || j == 0);
+                const double expected = inside ? full * wx[i] * wy[j + 1] : 0.0;
+                EXPECT_NEAR(d, expected, 2e-4 * full) << "voxel " << i << " " << j << " " << k;
+            }
+        EXPECT_NEAR(slice * h * h, kPi * r * r, 1e-6 * kPi * r * r) << "slice " << k;
+    }
+}
+
+TEST(Voxelizer, StraightStrandCrossSectionBoxAndTaper) {
+    // Box filter: the strand's voxel column holds (π/h³) ∫ r(z)² dz over each
+    // voxel's z extent, with r tapering linearly along z.
+    const double h = 0.0005, r0 = 60e-6, r1 = 20e-6, z0 = -0.00401, z1 = 0.00399;
+    const StrandFrame s = straightStrand(Vec3f(0.00011f, 0.00004f, float(z0)), Vec3f(0.00011f, 0.00004f, float(z1)),
+                                         7, float(r0), float(r1));
+    VoxelizeSettings box;
+    box.filter = VoxelFilter::Box;
+    const DensityGrid grid = voxelize(s, GridTransform::uniform(h), box);
+    auto radiusAt = [&](double z) { return r0 + (r1 - r0) * (z - z0) / (z1 - z0); };
+    auto integralR2 = [&](double a, double b) {  // exact ∫ r² dz of a linear r
+        const double ra = radiusAt(a), rb = radiusAt(b);
+        return (b - a) * (ra * ra + ra * rb + rb * rb) / 3.0;
+    };
+    size_t active = 0;
+    for (int k = -9; k <= 9; ++k) {
+        const double lo = std::max(z0, (k - 0.5) * h), hi = std::min(z1, (k + 0.5) * h);
+        const double expected = hi > lo ? kPi * integralR2(lo, hi) / (h * h * h) : 0.0;
+        EXPECT_NEAR(grid.density(Vec3i(0, 0, k)), expected, 1e-6 * kPi * r0 * r0 / (h * h)) << "voxel " << k;
+        EXPECT_EQ(grid.density(Vec3i(1, 0, k)), 0.f);
+        EXPECT_EQ(grid.density(Vec3i(0, 1, k)), 0.f);
+        if (expected > 0) ++active;
+    }
+    EXPECT_EQ(grid.activeVoxelCount(), active);
+}
+
+TEST(Voxelizer, ActiveBoundsContainEveryVertex) {
+    SyntheticHairSettings hs;
+    hs.strands = 300;
+    const StrandFrame hair = makeSyntheticHair(hs);
+    const double h = 0.002;
+    for (VoxelFilter f : {VoxelFilter::Trilinear, VoxelFilter::Box}) {
+        VoxelizeSettings s;
+        s.filter = f;
+        const DensityGrid grid = voxelize(hair, GridTransform::uniform(h), s);
+        Vec3i lo, hi;
+        ASSERT_TRUE(grid.activeBounds(&lo, &hi));
+        for (const Vec3f& p : hair.positions) {
+            const Vec3d i = p.cast<double>() / h;  // voxel (i) covers [i - ½, i + ½)
+            for (int a = 0; a < 3; ++a) {
+                EXPECT_GE(i[a], lo[a] - 0.5) << "vertex " << p.transpose();
+                EXPECT_LT(i[a], hi[a] + 0.5) << "vertex " << p.transpose();
+            }
+            // And the vertex's own voxel holds hair.
+            EXPECT_GT(grid.sample(p, Reconstruction::Nearest), 0.f) << "vertex " << p.transpose();
+        }
+    }
+}
+
+TEST(Voxelizer, IdenticalForOneAndTwoThreads) {
+    StrandFrame strands = randomStrands(1500, 11);
+    for (bool velocity : {false, true}) {
+        VoxelizeSettings s;
+        s.velocity = velocity;
+        DensityGrid one, two;
+        tbb::task_arena(1).execute([&] { one = voxelize(strands, GridTransform::uniform(0.0005), s); });
+        tbb::task_arena(2).execute([&] { two = voxelize(strands, GridTransform::uniform(0.0005), s); });
+        EXPECT_GT(one.blockCount(), 50u);
+        EXPECT_TRUE(identical(one, two)) << "velocity " << velocity;
+    }
+}
+
+TEST(Voxelizer, EmptyFrameGivesEmptyGrid) {
+    const DensityGrid grid = voxelize(StrandFrame(), GridTransform::uniform(0.001));
+    EXPECT_EQ(grid.blockCount(), 0u);
+    EXPECT_EQ(grid.totalVolume(), 0.0);
+    Vec3i lo, hi;
+    EXPECT_FALSE(grid.activeBounds(&lo, &hi));
+    EXPECT_EQ(grid.integrate(Vec3f(-1, 0, 0), Vec3f(1, 0, 0)), 0.0);
+}
+
+TEST(DensityGrid, RayIntegralsAcrossAStrandRecoverItsCrossSection) {
+    // Rays along x through every voxel-centre row y = j h of a slice cut
+    // through a strand along z: Σ_j (∫ density dx) · h = π r², for both
+    // reconstructions; transmittance is exp(-σ ∫).
+    const double h = 0.001, r = 50e-6;
+    const StrandFrame s = straightStrand(Vec3f(0.00037f, 0.00021f, -0.01f), Vec3f(0.00037f, 0.00021f, 0.01f), 3,
+                                         float(r), float(r));
+    const DensityGrid grid = voxelize(s, GridTransform::uniform(h));
+    for (Reconstruction mode : {Reconstruction::Nearest, Reconstruction::Trilinear}) {
+        double sum = 0;
+        for (int j = -3; j <= 3; ++j) {
+            const Vec3f from(-0.0052f, float(j * h), 0.f), to(0.0049f, float(j * h), 0.f);
+            const double i = grid.integrate(from, to, mode);
+            EXPECT_NEAR(grid.integrate(to, from, mode), i, 1e-12) << "reversed";
+            sum += i * h;
+            EXPECT_NEAR(grid.transmittance(from, to, 2e4, mode), std::exp(-2e4 * i), 1e-12);
+        }
+        EXPECT_NEAR(sum, kPi * r * r, 1e-5 * kPi * r * r) << "mode " << int(mode);
+    }
+    EXPECT_EQ(grid.integrate(Vec3f(-0.01f, 0.005f, 0), Vec3f(0.01f, 0.005f, 0)), 0.0);  // misses
+}
+
+TEST(DensityGrid, SampleMatchesVoxelsAndInterpolates) {
+    const double h = 0.001;
+    const StrandFrame s = straightStrand(Vec3f(0.0003f, 0, -0.005f), Vec3f(0.0003f, 0, 0.005f), 2, 4e-5f, 4e-5f);
+    const DensityGrid grid = voxelize(s, GridTransform::uniform(h));
+    const float d0 = grid.density(Vec3i(0, 0, 0)), d1 = grid.density(Vec3i(1, 0, 0));
+    ASSERT_GT(d0, d1);
+    ASSERT_GT(d1, 0.f);
+    EXPECT_FLOAT_EQ(grid.sample(Vec3f(0, 0, 0)), d0);
+    EXPECT_FLOAT_EQ(grid.sample(Vec3f(0.001f, 0, 0)), d1);
+    EXPECT_NEAR(grid.sample(Vec3f(0.0005f, 0, 0)), 0.5f * (d0 + d1), 1e-6f * d0);
+    EXPECT_FLOAT_EQ(grid.sample(Vec3f(0.0004f, 0, 0), Reconstruction::Nearest), d0);
+    EXPECT_FLOAT_EQ(grid.sample(Vec3f(0.0006f, 0, 0), Reconstruction::Nearest), d1);
+}
+
+TEST(DensityGrid, MatrixAndAxesTransformsAgree) {
+    // A texel-style grid: 64 texels over [-0.05, 0.05]³, index = u·N − ½.
+    const double n = 64, lo = -0.05, size = 0.1;
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    m.topLeftCorner<3, 3>() *= n / size;
+    m.topRightCorner<3, 1>() = Vec3d::Constant(-lo * n / size - 0.5);
+    const GridTransform a = GridTransform::fromMatrix(m);
+    const GridTransform b = GridTransform::fromAxes(Eigen::Matrix3d::Identity() * (size / n),
+                                                    Vec3d::Constant(lo + 0.5 * size / n));
+    EXPECT_TRUE(a.linear.isApprox(b.linear, 1e-12));
+    EXPECT_TRUE(a.offset.isApprox(b.offset, 1e-12));
+    EXPECT_TRUE(a.toIndex(Vec3d::Constant(lo)).isApprox(Vec3d::Constant(-0.5), 1e-12));  // texel 0's corner
+    EXPECT_NEAR(a.voxelVolume(), std::pow(size / n, 3), 1e-18);
+    EXPECT_NEAR(a.uniformVoxelSize(), size / n, 1e-15);
+}
+
+TEST(DensityGrid, LightSpaceColumnsIntegrateToTheHairVolume) {
+    // In a grid whose index z runs along the light, each column of voxels is
+    // one light ray: Σ over columns of (∫ density ds) × voxel cross-section =
+    // hair volume. This is the check the GL preview's shadow voxels use.
+    const StrandFrame strands = randomStrands(200, 3);
+    const Vec3d dir(-1, -1, -1);
+    const double h = 0.0008;
+    const GridTransform t = lightGrid(dir, h);
+    const DensityGrid grid = voxelize(strands, t);
+    Vec3i lo, hi;
+    ASSERT_TRUE(grid.activeBounds(&lo, &hi));
+    double sum = 0;
+    for (int i = lo.x(); i <= hi.x(); ++i)
+        for (int j = lo.y(); j <= hi.y(); ++j) {
+            const Vec3d a = t.toWorld(Vec3d(i, j, lo.z() - 2)), b = t.toWorld(Vec3d(i, j, hi.z() + 2));
+            sum += grid.integrate(a.cast<float>(), b.cast<float>(), Reconstruction::Nearest) * h * h;
+        }
+    const double volume = hairVolume(strands);
+    EXPECT_NEAR(sum, volume, 1e-5 * volume);
+}
+
+TEST(Voxelizer, VelocityIsTheDensityWeightedMean) {
+    // One strand moving uniformly: every voxel carries its velocity. Two
+    // strands of equal radius through the same voxels: the mean.
+    const double h = 0.001;
+    const Vec3f v1(0.5f, -1.f, 2.f), v2(-0.5f, 1.f, 0.f);
+    VoxelizeSettings s;
+    s.velocity = true;
+    StrandFrame one = straightStrand(Vec3f(0.0002f, 0, -0.004f), Vec3f(0.0002f, 0, 0.004f), 4, 3e-5f, 3e-5f, v1);
+    const DensityGrid a = voxelize(one, GridTransform::uniform(h), s);
+    ASSERT_TRUE(a.hasVelocity());
+    for (int k = -3; k <= 3; ++k) EXPECT_LT((a.velocity(Vec3i(0, 0, k)) - v1).norm(), 1e-5f) << k;
+
+    StrandFrame two = one;
+    const StrandFrame other = straightStrand(Vec3f(0.0002f, 0, -0.004f), Vec3f(0.0002f, 0, 0.004f), 4, 3e-5f, 3e-5f, v2);
+    two.addStrand(1, other.positions.data(), other.radii.data(), other.positions.size(), other.velocities.data());
+    const DensityGrid b = voxelize(two, GridTransform::uniform(h), s);
+    for (int k = -3; k <= 3; ++k)
+        EXPECT_LT((b.velocity(Vec3i(1, 0, k)) - 0.5f * (v1 + v2)).norm(), 1e-5f) << k;
+    // No velocity channel unless asked.
+    EXPECT_FALSE(voxelize(two, GridTransform::uniform(h)).hasVelocity());
+}
+
+TEST(Voxelizer, ErrorsNameTheProblem) {
+    StrandFrame bad = straightStrand(Vec3f(0, 0, 0), Vec3f(0, 0.01f, 0), 3, 1e-5f, 1e-5f);
+    bad.positions[1].x() = std::nanf("");
+    EXPECT_THROW(voxelize(bad, GridTransform::uniform(0.001)), Error);
+
+    const StrandFrame far = straightStrand(Vec3f(0, 0, 0), Vec3f(500.f, 0, 0), 2, 1e-5f, 1e-5f);
+    try {
+        voxelize(far, GridTransform::uniform(1e-5));
+        FAIL() << "expected an error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("voxel size far too small"), std::string::npos) << e.what();
+    }
+
+    VoxelizeSettings tight;
+    tight.maxMemoryGiB = 0.001;
+    try {
+        voxelize(randomStrands(300, 5), GridTransform::uniform(0.0002), tight);
+        FAIL() << "expected an error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("use a larger voxel size"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(GridTransform::uniform(0.0), Error);
+    Eigen::Matrix4d projective = Eigen::Matrix4d::Identity();
+    projective(3, 2) = -1;
+    EXPECT_THROW(GridTransform::fromMatrix(projective), Error);
+    EXPECT_THROW(GridTransform::fromAxes(Eigen::Matrix3d::Zero(), Vec3d::Zero()), Error);
+}

@@ -1,0 +1,202 @@
+// B-vdb (BENCHMARKS.md): voxelize the ~100k strands of B-render and write
+// one VDB frame, at 1 mm and 0.5 mm voxels, on 2 threads and 1.
+//
+// Until the simulation is integrated, the strands come from
+// makeSyntheticHair (sim/synthetic.h): 100,000 strands × 24 vertices on the
+// r = 0.1 m sphere's upper hemisphere, 0.25 m long, root radius 0.04 mm
+// tapering to 0.01 mm — the B-render geometry without simulated shapes.
+//
+// Reports per configuration the median and spread of `runs` runs: seconds to
+// voxelize, seconds to write, file size, active voxels, peak resident memory
+// (reset between configurations through /proc/self/clear_refs), and the
+// relative mass error |Σ density·V − hair volume| / hair volume.
+//
+// usage: bench_vdb [--strands N] [--voxel m ...] [--threads n ...] [--runs k]
+//                  [--filter box|trilinear] [--velocity] [--half] [--compression blosc|none]
+//                  [--keep DIR]   (keep the written files there)
+//                  [--sequence F] (instead: write frames 1..F of the hair spinning with the
+//                                  B-sim head, 90°/s about +Y at 24 fps, as hair.####.vdb —
+//                                  the whole-sequence time, and files to check in a DCC)
+#include "render/vdb_writer.h"
+#include "render/voxelizer.h"
+#include "sim/synthetic.h"
+
+#include <Eigen/Geometry>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace hp;
+
+namespace {
+
+double seconds(std::chrono::steady_clock::time_point since) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+/// CPU seconds of the whole process (all threads): on a shared machine wall
+/// time also counts other people's jobs.
+double cpuSeconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+/// Peak resident set (VmHWM) in MiB.
+double peakMiB() {
+    std::ifstream status("/proc/self/status");
+    std::string line;
+    while (std::getline(status, line))
+        if (line.rfind("VmHWM:", 0) == 0) return std::atof(line.c_str() + 6) / 1024.0;
+    return 0;
+}
+
+void resetPeak() { std::ofstream("/proc/self/clear_refs") << "5"; }
+
+struct Stats {
+    double median, min, max;
+};
+Stats stats(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return {v[v.size() / 2], v.front(), v.back()};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    size_t strands = 100000;
+    std::vector<double> voxels;
+    std::vector<int> threads;
+    int runs = 3, sequence = 0;
+    VoxelizeSettings vs;
+    VdbWriteSettings ws;
+    fs::path keep;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto next = [&]() -> std::string {
+            if (i + 1 >= argc) {
+                std::fprintf(stderr, "bench_vdb: %s needs a value\n", a.c_str());
+                std::exit(1);
+            }
+            return argv[++i];
+        };
+        if (a == "--strands") strands = size_t(std::atol(next().c_str()));
+        else if (a == "--voxel") voxels.push_back(std::atof(next().c_str()));
+        else if (a == "--threads") threads.push_back(std::atoi(next().c_str()));
+        else if (a == "--runs") runs = std::max(1, std::atoi(next().c_str()));
+        else if (a == "--filter") vs.filter = next() == "box" ? VoxelFilter::Box : VoxelFilter::Trilinear;
+        else if (a == "--velocity") vs.velocity = true;
+        else if (a == "--half") ws.halfFloat = true;
+        else if (a == "--compression") ws.compression = next() == "none" ? VdbCompression::None : VdbCompression::Blosc;
+        else if (a == "--keep") keep = next();
+        else if (a == "--sequence") sequence = std::max(1, std::atoi(next().c_str()));
+        else {
+            std::fprintf(stderr, "bench_vdb: unknown argument %s (see the comment at the top of bench_vdb.cpp)\n", a.c_str());
+            return 1;
+        }
+    }
+    if (voxels.empty()) voxels = {0.001, 0.0005};
+    if (threads.empty()) threads = {2, 1};
+
+    SyntheticHairSettings hs;
+    hs.strands = strands;
+    const auto t0 = std::chrono::steady_clock::now();
+    StrandFrame frame = makeSyntheticHair(hs);
+    if (vs.velocity) {  // a plausible velocity field: the head's spin about +Y at 90°/s
+        frame.velocities.resize(frame.positions.size());
+        for (size_t v = 0; v < frame.positions.size(); ++v)
+            frame.velocities[v] = Vec3f(0, 1.5707963f, 0).cross(frame.positions[v]);
+    }
+    const double volume = hairVolume(frame);
+    std::printf("B-vdb: %zu synthetic strands x %d vertices (makeSyntheticHair; no simulation yet), "
+                "hair volume %.6g m^3, built in %.2f s\n",
+                frame.strandCount(), hs.vertices, volume, seconds(t0));
+    std::printf("filter %s, velocity %s, %s, %s, %d runs (median [min-max])\n",
+                vs.filter == VoxelFilter::Box ? "box" : "trilinear", vs.velocity ? "on" : "off",
+                ws.halfFloat ? "half float" : "float",
+                ws.compression == VdbCompression::Blosc ? "blosc" : "no compression", runs);
+
+    const fs::path dir = keep.empty() ? fs::temp_directory_path() / ("bench_vdb_" + std::to_string(::getpid())) : keep;
+    fs::create_directories(dir);
+    if (sequence > 0) {
+        // Frame f: the strands rotated by the head's spin at time f / 24 s.
+        const double h = voxels.front();
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads.front()));
+        resetPeak();
+        const auto ts = std::chrono::steady_clock::now();
+        const double cs = cpuSeconds();
+        size_t bytes = 0;
+        for (int f = 1; f <= sequence; ++f) {
+            const Eigen::Matrix3f spin = Eigen::AngleAxisf(1.5707963f * float(f) / 24.f, Vec3f::UnitY()).toRotationMatrix();
+            StrandFrame moved = frame;
+            for (Vec3f& p : moved.positions) p = spin * p;
+            for (Vec3f& v : moved.velocities) v = spin * v;
+            VdbFrameInfo info;
+            info.frame = f;
+            info.time = f / 24.0;
+            info.scene = "B-vdb";
+            info.strandCount = moved.strandCount();
+            info.hairVolume = volume;
+            char name[32];
+            std::snprintf(name, sizeof name, "hair.%04d.vdb", f);
+            writeDensityVdb(dir / name, voxelize(moved, GridTransform::uniform(h), vs), info, ws);
+            bytes += size_t(fs::file_size(dir / name));
+        }
+        std::printf("sequence of %d frames at %.2f mm, %d thread(s): %.2f s (cpu %.2f s), %.1f MiB in all, "
+                    "peak RSS %.0f MiB -> %s\n",
+                    sequence, h * 1e3, threads.front(), seconds(ts), cpuSeconds() - cs, double(bytes) / (1 << 20),
+                    peakMiB(), dir.c_str());
+        if (keep.empty()) fs::remove_all(dir);
+        return 0;
+    }
+    for (double h : voxels) {
+        for (int n : threads) {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(n));
+            resetPeak();
+            std::vector<double> tv, tw, cv, cw;
+            size_t activeVoxels = 0, bytes = 0, blocks = 0;
+            double massError = 0;
+            const fs::path file = dir / ("hair_" + std::to_string(int(h * 1e6)) + "um.vdb");
+            for (int r = 0; r < runs; ++r) {
+                auto t = std::chrono::steady_clock::now();
+                double c = cpuSeconds();
+                DensityGrid grid = voxelize(frame, GridTransform::uniform(h), vs);
+                tv.push_back(seconds(t));
+                cv.push_back(cpuSeconds() - c);
+                activeVoxels = grid.activeVoxelCount();
+                blocks = grid.blockCount();
+                massError = std::abs(grid.totalVolume() - volume) / volume;
+                VdbFrameInfo info;
+                info.frame = 1;
+                info.scene = "B-vdb";
+                info.strandCount = frame.strandCount();
+                info.hairVolume = volume;
+                t = std::chrono::steady_clock::now();
+                c = cpuSeconds();
+                writeDensityVdb(file, std::move(grid), info, ws);  // consumes the grid, as the stage does
+                tw.push_back(seconds(t));
+                cw.push_back(cpuSeconds() - c);
+                bytes = size_t(fs::file_size(file));
+            }
+            const Stats v = stats(tv), w = stats(tw), vc = stats(cv), wc = stats(cw);
+            std::printf("voxel %.2f mm, %d thread%s: voxelize %.3f s [%.3f-%.3f] (cpu %.3f s), "
+                        "write %.3f s [%.3f-%.3f] (cpu %.3f s), file %.1f MiB, %zu active voxels in %zu leaves, "
+                        "peak RSS %.0f MiB, mass error %.2e\n",
+                        h * 1e3, n, n == 1 ? " " : "s", v.median, v.min, v.max, vc.median, w.median, w.min, w.max,
+                        wc.median, double(bytes) / (1 << 20), activeVoxels, blocks, peakMiB(), massError);
+            std::fflush(stdout);
+        }
+    }
+    if (keep.empty()) fs::remove_all(dir);
+    return 0;
+}
