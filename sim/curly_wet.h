@@ -77,7 +77,7 @@ struct CurlyWetSettings {
     bool cohesion = true;           ///< cohesion between wet strands (eq. 10)
     float cohesionTightness = 0.85f;///< λ (seed: 0.85)
     float cohesionRadius = 0.01f;   ///< kernel radius of the neighbour average, m
-    float cohesionStiffness = 200.f;///< pull toward the cohesive position, per unit mass, 1/s²
+    float cohesionStiffness = 1e4f; ///< pull toward the cohesive position, per unit mass, 1/s²
     bool adhesion = true;           ///< adhesion to the head (eq. 11-12)
     float adhesionWeight = 1300.f;  ///< ν (seed: 1300)
     float adhesionRadius = 0.005f;  ///< h of A(r): the shell outside the head where wet hair is held, m

@@ -137,8 +137,12 @@ bool BulletCurlyWorld::load(size_t g, const SubstepContext& ctx, size_t& adhesio
         for (int i = 0; i < n; ++i) {
             accel_[i].setZero();
             if (i == 0 || !(sigma[i] > 0.f)) continue;
+            // Evaluated where the particle will be at the step's end if it
+            // keeps its velocity: the shell (h/2, h] is thinner than a step's
+            // travel at hair speeds, so a particle leaving the head must feel
+            // the pull in the step it crosses the shell, not after.
             Vec3f normal;
-            const float phi = ctx.head.distance(x[i], &normal);
+            const float phi = ctx.head.distance(x[i] + ctx.h * v[i], &normal);
             accel_[i] = adhesionAcceleration(phi, normal, sigma[i], s.adhesionWeight, s.adhesionRadius);
             if (accel_[i].squaredNorm() > 0.f) ++adhesion;
         }

@@ -47,27 +47,38 @@ void curlForces(const Vec3f* p, size_t n, const Vec3f* helix, const Mat3f& root,
 
 // ---- SpatialHash ---------------------------------------------------------------
 
-uint32_t SpatialHash::bucket(int64_t i, int64_t j, int64_t k) const {
-    // Teschner et al. 2003's hash of a grid cell.
-    const uint64_t h = (uint64_t(i) * 73856093ull) ^ (uint64_t(j) * 19349663ull) ^ (uint64_t(k) * 83492791ull);
-    return uint32_t(h % uint64_t(start_.size() - 1));
+uint64_t SpatialHash::key(int64_t i, int64_t j, int64_t k) {
+    // 21 bits per axis: ±10⁶ cells, ±10 km at a 1 cm cell.
+    const uint64_t m = (1ull << 21) - 1;
+    return (uint64_t(i) & m) | ((uint64_t(j) & m) << 21) | ((uint64_t(k) & m) << 42);
 }
 
-void SpatialHash::build(const Vec3f* points, size_t count, float cell) {
-    inv_ = 1.f / cell;
+uint32_t SpatialHash::bucket(uint64_t c) const {
+    // A 64-bit mix (splitmix64's finaliser) folded onto the table.
+    c ^= c >> 31;
+    c *= 0x7fb5d329728ea185ull;
+    c ^= c >> 27;
+    return uint32_t(c % uint64_t(start_.size() - 1));
+}
+
+void SpatialHash::build(const Vec3f* points, size_t count, float radius) {
+    radius_ = radius;
+    inv_ = 0.5f / radius;
     const size_t table = std::max<size_t>(1, 2 * count);
     start_.assign(table + 1, 0);
     entries_.resize(count);
+    std::vector<uint64_t> cellOf(count);
     std::vector<uint32_t> bucketOf(count);
     for (size_t i = 0; i < count; ++i) {
         const Vec3f& x = points[i];
-        bucketOf[i] = bucket(int64_t(std::floor(x.x() * inv_)), int64_t(std::floor(x.y() * inv_)),
-                             int64_t(std::floor(x.z() * inv_)));
+        cellOf[i] = key(int64_t(std::floor(x.x() * inv_)), int64_t(std::floor(x.y() * inv_)),
+                        int64_t(std::floor(x.z() * inv_)));
+        bucketOf[i] = bucket(cellOf[i]);
         ++start_[bucketOf[i] + 1];
     }
     for (size_t b = 0; b < table; ++b) start_[b + 1] += start_[b];
     std::vector<uint32_t> fill(start_.begin(), start_.end() - 1);
-    for (size_t i = 0; i < count; ++i) entries_[fill[bucketOf[i]]++] = uint32_t(i);
+    for (size_t i = 0; i < count; ++i) entries_[fill[bucketOf[i]]++] = Entry{cellOf[i], uint32_t(i)};
 }
 
 // ---- Cohesion --------------------------------------------------------------------
@@ -81,8 +92,9 @@ float poly6(float r2, float h) {
 
 void cohesionTargets(const SpatialHash& hash, const Vec3f* points, const float* sigma, const uint32_t* strandOf,
                      size_t begin, size_t end, float radius, float tightness, CohesionTarget* out) {
+    // poly6 without its constant, which cancels in the normalised average.
     const float r2max = radius * radius;
-    const float w0 = poly6(0.f, radius);
+    const float w0 = r2max * r2max * r2max;
     for (size_t i = begin; i < end; ++i) {
         const Vec3f& x = points[i];
         Vec3f sum = Vec3f::Zero();
@@ -93,7 +105,8 @@ void cohesionTargets(const SpatialHash& hash, const Vec3f* points, const float* 
             const Vec3f d = points[j] - x;
             const float r2 = d.squaredNorm();
             if (r2 >= r2max) return;
-            const float w = poly6(r2, radius);
+            const float q = r2max - r2;
+            const float w = q * q * q;
             sum += sigma[j] * w * d;
             wSigma += sigma[j] * w;
             wSum += w;

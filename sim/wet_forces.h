@@ -50,21 +50,30 @@ void curlForces(const Vec3f* p, size_t n, const Vec3f* helix, const Mat3f& root,
 
 /// A uniform grid hashed into a table, rebuilt from scratch each step (counting
 /// sort, so the order of entries is fixed by the point order: deterministic).
+/// Each entry keeps its exact cell, so cells that share a bucket never mix.
 class SpatialHash {
   public:
-    /// Indexes `count` points with cells of size `cell` (the query radius).
-    void build(const Vec3f* points, size_t count, float cell);
-    /// Calls f(j) for every point j in the 27 cells around x, each once, in a
-    /// fixed order (points farther than one cell are included; callers test
-    /// the distance).
+    /// Indexes `count` points for queries of radius `radius`, with cells of
+    /// twice that size.
+    void build(const Vec3f* points, size_t count, float radius);
+    /// Calls f(j) for every point j within `radius` of x (and some farther
+    /// ones: callers test the distance), each once, in a fixed order. The
+    /// ball lies inside the 2×2×2 cells from floor((x - r)/cell): 8 bucket
+    /// lookups instead of the 27 a cell of size r needs, which is what
+    /// dominates when cells hold about one point.
     template <typename F>
     void forEachNear(const Vec3f& x, F&& f) const;
 
   private:
-    uint32_t bucket(int64_t i, int64_t j, int64_t k) const;
-    float inv_ = 1.f;
-    std::vector<uint32_t> start_;   // table size + 1
-    std::vector<uint32_t> entries_; // point indices sorted by bucket
+    struct Entry {
+        uint64_t cell;
+        uint32_t point;
+    };
+    static uint64_t key(int64_t i, int64_t j, int64_t k);
+    uint32_t bucket(uint64_t key) const;
+    float inv_ = 1.f, radius_ = 0.f;
+    std::vector<uint32_t> start_;  // table size + 1
+    std::vector<Entry> entries_;   // sorted by bucket, then point index
 };
 
 /// Cohesion of eq. (10) for one particle: the saturation-weighted,
@@ -132,20 +141,16 @@ float wetVelocityFactor(float sigma, float gamma0, float gamma1);
 template <typename F>
 void SpatialHash::forEachNear(const Vec3f& x, F&& f) const {
     if (entries_.empty()) return;
-    const int64_t ci = int64_t(std::floor(x.x() * inv_)), cj = int64_t(std::floor(x.y() * inv_)),
-                  ck = int64_t(std::floor(x.z() * inv_));
-    uint32_t seen[27];
-    int nSeen = 0;
-    for (int64_t di = -1; di <= 1; ++di)
-        for (int64_t dj = -1; dj <= 1; ++dj)
-            for (int64_t dk = -1; dk <= 1; ++dk) {
-                const uint32_t b = bucket(ci + di, cj + dj, ck + dk);
-                // Two of the 27 cells may share a bucket: visit it once.
-                bool dup = false;
-                for (int s = 0; s < nSeen; ++s) dup = dup || seen[s] == b;
-                if (dup) continue;
-                seen[nSeen++] = b;
-                for (uint32_t e = start_[b]; e < start_[b + 1]; ++e) f(entries_[e]);
+    const int64_t ci = int64_t(std::floor((x.x() - radius_) * inv_)),
+                  cj = int64_t(std::floor((x.y() - radius_) * inv_)),
+                  ck = int64_t(std::floor((x.z() - radius_) * inv_));
+    for (int64_t di = 0; di <= 1; ++di)
+        for (int64_t dj = 0; dj <= 1; ++dj)
+            for (int64_t dk = 0; dk <= 1; ++dk) {
+                const uint64_t c = key(ci + di, cj + dj, ck + dk);
+                const uint32_t b = bucket(c);
+                for (uint32_t e = start_[b]; e < start_[b + 1]; ++e)
+                    if (entries_[e].cell == c) f(entries_[e].point);
             }
 }
 
