@@ -1,6 +1,7 @@
 #include "pipeline/commands.h"
 
 #include "core/log.h"
+#include "pipeline/curly_settings.h"
 #include "pipeline/frame_range.h"
 #include "pipeline/progress.h"
 #include "pipeline/schema.h"
@@ -127,6 +128,7 @@ CommandSpec validateCommandSpec() {
         CommandContext ctx(cl);
         resolveShot(ctx.scene, ctx.options);
         makeView(ctx.scene);  // checks across render keys
+        if (usesCurlyWetModel(ctx.scene)) curlyWetSettings(ctx.scene).validate();  // across hair.curly/wet keys
         std::cout << ctx.scene.name() << ": ok\n";
         return int(kExitOk);
     };

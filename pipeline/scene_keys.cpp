@@ -6,6 +6,7 @@ namespace hp {
 void addSceneKeys(SchemaBuilder& b) {
     addShotKeys(b);
     addOutputKeys(b);
+    addCurlyKeys(b);
     addRenderKeys(b);
     addCompareKeys(b);
 }

@@ -3,9 +3,13 @@
 // that clumps wet strands only, adhesion that holds wet hair to the head,
 // stability under fast rotation, and thread-count independence.
 #include "core/errors.h"
+#include "pipeline/curly_settings.h"
+#include "pipeline/scene.h"
 #include "sim/curly_wet.h"
 #include "sim/fibonacci.h"
 #include "sim/head.h"
+
+#include "test_support.h"
 
 #include <gtest/gtest.h>
 
@@ -378,6 +382,88 @@ TEST(CurlyWet, BadInputIsAClearError) {
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("expected 24"), std::string::npos) << e.what();
     }
+}
+
+
+// ---- Scene keys (pipeline/curly_settings.h) ----------------------------------------
+
+TEST(CurlyWetScene, KeysMapOntoTheSettings) {
+    const Scene scene = Scene::parse(R"(fps: 25
+hair:
+  model: curly-wet
+  curly: {particles: 16, radius: 0.006, pitch: 0.02, bend_stiffness: 12, iterations: 5}
+  wet: {saturation: [[1, 0], [11, 1]], saturation_root: 0.3, cohesion: false, adhesion_weight: 2000}
+)",
+                                     "wet.yaml", ".");
+    EXPECT_TRUE(usesCurlyWetModel(scene));
+    const CurlyWetSettings s = curlyWetSettings(scene);
+    EXPECT_EQ(s.particles, 16);
+    EXPECT_FLOAT_EQ(s.curlRadius, 0.006f);
+    EXPECT_FLOAT_EQ(s.curlPitch, 0.02f);
+    EXPECT_FLOAT_EQ(s.bendStiffness, 12.f);
+    EXPECT_EQ(s.iterations, 5);
+    EXPECT_FLOAT_EQ(s.saturationRoot, 0.3f);
+    EXPECT_FALSE(s.cohesion);
+    EXPECT_FLOAT_EQ(s.adhesionWeight, 2000.f);
+    // The seed's constants are the defaults.
+    EXPECT_FLOAT_EQ(s.cohesionTightness, 0.85f);
+    EXPECT_FLOAT_EQ(s.globalStiffness, 0.999995f);
+    EXPECT_FLOAT_EQ(s.wetStiffness, 0.9999f);
+    EXPECT_FLOAT_EQ(s.dryStiffness, 1.f);
+    EXPECT_NO_THROW(s.validate());
+    // Frame 6 at 25 fps is t = 0.24 s, half-way up the curve.
+    EXPECT_FLOAT_EQ(sceneSaturation(scene, 0.24), 0.5f);
+    EXPECT_FLOAT_EQ(sceneSaturation(scene, 0.0), 0.f);
+    EXPECT_FLOAT_EQ(sceneSaturation(scene, 10.0), 1.f);
+    EXPECT_FALSE(usesCurlyWetModel(Scene::parse("fps: 24\n", "dry.yaml", ".")));
+}
+
+TEST(CurlyWetScene, CrossKeyErrorsNameTheKey) {
+    try {
+        curlyWetSettings(Scene::parse("hair: {wet: {adhesion_radius: 0.001}}\n", "bad.yaml", "."));
+        FAIL() << "an adhesion shell inside the collision clearance was accepted";
+    } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("hair.wet.adhesion_radius"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(Scene::parse("hair: {model: straight}\n", "bad.yaml", "."), SceneError);
+    EXPECT_THROW(Scene::parse("hair: {wet: {saturation: 2}}\n", "bad.yaml", "."), SceneError);
+}
+
+TEST(CurlyWetScene, ExampleSceneGetsWetMidShot) {
+    const std::filesystem::path file = test::sourcePath("scenes/curly_wet.yaml");
+    EXPECT_EQ(test::runHairpipe("validate " + file.string()).exitCode, 0);
+    const Scene scene = Scene::load(file);
+    ASSERT_TRUE(usesCurlyWetModel(scene));
+    // The driver the pipeline runs: step to each frame's time, setting the
+    // saturation of the scene's curve before every step, then write the frame.
+    CurlyWetSolver solver(curlyWetSettings(scene));
+    const SpinningSphere head(0.1f, 30.f);
+    const std::vector<Vec3f> dirs = fibonacciCap(60);
+    const double fps = scene.number("fps"), dt = solver.settings().timeStep;
+    const HeadPose first = head.sample(1 / fps);
+    solver.initialize(rootFrames(dirs, first, 0.1f), first);
+    std::vector<double> sigma;
+    std::vector<float> radius;
+    for (int frame = 2; frame <= 60; ++frame) {
+        const double t = frame / fps;
+        while (solver.time() < t - 1e-9) {
+            const HeadPose pose = head.sample(solver.time() + dt);
+            solver.setSaturation(sceneSaturation(scene, pose.time));
+            const CurlyWetStats& st = solver.step(rootFrames(dirs, pose, 0.1f), pose);
+            ASSERT_EQ(st.nanCount, 0u);
+        }
+        StrandFrame f;
+        solver.write(f, t);
+        ASSERT_NO_THROW(f.validate());
+        sigma.push_back(solver.lastStats().meanSaturation);
+        radius.push_back(solver.measureCurl().x());
+    }
+    EXPECT_EQ(sigma[10], 0.0);   // frame 12: dry
+    EXPECT_GT(sigma.back(), 0.6);  // frame 60: soaked, drier at the roots
+    EXPECT_LT(sigma.back(), 1.0);
+    std::printf("curl radius: %.2f mm dry (frame 20), %.2f mm wet (frame 60)\n", 1e3f * radius[18],
+                1e3f * radius.back());
+    EXPECT_LT(radius.back(), radius[18] - 0.0005f) << "wet curls tighten toward the 8 mm helix";
 }
 
 }  // namespace
