@@ -121,7 +121,7 @@ struct CurlyWetSolver::Impl {
         }
         const size_t total = set.x.size();
         set.cohesion.resize(total);
-        hash.build(set.x.data(), total, s.cohesionRadius);
+        hash.build(set.x.data(), strandOf.data(), total, s.cohesionRadius);
         parallel(total, 1024, [&](size_t b, size_t e) {
             curly::cohesionTargets(hash, set.x.data(), set.sigma.data(), strandOf.data(), b, e, s.cohesionRadius,
                                    s.cohesionTightness, &set.cohesion[b]);

@@ -58,13 +58,14 @@ uint32_t SpatialHash::bucket(uint64_t c) const {
     c ^= c >> 31;
     c *= 0x7fb5d329728ea185ull;
     c ^= c >> 27;
-    return uint32_t(c % uint64_t(start_.size() - 1));
+    return uint32_t(c & mask_);
 }
 
-void SpatialHash::build(const Vec3f* points, size_t count, float radius) {
-    radius_ = radius;
-    inv_ = 0.5f / radius;
-    const size_t table = std::max<size_t>(1, 2 * count);
+void SpatialHash::build(const Vec3f* points, const uint32_t* groups, size_t count, float radius) {
+    inv_ = 1.f / radius;
+    size_t table = 1;  // a power of two ≥ 2·count: buckets by mask, not division
+    while (table < 2 * count) table *= 2;
+    mask_ = table - 1;
     start_.assign(table + 1, 0);
     entries_.resize(count);
     std::vector<uint64_t> cellOf(count);
@@ -78,7 +79,7 @@ void SpatialHash::build(const Vec3f* points, size_t count, float radius) {
     }
     for (size_t b = 0; b < table; ++b) start_[b + 1] += start_[b];
     std::vector<uint32_t> fill(start_.begin(), start_.end() - 1);
-    for (size_t i = 0; i < count; ++i) entries_[fill[bucketOf[i]]++] = Entry{cellOf[i], uint32_t(i)};
+    for (size_t i = 0; i < count; ++i) entries_[fill[bucketOf[i]]++] = Entry{cellOf[i], points[i], uint32_t(i), groups[i]};
 }
 
 // ---- Cohesion --------------------------------------------------------------------
@@ -100,9 +101,10 @@ void cohesionTargets(const SpatialHash& hash, const Vec3f* points, const float* 
         Vec3f sum = Vec3f::Zero();
         float wSum = 0.f, wSigma = 0.f;
         uint32_t count = 0;
-        hash.forEachNear(x, [&](uint32_t j) {
-            if (strandOf[j] == strandOf[i]) return;
-            const Vec3f d = points[j] - x;
+        const uint32_t own = strandOf[i];
+        hash.forEachNear(x, [&](uint32_t j, const Vec3f& pj, uint32_t strand) {
+            if (strand == own) return;
+            const Vec3f d = pj - x;
             const float r2 = d.squaredNorm();
             if (r2 >= r2max) return;
             const float q = r2max - r2;

@@ -50,28 +50,31 @@ void curlForces(const Vec3f* p, size_t n, const Vec3f* helix, const Mat3f& root,
 
 /// A uniform grid hashed into a table, rebuilt from scratch each step (counting
 /// sort, so the order of entries is fixed by the point order: deterministic).
-/// Each entry keeps its exact cell, so cells that share a bucket never mix.
+/// Each entry keeps its exact cell, so cells that share a bucket never mix,
+/// and a copy of its point and group, so a query reads one contiguous run of
+/// memory per cell instead of chasing indices.
 class SpatialHash {
   public:
-    /// Indexes `count` points for queries of radius `radius`, with cells of
-    /// twice that size.
-    void build(const Vec3f* points, size_t count, float radius);
-    /// Calls f(j) for every point j within `radius` of x (and some farther
-    /// ones: callers test the distance), each once, in a fixed order. The
-    /// ball lies inside the 2×2×2 cells from floor((x - r)/cell): 8 bucket
-    /// lookups instead of the 27 a cell of size r needs, which is what
-    /// dominates when cells hold about one point.
+    /// Indexes `count` points (with a group id each, e.g. their strand) for
+    /// queries of radius `radius`.
+    void build(const Vec3f* points, const uint32_t* groups, size_t count, float radius);
+    /// Calls f(j, p_j, group_j) for every point j within `radius` of x (and
+    /// some farther ones: callers test the distance), each once, in a fixed
+    /// order: the 27 cells of size `radius` around x.
     template <typename F>
     void forEachNear(const Vec3f& x, F&& f) const;
 
   private:
     struct Entry {
         uint64_t cell;
-        uint32_t point;
+        Vec3f point;
+        uint32_t index;
+        uint32_t group;
     };
     static uint64_t key(int64_t i, int64_t j, int64_t k);
     uint32_t bucket(uint64_t key) const;
-    float inv_ = 1.f, radius_ = 0.f;
+    float inv_ = 1.f;
+    uint64_t mask_ = 0;            // table size - 1
     std::vector<uint32_t> start_;  // table size + 1
     std::vector<Entry> entries_;   // sorted by bucket, then point index
 };
@@ -97,8 +100,8 @@ struct CohesionTarget {
 };
 
 /// Cohesion targets for particles [begin, end) of `points`, from neighbours
-/// found in `hash` (built on the same points). Particles with the same
-/// `strandOf` never attract each other (no self-clumping of a curl); dry
+/// found in `hash` (built on the same points, grouped by `strandOf`).
+/// Particles with the same `strandOf` never attract each other (no self-clumping of a curl); dry
 /// neighbours (σ_j = 0) only dilute the average, as in eq. (10).
 void cohesionTargets(const SpatialHash& hash, const Vec3f* points, const float* sigma, const uint32_t* strandOf,
                      size_t begin, size_t end, float radius, float tightness, CohesionTarget* out);
@@ -141,16 +144,17 @@ float wetVelocityFactor(float sigma, float gamma0, float gamma1);
 template <typename F>
 void SpatialHash::forEachNear(const Vec3f& x, F&& f) const {
     if (entries_.empty()) return;
-    const int64_t ci = int64_t(std::floor((x.x() - radius_) * inv_)),
-                  cj = int64_t(std::floor((x.y() - radius_) * inv_)),
-                  ck = int64_t(std::floor((x.z() - radius_) * inv_));
-    for (int64_t di = 0; di <= 1; ++di)
-        for (int64_t dj = 0; dj <= 1; ++dj)
-            for (int64_t dk = 0; dk <= 1; ++dk) {
+    const int64_t ci = int64_t(std::floor(x.x() * inv_)), cj = int64_t(std::floor(x.y() * inv_)),
+                  ck = int64_t(std::floor(x.z() * inv_));
+    for (int64_t di = -1; di <= 1; ++di)
+        for (int64_t dj = -1; dj <= 1; ++dj)
+            for (int64_t dk = -1; dk <= 1; ++dk) {
                 const uint64_t c = key(ci + di, cj + dj, ck + dk);
                 const uint32_t b = bucket(c);
-                for (uint32_t e = start_[b]; e < start_[b + 1]; ++e)
-                    if (entries_[e].cell == c) f(entries_[e].point);
+                for (uint32_t e = start_[b]; e < start_[b + 1]; ++e) {
+                    const Entry& en = entries_[e];
+                    if (en.cell == c) f(en.index, en.point, en.group);
+                }
             }
 }
 

@@ -360,12 +360,18 @@ TEST(WetForces, SpatialHashFindsEveryNeighbourOnce) {
     std::uniform_real_distribution<float> u(-0.05f, 0.05f);
     std::vector<Vec3f> pts(2000);
     for (Vec3f& p : pts) p = Vec3f(u(rng), u(rng), u(rng));
+    std::vector<uint32_t> groups(pts.size());
+    for (size_t i = 0; i < pts.size(); ++i) groups[i] = uint32_t(i % 7);
     SpatialHash hash;
     const float r = 0.01f;
-    hash.build(pts.data(), pts.size(), r);
+    hash.build(pts.data(), groups.data(), pts.size(), r);
     for (size_t i = 0; i < pts.size(); i += 37) {
         std::vector<int> seen(pts.size(), 0);
-        hash.forEachNear(pts[i], [&](uint32_t j) { ++seen[j]; });
+        hash.forEachNear(pts[i], [&](uint32_t j, const Vec3f& p, uint32_t g) {
+            ++seen[j];
+            EXPECT_EQ(p, pts[j]);
+            EXPECT_EQ(g, groups[j]);
+        });
         for (size_t j = 0; j < pts.size(); ++j) {
             EXPECT_LE(seen[j], 1);
             if ((pts[j] - pts[i]).norm() < r) {
@@ -387,7 +393,7 @@ TEST(WetForces, CohesionPullsTowardWetNeighboursOfOtherStrandsOnly) {
         }
     SpatialHash hash;
     const float radius = 0.01f;
-    hash.build(pts.data(), pts.size(), radius);
+    hash.build(pts.data(), strand.data(), pts.size(), radius);
     std::vector<CohesionTarget> out(pts.size());
     std::vector<float> sigma(pts.size(), 0.f);
     cohesionTargets(hash, pts.data(), sigma.data(), strand.data(), 0, pts.size(), radius, 0.85f, out.data());

@@ -3,7 +3,9 @@
 // about Y, roots on a Fibonacci lattice over the upper hemisphere, 0.02 s
 // steps, 20 warm-up + 250 timed steps. Reports steps/s (median of 3 runs and
 // the spread), the largest edge stretch and the deepest penetration over the
-// timed steps, NaN count, the fitted curl radius/pitch at the end, threads.
+// timed steps, NaN count, the fitted curl radius/pitch at the end, threads,
+// and the process CPU time per step (all threads; a steadier figure than wall
+// time on a machine shared with other jobs).
 //
 // Modes: dry (σ = 0), wet (σ = 1, cohesion off), cohesion (σ = 1, cohesion on).
 //
@@ -19,6 +21,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <string>
 #include <vector>
 
@@ -26,8 +29,15 @@ namespace {
 
 using namespace hp;
 
+double cpuSeconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
 struct Result {
     double stepsPerSecond = 0;
+    double cpuMsPerStep = 0;  ///< process CPU time (all threads) per timed step
     CurlyWetStats stats;
     Eigen::Vector2f curl = Eigen::Vector2f::Zero();
 };
@@ -60,8 +70,9 @@ Result run(size_t guides, const std::string& mode, int threads, int warmup, int 
     Result r;
     CurlyWetStats acc;
     bool first = true;
-    double ms = 0;
+    double ms = 0, cpu = 0;
     for (int k = 1; k <= warmup + timed; ++k) {
+        if (k == warmup + 1) cpu = cpuSeconds();
         pose = head.sample(k * double(s.timeStep));
         const CurlyWetStats& st = solver.step(rootFrames(dirs, pose, radius), pose);
         if (k <= warmup) continue;
@@ -69,6 +80,7 @@ Result run(size_t guides, const std::string& mode, int threads, int warmup, int 
         if (first) acc = st, first = false;
         else acc.accumulate(st);
     }
+    r.cpuMsPerStep = 1000.0 * (cpuSeconds() - cpu) / timed;
     r.stepsPerSecond = 1000.0 * timed / ms;
     r.stats = acc;
     r.curl = solver.measureCurl();
@@ -104,21 +116,25 @@ int main(int argc, char** argv) {
     std::printf("B-sim, curly/wet model: sphere r=0.1 m spinning 90 deg/s about Y, 24 particles x 0.25 m, "
                 "0.02 s steps (1 Bullet step, 8 link iterations), %d warm-up + %d timed steps, median of %d\n",
                 warmup, timed, runs);
-    std::printf("%7s %9s %7s %10s %16s %10s %12s %5s %14s\n", "guides", "mode", "threads", "steps/s", "spread",
-                "max strain", "max pen. mm", "NaN", "curl r/p mm");
+    std::printf("%7s %9s %7s %10s %16s %11s %10s %12s %5s %14s\n", "guides", "mode", "threads", "steps/s", "spread",
+                "CPU ms/step", "max strain", "max pen. mm", "NaN", "curl r/p mm");
     for (size_t n : counts)
         for (const std::string& mode : modes)
             for (int t : threads) {
                 std::vector<Result> rs;
                 for (int k = 0; k < runs; ++k) rs.push_back(run(n, mode, t, warmup, timed));
-                std::vector<double> sps;
-                for (const Result& r : rs) sps.push_back(r.stepsPerSecond);
+                std::vector<double> sps, cpu;
+                for (const Result& r : rs) {
+                    sps.push_back(r.stepsPerSecond);
+                    cpu.push_back(r.cpuMsPerStep);
+                }
                 std::sort(sps.begin(), sps.end());
+                std::sort(cpu.begin(), cpu.end());
                 const Result& r = rs.back();
                 char spread[64];
                 std::snprintf(spread, sizeof spread, "%.1f-%.1f", sps.front(), sps.back());
-                std::printf("%7zu %9s %7d %10.1f %16s %9.3f%% %12.3f %5zu %6.1f/%-6.1f\n", n, mode.c_str(), t,
-                            sps[sps.size() / 2], spread, 100.0 * r.stats.maxLengthError,
+                std::printf("%7zu %9s %7d %10.1f %16s %11.2f %9.3f%% %12.3f %5zu %6.1f/%-6.1f\n", n, mode.c_str(), t,
+                            sps[sps.size() / 2], spread, cpu[cpu.size() / 2], 100.0 * r.stats.maxLengthError,
                             1000.0 * r.stats.maxPenetration, r.stats.nanCount, 1000.0 * r.curl.x(),
                             1000.0 * r.curl.y());
                 std::fflush(stdout);
