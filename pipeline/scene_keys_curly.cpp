@@ -40,7 +40,7 @@ void addCurlyKeys(SchemaBuilder& b) {
                 "kc of the core springs on the smoothed curve (seed eq. 5): keeps curls from unwinding.")
         .number("hair.curly.core_damping", 0.02, 0, 1e4, "N·s/m", "cc of the core springs.")
         .number("hair.curly.core_smoothing", 0.05, 0, 10, "m", "α_c of the core curve's smoothing filter.")
-        .number("hair.curly.max_strain", 0.005, 1e-5, 0.5, "", "Strain limit |l/l_rest - 1| of an edge.")
+        .number("hair.curly.max_strain", 0.001, 1e-5, 0.5, "", "Strain limit |l/l_rest - 1| of an edge.")
         .number("hair.curly.max_relative_velocity", 2, 1e-3, 1e3, "m/s",
                 "Root-to-tip limit on the velocity difference of neighbouring particles.")
         .number("hair.curly.friction", 0.2, 0, 10, "", "Coulomb friction against the head.")

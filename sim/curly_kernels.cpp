@@ -162,7 +162,7 @@ Contact placeParticle(const Vec3f& parent, Vec3f& child, float length, const Obs
     Contact total;
     if (!head.collider) return total;
     const Vec3f start = child;
-    for (int iter = 0; iter < 4; ++iter) {
+    for (int iter = 0; iter < 16; ++iter) {
         const Contact c = projectOut(head, radius, child);
         if (!c.active) break;
         total.active = true;

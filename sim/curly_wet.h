@@ -62,7 +62,7 @@ struct CurlyWetSettings {
     float coreStiffness = 20.f;     ///< kc, N/m
     float coreDamping = 0.02f;      ///< cc, N·s/m
     float coreSmoothing = 0.05f;    ///< α_c of the core curve, m
-    float maxStrain = 0.005f;       ///< strain limit |l/l̄ - 1| after each Bullet step
+    float maxStrain = 0.001f;       ///< strain limit |l/l̄ - 1| after each Bullet step
     float maxRelativeVelocity = 2.f;///< root-to-tip velocity limit |v_{i+1} - v_i|, m/s
     float friction = 0.2f;          ///< Coulomb friction against the head
 
