@@ -60,7 +60,9 @@ void addCurlyKeys(SchemaBuilder& b) {
         .number("hair.wet.helix_radius", 0, 0, 1, "m",
                 "Radius of the wet helix that curl exaggeration pulls toward (seed eq. 6); 0: hair.curly.radius.")
         .number("hair.wet.helix_pitch", 0, 0, 10, "m", "Advance per turn of the wet helix; 0: hair.curly.pitch.")
-        .number("hair.wet.helix_weight", 10, 0, 1e6, "N/m", "w_h of curl exaggeration (seed eq. 9).")
+        .number("hair.wet.helix_weight", 100, 0, 1e6, "N/m",
+                "w_h of curl exaggeration (seed eq. 9). Against the bending springs (bend_stiffness) that hold the "
+                "dry curl: at 5× their stiffness, soaked hair takes most of the wet helix's shape.")
         .flag("hair.wet.cohesion", true, "Cohesion between wet strands (seed eq. 10).")
         .number("hair.wet.cohesion_tightness", 0.85, 0, 1, "", "λ, the tightness of the cohesive position (seed: 0.85).")
         .number("hair.wet.cohesion_radius", 0.01, 1e-5, 1, "m", "Kernel radius of the neighbour average.")

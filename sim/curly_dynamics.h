@@ -4,10 +4,10 @@
 // world: the solver (sim/curly_world.cpp) hands the result to Bullet as node
 // forces, and Bullet integrates and solves the inextensible links.
 //
-// Why implicit: the springs that hold a curl against gravity are ~100× stiffer
-// than an explicit step of 0.02 s tolerates for these particle masses
-// (h²k/m ≈ 400 at the defaults), and Iben et al. themselves integrate
-// implicitly. Backward Euler linearised once (Baraff & Witkin 1998):
+// Why implicit: an explicit step of a spring k on a mass m is stable only for
+// h²k/m < 4; the springs that hold a curl against gravity have h²k/m ≈ 150
+// (bending) and ≈ 4·10⁴ (stretch) at the defaults and h = 0.02 s. Backward
+// Euler linearised once (Baraff & Witkin 1998) is stable for any k:
 //   (M + hC + h²K) Δv = h (f + M g + M a_ext) - h² K v,
 // with K and C the stiffness and damping Jacobians of the pair springs (block
 // tridiagonal: each spring couples particles i and i+1), the bending targets

@@ -73,7 +73,7 @@ struct CurlyWetSettings {
     float saturationTip = 1.f;      ///< profile factor at the tip (linear in between)
     float helixRadius = 0.f;        ///< wet helix radius r (eq. 6), m; 0: the curl radius
     float helixPitch = 0.f;         ///< wet helix advance per turn (2π p of eq. 6), m; 0: the curl pitch
-    float helixWeight = 10.f;       ///< w_h of eq. (9), N/m
+    float helixWeight = 100.f;      ///< w_h of eq. (9), N/m (5 kb: a wet helix unlike the rest curl wins)
     bool cohesion = true;           ///< cohesion between wet strands (eq. 10)
     float cohesionTightness = 0.85f;///< λ (seed: 0.85)
     float cohesionRadius = 0.01f;   ///< kernel radius of the neighbour average, m

@@ -19,10 +19,12 @@
 //     (step-size independent).
 //
 // Why this arrangement: the seed's springs are force-based, and a curl needs
-// stiff ones — explicit forces at 0.02 s blow up (h²k/m ≈ 400), so the step
-// is implicit (as in Iben et al.), which the soft-body solver does not offer
-// for these springs; Bullet keeps what it does well here, integration and
-// exact-enough inextensibility. Head contact goes through the signed distance
+// stiff ones — as explicit forces at 0.02 s they blow up (h²k/m ≈ 150 for the
+// bending springs; explicit needs < 4), so they go through an implicit step,
+// which Bullet's soft-body solver does not offer for such springs (its links
+// and bending links are position constraints without targets that turn with
+// the strand); Bullet keeps what it does well here, integration and
+// inextensibility. Head contact goes through the signed distance
 // (as the rigid-chain guides do, and as the seed's adhesion needs anyway)
 // rather than Bullet's soft-rigid sparse SDF, whose cell size and per-step
 // garbage collection cost (STACK.md) buy nothing for a single smooth head.
