@@ -74,7 +74,7 @@ struct CurlyWetSolver::Impl {
     CurlySet set;
     std::vector<std::unique_ptr<curly::CurlyWorld>> groups;
     std::vector<uint32_t> strandOf;
-    curly::SpatialHash hash;
+    curly::SpatialGrid grid;
     std::unique_ptr<tbb::task_arena> arena;
     double time = 0, prevTime = 0;
     Eigen::Isometry3f headTransform = Eigen::Isometry3f::Identity();
@@ -121,10 +121,10 @@ struct CurlyWetSolver::Impl {
         }
         const size_t total = set.x.size();
         set.cohesion.resize(total);
-        hash.build(set.x.data(), strandOf.data(), total, s.cohesionRadius);
+        grid.build(set.x.data(), strandOf.data(), total, s.cohesionRadius);
         parallel(total, 1024, [&](size_t b, size_t e) {
-            curly::cohesionTargets(hash, set.x.data(), set.sigma.data(), strandOf.data(), b, e, s.cohesionRadius,
-                                   s.cohesionTightness, &set.cohesion[b]);
+            curly::cohesionTargets(grid, set.sigma.data(), b, e, s.cohesionRadius, s.cohesionTightness,
+                                   set.cohesion.data());
         });
         size_t neighbours = 0;
         for (size_t g = 0; g < set.count; ++g) {

@@ -45,41 +45,43 @@ void curlForces(const Vec3f* p, size_t n, const Vec3f* helix, const Mat3f& root,
     }
 }
 
-// ---- SpatialHash ---------------------------------------------------------------
+// ---- SpatialGrid -----------------------------------------------------------------
 
-uint64_t SpatialHash::key(int64_t i, int64_t j, int64_t k) {
-    // 21 bits per axis: ±10⁶ cells, ±10 km at a 1 cm cell.
-    const uint64_t m = (1ull << 21) - 1;
-    return (uint64_t(i) & m) | ((uint64_t(j) & m) << 21) | ((uint64_t(k) & m) << 42);
-}
-
-uint32_t SpatialHash::bucket(uint64_t c) const {
-    // A 64-bit mix (splitmix64's finaliser) folded onto the table.
-    c ^= c >> 31;
-    c *= 0x7fb5d329728ea185ull;
-    c ^= c >> 27;
-    return uint32_t(c & mask_);
-}
-
-void SpatialHash::build(const Vec3f* points, const uint32_t* groups, size_t count, float radius) {
-    inv_ = 1.f / radius;
-    size_t table = 1;  // a power of two ≥ 2·count: buckets by mask, not division
-    while (table < 2 * count) table *= 2;
-    mask_ = table - 1;
-    start_.assign(table + 1, 0);
+void SpatialGrid::build(const Vec3f* points, const uint32_t* groups, size_t count, float radius) {
+    Eigen::AlignedBox3f box;
+    for (size_t i = 0; i < count; ++i)
+        if (points[i].allFinite()) box.extend(points[i]);
+    if (box.isEmpty()) box.extend(Vec3f::Zero());
+    origin_ = box.min();
+    const Vec3f extent = box.sizes();
+    float cell = radius;
+    auto dims = [&](float c) {
+        nx_ = int64_t(extent.x() / c) + 1;
+        ny_ = int64_t(extent.y() / c) + 1;
+        nz_ = int64_t(extent.z() / c) + 1;
+        return double(nx_) * double(ny_) * double(nz_);
+    };
+    const double budget = 4.0 * double(count) + 64.0;
+    for (double cells = dims(cell); cells > budget; cells = dims(cell)) cell *= float(std::cbrt(cells / budget)) * 1.01f;
+    inv_ = 1.f / cell;
+    const size_t cells = size_t(nx_ * ny_ * nz_);
+    start_.assign(cells + 1, 0);
     entries_.resize(count);
-    std::vector<uint64_t> cellOf(count);
-    std::vector<uint32_t> bucketOf(count);
+    std::vector<uint32_t> cellOf(count);
     for (size_t i = 0; i < count; ++i) {
-        const Vec3f& x = points[i];
-        cellOf[i] = key(int64_t(std::floor(x.x() * inv_)), int64_t(std::floor(x.y() * inv_)),
-                        int64_t(std::floor(x.z() * inv_)));
-        bucketOf[i] = bucket(cellOf[i]);
-        ++start_[bucketOf[i] + 1];
+        size_t c = 0;  // non-finite points go to cell 0, where distance tests reject them
+        if (points[i].allFinite()) {
+            const Vec3f p = (points[i] - origin_) * inv_;
+            const int64_t x = std::min<int64_t>(int64_t(p.x()), nx_ - 1), y = std::min<int64_t>(int64_t(p.y()), ny_ - 1),
+                          z = std::min<int64_t>(int64_t(p.z()), nz_ - 1);
+            c = size_t((z * ny_ + y) * nx_ + x);
+        }
+        cellOf[i] = uint32_t(c);
+        ++start_[c + 1];
     }
-    for (size_t b = 0; b < table; ++b) start_[b + 1] += start_[b];
+    for (size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
     std::vector<uint32_t> fill(start_.begin(), start_.end() - 1);
-    for (size_t i = 0; i < count; ++i) entries_[fill[bucketOf[i]]++] = Entry{cellOf[i], points[i], uint32_t(i), groups[i]};
+    for (size_t i = 0; i < count; ++i) entries_[fill[cellOf[i]]++] = Entry{points[i], uint32_t(i), groups[i]};
 }
 
 // ---- Cohesion --------------------------------------------------------------------
@@ -91,22 +93,22 @@ float poly6(float r2, float h) {
     return float(315.0 / (64.0 * M_PI)) / std::pow(h, 9.f) * d * d * d;
 }
 
-void cohesionTargets(const SpatialHash& hash, const Vec3f* points, const float* sigma, const uint32_t* strandOf,
-                     size_t begin, size_t end, float radius, float tightness, CohesionTarget* out) {
+void cohesionTargets(const SpatialGrid& grid, const float* sigma, size_t begin, size_t end, float radius,
+                     float tightness, CohesionTarget* out) {
     // poly6 without its constant, which cancels in the normalised average.
     const float r2max = radius * radius;
     const float w0 = r2max * r2max * r2max;
-    for (size_t i = begin; i < end; ++i) {
-        const Vec3f& x = points[i];
+    for (size_t k = begin; k < end; ++k) {
+        const Vec3f& x = grid.orderedPoint(k);
+        const uint32_t own = grid.orderedGroup(k);
         Vec3f sum = Vec3f::Zero();
         float wSum = 0.f, wSigma = 0.f;
         uint32_t count = 0;
-        const uint32_t own = strandOf[i];
-        hash.forEachNear(x, [&](uint32_t j, const Vec3f& pj, uint32_t strand) {
+        grid.forEachNear(x, [&](uint32_t j, const Vec3f& pj, uint32_t strand) {
             if (strand == own) return;
             const Vec3f d = pj - x;
             const float r2 = d.squaredNorm();
-            if (r2 >= r2max) return;
+            if (!(r2 < r2max)) return;
             const float q = r2max - r2;
             const float w = q * q * q;
             sum += sigma[j] * w * d;
@@ -114,7 +116,7 @@ void cohesionTargets(const SpatialHash& hash, const Vec3f* points, const float* 
             wSum += w;
             ++count;
         });
-        CohesionTarget& t = out[i - begin];
+        CohesionTarget& t = out[grid.ordered(k)];
         const float norm = tightness / (w0 + wSum);
         t.offset = sum * norm;
         t.weight = wSigma * norm;

@@ -10,6 +10,7 @@
 
 #include "sim/curly_kernels.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -48,35 +49,43 @@ void curlForces(const Vec3f* p, size_t n, const Vec3f* helix, const Mat3f& root,
 
 // ---- Cohesion (seed §3, eq. 10) ----------------------------------------------
 
-/// A uniform grid hashed into a table, rebuilt from scratch each step (counting
-/// sort, so the order of entries is fixed by the point order: deterministic).
-/// Each entry keeps its exact cell, so cells that share a bucket never mix,
-/// and a copy of its point and group, so a query reads one contiguous run of
-/// memory per cell instead of chasing indices.
-class SpatialHash {
+/// Neighbour search for the cohesion pass: a uniform grid over the points'
+/// bounding box (the dense form of a spatial hash: a cell's key is its linear
+/// index), filled by counting sort each step, so the order of its entries is
+/// fixed by the points: deterministic. Entries carry a copy of their point
+/// and group and cells are stored x-fastest, so a query reads 9 contiguous
+/// runs (the 3×3 rows of its 27 cells) instead of chasing 27 hash buckets,
+/// which at ~1 point per cell is what the search's time goes to.
+class SpatialGrid {
   public:
     /// Indexes `count` points (with a group id each, e.g. their strand) for
-    /// queries of radius `radius`.
+    /// queries of radius `radius`. Cells are `radius` wide, wider where the
+    /// bounding box would need more than ~4 cells per point (memory stays
+    /// linear in the points).
     void build(const Vec3f* points, const uint32_t* groups, size_t count, float radius);
+    size_t size() const { return entries_.size(); }
+    /// The k-th point in grid order (cell by cell). Queries made in this
+    /// order read neighbouring cells one after the other (cache-friendly).
+    uint32_t ordered(size_t k) const { return entries_[k].index; }
+    const Vec3f& orderedPoint(size_t k) const { return entries_[k].point; }
+    uint32_t orderedGroup(size_t k) const { return entries_[k].group; }
     /// Calls f(j, p_j, group_j) for every point j within `radius` of x (and
     /// some farther ones: callers test the distance), each once, in a fixed
-    /// order: the 27 cells of size `radius` around x.
+    /// order (the 27 cells around x, then the point order).
     template <typename F>
     void forEachNear(const Vec3f& x, F&& f) const;
 
   private:
     struct Entry {
-        uint64_t cell;
         Vec3f point;
         uint32_t index;
         uint32_t group;
     };
-    static uint64_t key(int64_t i, int64_t j, int64_t k);
-    uint32_t bucket(uint64_t key) const;
+    Vec3f origin_ = Vec3f::Zero();
     float inv_ = 1.f;
-    uint64_t mask_ = 0;            // table size - 1
-    std::vector<uint32_t> start_;  // table size + 1
-    std::vector<Entry> entries_;   // sorted by bucket, then point index
+    int64_t nx_ = 0, ny_ = 0, nz_ = 0;
+    std::vector<uint32_t> start_;  // cells + 1, x fastest
+    std::vector<Entry> entries_;   // by cell, then point index
 };
 
 /// Cohesion of eq. (10) for one particle: the saturation-weighted,
@@ -99,12 +108,14 @@ struct CohesionTarget {
     uint32_t neighbours = 0;
 };
 
-/// Cohesion targets for particles [begin, end) of `points`, from neighbours
-/// found in `hash` (built on the same points, grouped by `strandOf`).
-/// Particles with the same `strandOf` never attract each other (no self-clumping of a curl); dry
-/// neighbours (σ_j = 0) only dilute the average, as in eq. (10).
-void cohesionTargets(const SpatialHash& hash, const Vec3f* points, const float* sigma, const uint32_t* strandOf,
-                     size_t begin, size_t end, float radius, float tightness, CohesionTarget* out);
+/// Cohesion targets for the points [begin, end) in `grid` order (the grid
+/// built on all particles, grouped by strand), written to out[particle index].
+/// Particles of the same strand never attract each other (no self-clumping of
+/// a curl); dry neighbours (σ_j = 0) only dilute the average, as in eq. (10).
+/// Each particle's result depends only on the positions, whatever the range
+/// split: parallel calls over disjoint ranges are deterministic.
+void cohesionTargets(const SpatialGrid& grid, const float* sigma, size_t begin, size_t end, float radius,
+                     float tightness, CohesionTarget* out);
 
 /// The poly6 kernel W(r, h) = 315/(64π h⁹) (h² - r²)³ for r < h, else 0.
 float poly6(float r2, float h);
@@ -142,20 +153,18 @@ float wetVelocityFactor(float sigma, float gamma0, float gamma1);
 // ---- template implementation --------------------------------------------------
 
 template <typename F>
-void SpatialHash::forEachNear(const Vec3f& x, F&& f) const {
-    if (entries_.empty()) return;
-    const int64_t ci = int64_t(std::floor(x.x() * inv_)), cj = int64_t(std::floor(x.y() * inv_)),
-                  ck = int64_t(std::floor(x.z() * inv_));
-    for (int64_t di = -1; di <= 1; ++di)
-        for (int64_t dj = -1; dj <= 1; ++dj)
-            for (int64_t dk = -1; dk <= 1; ++dk) {
-                const uint64_t c = key(ci + di, cj + dj, ck + dk);
-                const uint32_t b = bucket(c);
-                for (uint32_t e = start_[b]; e < start_[b + 1]; ++e) {
-                    const Entry& en = entries_[e];
-                    if (en.cell == c) f(en.index, en.point, en.group);
-                }
-            }
+void SpatialGrid::forEachNear(const Vec3f& x, F&& f) const {
+    if (entries_.empty() || !x.allFinite()) return;
+    const Vec3f c = (x - origin_) * inv_;
+    const int64_t cx = int64_t(std::floor(c.x())), cy = int64_t(std::floor(c.y())), cz = int64_t(std::floor(c.z()));
+    const int64_t x0 = std::max<int64_t>(cx - 1, 0), x1 = std::min<int64_t>(cx + 1, nx_ - 1);
+    if (x0 > x1) return;
+    for (int64_t z = std::max<int64_t>(cz - 1, 0); z <= std::min<int64_t>(cz + 1, nz_ - 1); ++z)
+        for (int64_t y = std::max<int64_t>(cy - 1, 0); y <= std::min<int64_t>(cy + 1, ny_ - 1); ++y) {
+            const size_t row = size_t((z * ny_ + y) * nx_);
+            for (uint32_t e = start_[row + size_t(x0)]; e < start_[row + size_t(x1) + 1]; ++e)
+                f(entries_[e].index, entries_[e].point, entries_[e].group);
+        }
 }
 
 }  // namespace hp::curly

@@ -355,19 +355,20 @@ TEST(WetForces, CurlForcesFollowTheRotatedHelixAndVanishWhenDry) {
     for (size_t i = 0; i + 1 < n; ++i) EXPECT_LT((f[i] - 10.f * (p[i + 1] - p[i])).norm(), 1e-5f) << i;
 }
 
-TEST(WetForces, SpatialHashFindsEveryNeighbourOnce) {
+TEST(WetForces, SpatialGridFindsEveryNeighbourOnce) {
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> u(-0.05f, 0.05f);
     std::vector<Vec3f> pts(2000);
     for (Vec3f& p : pts) p = Vec3f(u(rng), u(rng), u(rng));
     std::vector<uint32_t> groups(pts.size());
     for (size_t i = 0; i < pts.size(); ++i) groups[i] = uint32_t(i % 7);
-    SpatialHash hash;
+    SpatialGrid grid;
     const float r = 0.01f;
-    hash.build(pts.data(), groups.data(), pts.size(), r);
+    grid.build(pts.data(), groups.data(), pts.size(), r);
+    ASSERT_EQ(grid.size(), pts.size());
     for (size_t i = 0; i < pts.size(); i += 37) {
         std::vector<int> seen(pts.size(), 0);
-        hash.forEachNear(pts[i], [&](uint32_t j, const Vec3f& p, uint32_t g) {
+        grid.forEachNear(pts[i], [&](uint32_t j, const Vec3f& p, uint32_t g) {
             ++seen[j];
             EXPECT_EQ(p, pts[j]);
             EXPECT_EQ(g, groups[j]);
@@ -381,6 +382,28 @@ TEST(WetForces, SpatialHashFindsEveryNeighbourOnce) {
     }
 }
 
+TEST(WetForces, SpatialGridStaysCorrectWhenSparseOrQueriedOutside) {
+    // A few points spread over 10 m: the grid coarsens its cells (memory stays
+    // linear) and must still find every neighbour, also for queries outside it.
+    std::vector<Vec3f> pts = {Vec3f(0.f, 0.f, 0.f), Vec3f(0.005f, 0.f, 0.f), Vec3f(10.f, 10.f, 10.f),
+                              Vec3f(9.995f, 10.f, 10.f), Vec3f(5.f, 0.f, 10.f)};
+    std::vector<uint32_t> groups = {0, 1, 2, 3, 4};
+    SpatialGrid grid;
+    grid.build(pts.data(), groups.data(), pts.size(), 0.01f);
+    auto near = [&](const Vec3f& x) {
+        std::vector<uint32_t> found;
+        grid.forEachNear(x, [&](uint32_t j, const Vec3f& p, uint32_t) {
+            if ((p - x).norm() < 0.01f) found.push_back(j);
+        });
+        return found;
+    };
+    EXPECT_EQ(near(pts[0]), (std::vector<uint32_t>{0, 1}));
+    EXPECT_EQ(near(pts[3]), (std::vector<uint32_t>{2, 3}));
+    EXPECT_EQ(near(Vec3f(-0.006f, 0.f, 0.f)), (std::vector<uint32_t>{0}));  // just outside the box
+    EXPECT_TRUE(near(Vec3f(-5.f, 0.f, 0.f)).empty());
+    EXPECT_TRUE(near(Vec3f(std::nanf(""), 0.f, 0.f)).empty());
+}
+
 TEST(WetForces, CohesionPullsTowardWetNeighboursOfOtherStrandsOnly) {
     // Two parallel strands 4 mm apart along X, plus a far third one.
     const size_t n = 10;
@@ -391,18 +414,18 @@ TEST(WetForces, CohesionPullsTowardWetNeighboursOfOtherStrandsOnly) {
             pts.push_back(Vec3f(s == 2 ? 0.5f : 0.004f * float(s), 0.002f * float(i), 0.f));
             strand.push_back(s);
         }
-    SpatialHash hash;
+    SpatialGrid grid;
     const float radius = 0.01f;
-    hash.build(pts.data(), strand.data(), pts.size(), radius);
+    grid.build(pts.data(), strand.data(), pts.size(), radius);
     std::vector<CohesionTarget> out(pts.size());
     std::vector<float> sigma(pts.size(), 0.f);
-    cohesionTargets(hash, pts.data(), sigma.data(), strand.data(), 0, pts.size(), radius, 0.85f, out.data());
+    cohesionTargets(grid, sigma.data(), 0, pts.size(), radius, 0.85f, out.data());
     for (const CohesionTarget& t : out) {
         EXPECT_EQ(t.offset.squaredNorm(), 0.f);  // dry: nothing
         EXPECT_EQ(t.weight, 0.f);
     }
     std::fill(sigma.begin(), sigma.end(), 1.f);
-    cohesionTargets(hash, pts.data(), sigma.data(), strand.data(), 0, pts.size(), radius, 0.85f, out.data());
+    cohesionTargets(grid, sigma.data(), 0, pts.size(), radius, 0.85f, out.data());
     for (size_t i = 0; i < n; ++i) {
         EXPECT_GT(out[i].offset.x(), 0.f) << i;        // strand 0 toward strand 1 (+X)
         EXPECT_LT(out[n + i].offset.x(), 0.f) << i;    // strand 1 toward strand 0
@@ -428,7 +451,7 @@ TEST(WetForces, CohesionPullsTowardWetNeighboursOfOtherStrandsOnly) {
     // Half as wet neighbours pull half as hard.
     std::fill(sigma.begin() + n, sigma.begin() + 2 * n, 0.5f);
     std::vector<CohesionTarget> half(pts.size());
-    cohesionTargets(hash, pts.data(), sigma.data(), strand.data(), 0, pts.size(), radius, 0.85f, half.data());
+    cohesionTargets(grid, sigma.data(), 0, pts.size(), radius, 0.85f, half.data());
     EXPECT_NEAR(half[mid].offset.x(), 0.5f * out[mid].offset.x(), 1e-6f * out[mid].offset.x());
 }
 
