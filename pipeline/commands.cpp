@@ -1,6 +1,7 @@
 #include "pipeline/commands.h"
 
 #include "core/log.h"
+#include "pipeline/curly_settings.h"
 #include "pipeline/frame_range.h"
 #include "pipeline/head_setup.h"
 #include "pipeline/progress.h"
@@ -131,6 +132,7 @@ CommandSpec validateCommandSpec() {
         resolveShot(ctx.scene, ctx.options);
         makeView(ctx.scene);  // checks across render keys
         if (sceneHasHead(ctx.scene)) loadHead(ctx.scene);  // mesh, clip and scalp selections
+        if (usesCurlyWetModel(ctx.scene)) curlyWetSettings(ctx.scene).validate();  // across hair.curly/wet keys
         std::cout << ctx.scene.name() << ": ok\n";
         return int(kExitOk);
     };

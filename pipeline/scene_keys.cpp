@@ -9,6 +9,7 @@ void addSceneKeys(SchemaBuilder& b) {
     addHeadKeys(b);
     addHairKeys(b);
     addFollowerKeys(b);
+    addCurlyKeys(b);
     addRenderKeys(b);
     addPreviewKeys(b);
     addReferenceKeys(b);

@@ -18,5 +18,6 @@ void addHeadKeys(SchemaBuilder& b);    // head: import, clip, scalp, collider (s
 void addHairKeys(SchemaBuilder& b);    // hair: root counts and placement (scene_keys_hair.cpp)
 void addReferenceKeys(SchemaBuilder& b);  // reference: Embree reference renderer (scene_keys_reference.cpp)
 void addVdbKeys(SchemaBuilder& b);     // vdb: OpenVDB density caches (scene_keys_vdb.cpp)
+void addCurlyKeys(SchemaBuilder& b);   // hair.model, hair.curly, hair.wet: the curly/wet model (scene_keys_curly.cpp)
 
 }  // namespace hp

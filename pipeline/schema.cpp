@@ -42,7 +42,12 @@ void Schema::add(KeySpec spec) {
     keys_.push_back(std::move(spec));
 }
 
-void Schema::section(const std::string& path, const std::string& doc) { sections_.push_back({path, doc}); }
+void Schema::section(const std::string& path, const std::string& doc) {
+    // Several files may open the same section (e.g. "hair"); the first doc wins.
+    for (const SectionSpec& s : sections_)
+        if (s.path == path) return;
+    sections_.push_back({path, doc});
+}
 
 const KeySpec* Schema::find(const std::string& path) const {
     for (const KeySpec& k : keys_)
