@@ -1,0 +1,256 @@
+// The production formulation: guides as Bullet soft-body ropes, corrected by
+// the kernels of sim/strand_constraints.h after every Bullet step.
+//
+// Division of labour per Bullet step h (one world per group of guides):
+//  1. Bullet (btSoftRigidDynamicsWorld, btSoftBody::predictMotion and
+//     solveConstraints): integrates gravity and velocities, then solves the
+//     stretch links with `iterations` mass-weighted Gauss-Seidel passes. This
+//     is the two-sided part of the dynamics: tension pulls the root side by
+//     the tip side, which a one-way follow-the-leader pass cannot do. The root
+//     node has zero mass and is moved by velocity to its kinematic target, so
+//     head motion enters the strand as real velocity.
+//  2. Kernels, root to tip, on each vertex: the joint spring toward the rest
+//     shape (implicit, XPBD compliance with the joint's subtree inertia, so κ
+//     means N·m/rad as in the rigid formulation), the gravity pre-load (a
+//     head-fixed push that makes the groom an exact equilibrium), the soft
+//     bend limit with projection,
+//     follow-the-leader (exact segment lengths), projection out of the head's
+//     signed distance keeping the collision radius clear.
+//  3. Velocities from positions (Müller's FTL damping), Coulomb friction
+//     against the moving head surface, damping exp(-c·h) (step-size free).
+//
+// Why this arrangement (measurements in the report / BENCHMARKS notes, B-sim
+// on this 2-core machine): STACK.md's probes found btMultiBody exact but too
+// soft (explicit springs) and slow in a shared world, rigid 6-DoF chains
+// tearing at one step, and plain soft-body ropes colliding well but stretching
+// ~12% at one step. Keeping Bullet's rope and fixing the residual with a
+// follow-the-leader pass gives exact lengths at one Bullet step per 0.02 s;
+// taking head contact to the signed distance (instead of Bullet's soft-rigid
+// sparse SDF) keeps every vertex out even when a strand moves centimetres per
+// step, and costs one distance query per vertex; small worlds with no
+// broadphase pairs (collision mask 0) scale linearly and in parallel.
+#include "sim/guide_group.h"
+
+#include <BulletSoftBody/btDefaultSoftBodySolver.h>
+#include <BulletSoftBody/btSoftBody.h>
+#include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
+#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
+#include <btBulletDynamicsCommon.h>
+
+#include <cmath>
+
+namespace hp::guides {
+namespace {
+
+inline btVector3 bt(const Vec3f& v) { return btVector3(v.x(), v.y(), v.z()); }
+inline Vec3f ei(const btVector3& v) { return Vec3f(v.x(), v.y(), v.z()); }
+
+/// Ropes never touch anything in their world, so its contact pools stay
+/// tiny (Bullet's default preallocates ~4 MB per world).
+btDefaultCollisionConstructionInfo smallPools() {
+    btDefaultCollisionConstructionInfo info;
+    info.m_defaultMaxPersistentManifoldPoolSize = 16;
+    info.m_defaultMaxCollisionAlgorithmPoolSize = 16;
+    return info;
+}
+
+/// Bullet's default soft-body solver with one addition at its extension
+/// point: before the link solve, compressed segments are relieved root to tip
+/// (strand::relieveCompression), so Bullet's two-sided link solve handles
+/// tension only.
+class StrandSoftBodySolver final : public btDefaultSoftBodySolver {
+  public:
+    explicit StrandSoftBodySolver(const GuideSet& set) : set_(set) {}
+    void solveConstraints(btScalar solverdt) override {
+        for (int b = 0; b < m_softBodySet.size(); ++b) {
+            btSoftBody* body = m_softBodySet[b];
+            const size_t g = size_t(body->getUserIndex());
+            const int n = body->m_nodes.size();
+            x_.resize(n);
+            for (int i = 0; i < n; ++i) x_[i] = ei(body->m_nodes[i].m_x);
+            strand::relieveCompression(x_.data(), &set_.restLength[set_.segment(g, 0)], size_t(n));
+            for (int i = 1; i < n; ++i) body->m_nodes[i].m_x = bt(x_[i]);
+        }
+        btDefaultSoftBodySolver::solveConstraints(solverdt);
+    }
+
+  private:
+    const GuideSet& set_;
+    std::vector<Vec3f> x_;
+};
+
+class RopeGroup final : public GuideGroup {
+  public:
+    RopeGroup(GuideSet& set, size_t begin, size_t end);
+    ~RopeGroup() override;
+
+    void reset() override;
+    void preload(const SubstepContext& ctx) override;
+    void substep(const SubstepContext& ctx) override;
+    double kineticEnergy() const override;
+    void jointAngles(float& bend, float& twist) const override;
+
+  private:
+    void load(size_t g, float h, float alpha);
+    void relax(size_t g, const SubstepContext& ctx);
+
+    btSoftBodyRigidBodyCollisionConfiguration config_{smallPools()};
+    btCollisionDispatcher dispatcher_{&config_};
+    btDbvtBroadphase broadphase_;
+    btSequentialImpulseConstraintSolver solver_;
+    StrandSoftBodySolver softSolver_{set_};
+    btSoftRigidDynamicsWorld world_{&dispatcher_, &broadphase_, &solver_, &config_, &softSolver_};
+    std::vector<btSoftBody*> bodies_;
+    // Scratch for one guide, reused (groups run one at a time per thread).
+    std::vector<Vec3f> x_;
+    std::vector<strand::Contact> contact_;
+};
+
+RopeGroup::RopeGroup(GuideSet& set, size_t begin, size_t end) : GuideGroup(set, begin, end) {
+    const GuideSettings& s = set.settings;
+    btSoftBodyWorldInfo& info = world_.getWorldInfo();
+    info.m_gravity = bt(s.gravity);
+    info.air_density = 0;  // no aerodynamics: damping is ours, step-size independent
+    info.water_density = 0;
+    world_.setGravity(bt(s.gravity));
+    const int n = set.vertices;
+    x_.resize(n);
+    contact_.resize(n);
+    std::vector<btVector3> pos(n);
+    std::vector<btScalar> mass(n);
+    for (size_t g = begin; g < end; ++g) {
+        for (int i = 0; i < n; ++i) {
+            pos[i] = bt(set.x[set.vertex(g, i)]);
+            mass[i] = set.mass[set.vertex(g, i)];  // root: 0 = kinematic
+        }
+        // Bullet takes each link's rest length from the nodes at its first
+        // step, which is always taken from the rest shape.
+        auto* body = new btSoftBody(&info, n, pos.data(), mass.data());
+        for (int j = 0; j < set.segments; ++j) body->appendLink(j, j + 1);
+        btSoftBody::Config& cfg = body->m_cfg;
+        cfg.piterations = s.iterations;
+        cfg.viterations = 0;
+        cfg.diterations = 0;
+        cfg.kDP = 0;          // damping is applied by the kernels, exp(-c·h)
+        cfg.collisions = 0;   // head contact is the signed-distance projection
+        cfg.m_psequence.clear();
+        cfg.m_psequence.push_back(btSoftBody::ePSolver::Linear);
+        body->setActivationState(DISABLE_DEACTIVATION);
+        body->setUserIndex(int(g));
+        // Bullet keeps a tree of node boxes per rope, refitted each step; a
+        // wide margin lets a node move centimetres before its box is re-inserted.
+        body->getCollisionShape()->setMargin(0.05f);
+        // Mask 0: the broadphase never pairs a rope with anything, so a world's
+        // cost is linear in its guides.
+        world_.addSoftBody(body, btBroadphaseProxy::DefaultFilter, 0);
+        bodies_.push_back(body);
+    }
+}
+
+RopeGroup::~RopeGroup() {
+    for (btSoftBody* b : bodies_) {
+        world_.removeSoftBody(b);
+        delete b;
+    }
+}
+
+void RopeGroup::reset() {
+    for (size_t g = begin_; g < end_; ++g) {
+        set_.restShape(g, set_.rootPos1[g], set_.rootRot1[g].toRotationMatrix(), &set_.x[set_.vertex(g, 0)]);
+        for (int i = 0; i < set_.vertices; ++i) set_.v[set_.vertex(g, i)] = Vec3f::Zero();
+    }
+}
+
+void RopeGroup::load(size_t g, float h, float alpha) {
+    btSoftBody* body = bodies_[g - begin_];
+    for (int i = 0; i < set_.vertices; ++i) {
+        btSoftBody::Node& node = body->m_nodes[i];
+        node.m_x = bt(set_.x[set_.vertex(g, i)]);
+        node.m_v = bt(set_.v[set_.vertex(g, i)]);
+    }
+    // The massless root moves to its target by velocity during
+    // predictMotion, so head motion enters the strand as real velocity.
+    body->m_nodes[0].m_v = bt((set_.rootPosition(g, alpha) - set_.x[set_.vertex(g, 0)]) / h);
+}
+
+void RopeGroup::preload(const SubstepContext& ctx) {
+    // One Bullet step from rest shows how far gravity moves each joint; the
+    // joint pass then aims each spring past the rest direction by that much,
+    // so the rest shape is an exact equilibrium (see strand::relaxJoints).
+    // The targets are joint angles, like a pre-bent rod's, so they turn with
+    // the parent segment; a push fixed in space instead (a follower load on
+    // a cantilever) flutters (measured: ×4 energy per step).
+    for (size_t g = begin_; g < end_; ++g) load(g, ctx.h, ctx.alpha);
+    world_.stepSimulation(ctx.h, 0, ctx.h);
+    const int n = set_.vertices;
+    for (size_t g = begin_; g < end_; ++g) {
+        const btSoftBody* body = bodies_[g - begin_];
+        for (int i = 0; i < n; ++i) x_[i] = ei(body->m_nodes[i].m_x);
+        x_[0] = set_.x[set_.vertex(g, 0)];
+        strand::relaxJoints(x_.data(), n, set_.rootRot1[g].toRotationMatrix(), set_.joints(g), nullptr, 0.f,
+                            nullptr, true);
+    }
+}
+
+void RopeGroup::substep(const SubstepContext& ctx) {
+    for (size_t g = begin_; g < end_; ++g) load(g, ctx.h, ctx.alpha);
+    world_.stepSimulation(ctx.h, 0, ctx.h);
+    for (size_t g = begin_; g < end_; ++g) relax(g, ctx);
+}
+
+void RopeGroup::relax(size_t g, const SubstepContext& ctx) {
+    const GuideSettings& s = set_.settings;
+    const float h = ctx.h;
+    const strand::HeadQuery* head = ctx.headCollision && ctx.head.collider ? &ctx.head : nullptr;
+    const btSoftBody* body = bodies_[g - begin_];
+    const int n = set_.vertices;
+    for (int i = 0; i < n; ++i) x_[i] = ei(body->m_nodes[i].m_x);
+    x_[0] = set_.rootPosition(g, ctx.alpha);
+    strand::relaxJoints(x_.data(), n, set_.rootRotation(g, ctx.alpha).toRotationMatrix(), set_.joints(g), head,
+                        s.collisionRadius, contact_.data());
+
+    // Velocities from positions (position-based dynamics), then friction
+    // against the moving head and step-size independent damping.
+    const float damp = strand::dampingFactor(s.damping, h);
+    for (int i = 0; i < n; ++i) {
+        const size_t k = set_.vertex(g, i);
+        Vec3f v = (x_[i] - set_.x[k]) / h;
+        if (i > 0) {
+            if (contact_[i].active)
+                v = strand::contactFriction(v, ctx.head.surfaceVelocity(x_[i], h), contact_[i], s.friction, h);
+            v *= damp;
+        }
+        set_.x[k] = x_[i];
+        set_.v[k] = v;
+    }
+}
+
+double RopeGroup::kineticEnergy() const {
+    double e = 0;
+    for (size_t g = begin_; g < end_; ++g)
+        for (int i = 1; i < set_.vertices; ++i) {
+            const size_t k = set_.vertex(g, i);
+            e += 0.5 * set_.mass[k] * set_.v[k].squaredNorm();
+        }
+    return e;
+}
+
+void RopeGroup::jointAngles(float& bend, float& twist) const {
+    bend = 0.f;
+    twist = 0.f;
+    for (size_t g = begin_; g < end_; ++g)
+        bend = std::max(bend, maxBendAngle(set_, g, &set_.x[set_.vertex(g, 0)], set_.rootRot1[g]));
+}
+
+class RopeFormulation final : public Formulation {
+  public:
+    std::unique_ptr<GuideGroup> makeGroup(GuideSet& set, size_t begin, size_t end) override {
+        return std::make_unique<RopeGroup>(set, begin, end);
+    }
+};
+
+}  // namespace
+
+std::unique_ptr<Formulation> makeRopeFormulation(const GuideSet&) { return std::make_unique<RopeFormulation>(); }
+
+}  // namespace hp::guides

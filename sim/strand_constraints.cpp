@@ -1,0 +1,201 @@
+#include "sim/strand_constraints.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace hp::strand {
+
+Mat3f rootRotation(const SurfaceFrame& frame) {
+    const Vec3f n = frame.normal.normalized();
+    Vec3f t = frame.tangent - n * n.dot(frame.tangent);
+    t = t.squaredNorm() > 1e-12f ? Vec3f(t.normalized()) : Vec3f(n.unitOrthogonal());
+    Mat3f r;
+    r.col(0) = t;
+    r.col(1) = n;
+    r.col(2) = t.cross(n);
+    return r;
+}
+
+float springFraction(float stiffness, float inertia, float h) {
+    const float k = stiffness * h * h;
+    return k > 0.f ? k / (inertia + k) : 0.f;
+}
+
+float dampingFactor(float rate, float h) { return std::exp(-rate * h); }
+
+Quatf transport(const Vec3f& from, const Vec3f& to) {
+    // For unit a, b the half-way quaternion (1 + a·b, a×b), normalised, is the
+    // minimal rotation; only the antiparallel case needs Eigen's general path.
+    const float w = 1.f + from.dot(to);
+    if (w < 1e-6f) return Quatf::FromTwoVectors(from, to);
+    const Vec3f v = from.cross(to);
+    return Quatf(w, v.x(), v.y(), v.z()).normalized();
+}
+
+float angleBetween(const Vec3f& a, const Vec3f& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
+
+Vec3f rotateToAngle(const Vec3f& d, const Vec3f& axis, float angle) {
+    Vec3f perp = d - axis * axis.dot(d);
+    const float len = perp.norm();
+    // d parallel to the axis: any perpendicular will do (only reached when
+    // angle > 0 is asked of a direction at angle 0 or π).
+    perp = len > 1e-12f ? Vec3f(perp / len) : Vec3f(axis.unitOrthogonal());
+    return std::cos(angle) * axis + std::sin(angle) * perp;
+}
+
+Vec3f limitBend(const Vec3f& d, const Vec3f& axis, float limit, float fraction, float projection) {
+    const float theta = angleBetween(d, axis);
+    if (theta <= limit) return d;
+    const float soft = theta - fraction * (theta - limit);
+    return rotateToAngle(d, axis, std::min(soft, limit + projection));
+}
+
+Vec3f followTheLeader(const Vec3f& parent, const Vec3f& child, float length) {
+    const Vec3f e = child - parent;
+    const float len = e.norm();
+    // A collapsed segment keeps its length along an arbitrary (deterministic) axis.
+    return len > 1e-12f ? Vec3f(parent + e * (length / len)) : Vec3f(parent + Vec3f::UnitY() * length);
+}
+
+void followTheLeader(Vec3f* x, const float* restLength, size_t vertexCount, Vec3f* correction) {
+    if (correction && vertexCount > 0) correction[0] = Vec3f::Zero();
+    for (size_t i = 0; i + 1 < vertexCount; ++i) {
+        const Vec3f placed = followTheLeader(x[i], x[i + 1], restLength[i]);
+        if (correction) correction[i + 1] = placed - x[i + 1];
+        x[i + 1] = placed;
+    }
+}
+
+void relieveCompression(Vec3f* x, const float* restLength, size_t vertexCount) {
+    for (size_t i = 0; i + 1 < vertexCount; ++i)
+        if ((x[i + 1] - x[i]).squaredNorm() < restLength[i] * restLength[i])
+            x[i + 1] = followTheLeader(x[i], x[i + 1], restLength[i]);
+}
+
+float HeadQuery::distance(const Vec3f& x, Vec3f* normal) const {
+    Vec3f n;
+    const float d = collider->signedDistance(toCollider * x, &n);
+    if (normal) *normal = normalToWorld * n;
+    return d;
+}
+
+Contact projectOut(const HeadQuery& head, float radius, Vec3f& x) {
+    Contact c;
+    if (!head.collider) return c;
+    Vec3f n;
+    const float d = head.distance(x, &n);
+    if (d >= radius) return c;
+    c.active = true;
+    c.normal = n;
+    c.push = radius - d;
+    x += c.push * n;
+    return c;
+}
+
+Contact placeSegment(const Vec3f& parent, Vec3f& child, float length, const HeadQuery* head, float radius) {
+    child = followTheLeader(parent, child, length);
+    Contact total;
+    if (!head || !head->collider) return total;
+    const Vec3f start = child;
+    for (int iter = 0; iter < 4; ++iter) {
+        const Contact c = projectOut(*head, radius, child);
+        if (!c.active) break;
+        total.active = true;
+        total.normal = c.normal;
+        child = followTheLeader(parent, child, length);
+    }
+    if (total.active) {
+        // A last projection guarantees the clearance; it can only cost length
+        // when the parent itself sits inside the clearance band.
+        const Contact c = projectOut(*head, radius, child);
+        if (c.active) total.normal = c.normal;
+        total.push = std::max(0.f, (child - start).dot(total.normal));
+    }
+    return total;
+}
+
+Vec3f contactFriction(const Vec3f& v, const Vec3f& vs, const Contact& contact, float mu, float h) {
+    if (!contact.active) return v;
+    const Vec3f& n = contact.normal;
+    const Vec3f rel = v - vs;
+    const float vnRaw = rel.dot(n) - contact.push / h;  // what it would have been without the push
+    const float vn = std::max(vnRaw, 0.f);
+    const float removed = vn - vnRaw;                    // ≥ 0: approach speed the contact stopped
+    Vec3f vt = rel - rel.dot(n) * n;
+    const float vtLen = vt.norm();
+    if (vtLen > 0.f) vt *= std::max(0.f, 1.f - mu * removed / vtLen);
+    return vs + vn * n + vt;
+}
+
+void relaxJoints(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& p, const HeadQuery* head,
+                 float radius, Contact* contacts, bool solvePreload) {
+    Mat3f Q = rootFrame;
+    if (contacts) contacts[0] = Contact{};
+    // Carrying every subtree explicitly costs O(n²); instead the carries are
+    // composed into one rigid map (C, c) applied to each vertex when its turn
+    // comes: the vertex's current position is C·x + c.
+    Mat3f C = Mat3f::Identity();
+    Vec3f c = Vec3f::Zero();
+    const float cosLimit = std::cos(p.limit);
+    for (int j = 0; j + 1 < vertexCount; ++j) {
+        const Vec3f parent = x[j];
+        const Vec3f oldChild = C * x[j + 1] + c;
+        const float length = p.restLength[j];
+        const Vec3f rest = Q * p.restDir[j];
+        const Vec3f e = oldChild - parent;
+        const float len = e.norm();
+        const Vec3f d = len > 1e-12f ? Vec3f(e / len) : rest;
+        const float f = p.spring[j];
+        Vec3f dir;
+        if (solvePreload) {
+            // Aim past the rest direction r so that the spring step lands on
+            // it: normalize((1-f)·d + f·t) = r with |t| = 1 gives
+            // t = (λ·r - (1-f)·d)/f, λ the positive root of
+            // λ² - 2λ(1-f)(r·d) + (1-f)² - f² = 0.
+            Vec3f target = rest;
+            if (f > 0.f) {
+                const float g = 1.f - f, cd = rest.dot(d);
+                const float lambda = g * cd + std::sqrt(std::max(0.f, g * g * cd * cd - g * g + f * f));
+                target = ((lambda * rest - g * d) / f).normalized();
+                // A pre-bend far beyond the joint's limit makes a soft joint
+                // unstable; such a joint keeps some sag instead.
+                if (angleBetween(target, rest) > 2.f * p.limit) target = rotateToAngle(target, rest, 2.f * p.limit);
+            }
+            p.springDir[j] = Q.transpose() * target;
+            dir = rest;
+        } else {
+            // The implicit spring on the segment's end, x ← x + f·(x* - x),
+            // renormalised onto the segment's length.
+            dir = ((1.f - f) * d + f * (Q * p.springDir[j])).normalized();
+            if (dir.dot(rest) < cosLimit) dir = limitBend(dir, rest, p.limit, p.limitSpring[j], p.projection);
+        }
+        Vec3f child = parent + length * dir;
+        const Contact k = placeSegment(parent, child, length, head, radius);
+        if (contacts) contacts[j + 1] = k;
+        const Vec3f dFinal = (child - parent) / (child - parent).norm();
+        // Carry the subtree: rotate it with the segment, shift it with the length fix.
+        const Mat3f q = transport(d, dFinal).toRotationMatrix();
+        C = q * C;
+        c = child + q * (c - oldChild);
+        x[j + 1] = child;
+        Q = transport(rest, dFinal).toRotationMatrix() * Q;
+    }
+}
+
+void separateSegments(Vec3f& a0, Vec3f& a1, Vec3f& b0, Vec3f& b1, float s, float t, const Vec3f& normal,
+                      float depth, const float w[4]) {
+    const float alpha[2] = {1.f - s, s};
+    const float beta[2] = {1.f - t, t};
+    const float denom = w[0] * alpha[0] * alpha[0] + w[1] * alpha[1] * alpha[1] + w[2] * beta[0] * beta[0] +
+                        w[3] * beta[1] * beta[1];
+    if (denom <= 0.f) return;
+    const float lambda = depth / denom;
+    a0 += w[0] * alpha[0] * lambda * normal;
+    a1 += w[1] * alpha[1] * lambda * normal;
+    b0 -= w[2] * beta[0] * lambda * normal;
+    b1 -= w[3] * beta[1] * lambda * normal;
+}
+
+}  // namespace hp::strand

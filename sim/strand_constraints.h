@@ -1,0 +1,166 @@
+// Solver kernels for guide strands: pure functions on plain vectors, each
+// with its governing equation, testable without a physics world (after
+// PositionBasedDynamics). The rope formulation (sim/rope_group.cpp) runs them
+// after every Bullet step; the rigid formulation uses the collision and
+// measurement kernels.
+//
+// Notation: x_i vertex positions (x_0 the root), l_i rest length of segment
+// i = (x_i, x_{i+1}), h the Bullet step, m mass, κ angular stiffness.
+#pragma once
+
+#include "sim/head.h"
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <cstddef>
+
+namespace hp::strand {
+
+using Mat3f = Eigen::Matrix3f;
+using Quatf = Eigen::Quaternionf;
+
+/// The root's orthonormal, right-handed frame as a rotation: columns
+/// (tangent, normal, tangent × normal), the tangent re-orthogonalised against
+/// the normal. Rest shapes are stored in these root-local coordinates.
+Mat3f rootRotation(const SurfaceFrame& frame);
+
+/// Compliance of an implicit spring in one XPBD iteration (Macklin 2016):
+/// a constraint C with stiffness κ on a coordinate of inertia I is corrected by
+///   Δ = -C · h²κ / (I + h²κ),
+/// which is implicit Euler for the spring: stable for any κ, and the static
+/// sag under a load τ is τ/κ whatever h. Returns the fraction h²κ/(I + h²κ).
+float springFraction(float stiffness, float inertia, float h);
+
+/// Velocity damping over a time h: v ← v·exp(-c·h). Applying it n times with
+/// h/n gives the same decay, so damping does not depend on the step size.
+float dampingFactor(float rate, float h);
+
+/// The rotation-minimising transport of a frame: the smallest rotation taking
+/// unit vector `from` to unit vector `to` (parallel transport along a bend).
+Quatf transport(const Vec3f& from, const Vec3f& to);
+
+/// Angle between unit vectors, radians, accurate near 0 (atan2 of |a×b|, a·b).
+float angleBetween(const Vec3f& a, const Vec3f& b);
+
+/// Rotates unit `d` toward unit `axis` in their common plane so the angle
+/// between them is exactly `angle` (radians):
+///   d' = cos(angle)·axis + sin(angle)·normalize(d - (d·axis)·axis).
+Vec3f rotateToAngle(const Vec3f& d, const Vec3f& axis, float angle);
+
+/// Soft cone limit of one joint (seed: soft ±limit with a spring pushing back,
+/// and a projection limit). θ = angle(d, axis); beyond `limit` the excess
+/// decays by the spring fraction f: θ' = θ - f·(θ - limit); then θ' is
+/// clamped to limit + projection. Returns the limited direction (unit).
+Vec3f limitBend(const Vec3f& d, const Vec3f& axis, float limit, float fraction, float projection);
+
+/// Follow-the-leader (Müller et al. 2012): places the child at exactly the rest
+/// length from its already-placed parent, along the current direction:
+///   x_{i+1} ← x_i + l_i · (x_{i+1} - x_i)/|x_{i+1} - x_i|.
+Vec3f followTheLeader(const Vec3f& parent, const Vec3f& child, float length);
+
+/// Follow-the-leader along a whole strand, root fixed. `correction[i]` (may
+/// be null) receives x_i(after) - x_i(before), used for the velocity update.
+void followTheLeader(Vec3f* x, const float* restLength, size_t vertexCount, Vec3f* correction = nullptr);
+
+/// Follow-the-leader on compressed segments only: where |x_{i+1} - x_i| < l_i
+/// the child is pushed out to l_i along the segment, root to tip; stretched
+/// segments are left alone. Run before a mass-weighted link solve so that it
+/// only sees tension: Gauss-Seidel on a compressed limp chain folds it into a
+/// zig-zag (measured: 8° kinks at the root of a standing strand), whereas a
+/// hair resists buckling through its bending stiffness.
+void relieveCompression(Vec3f* x, const float* restLength, size_t vertexCount);
+
+/// The head during one Bullet step, as the kernels see it. The collider is
+/// posed at the end of the outer step; `toCollider` maps a world point at the
+/// end of this Bullet step onto that pose (identity without substeps) and
+/// `normalToWorld` maps normals back; `toPrevious` maps a point riding on the
+/// head at the end of the step to where it was at the step's start, which
+/// gives the surface velocity for friction. Rigid head motion is exact; a
+/// deforming head's non-rigid motion is taken from the end pose.
+struct HeadQuery {
+    const Collider* collider = nullptr;
+    Eigen::Isometry3f toCollider = Eigen::Isometry3f::Identity();
+    Mat3f normalToWorld = Mat3f::Identity();
+    Eigen::Isometry3f toPrevious = Eigen::Isometry3f::Identity();
+
+    /// Signed distance (negative inside) and outward world normal at `x`.
+    float distance(const Vec3f& x, Vec3f* normal) const;
+    /// Velocity of the head surface at `x` over a step of length h.
+    Vec3f surfaceVelocity(const Vec3f& x, float h) const { return (x - toPrevious * x) / h; }
+};
+
+/// What a contact did to one vertex (for the velocity update).
+struct Contact {
+    bool active = false;
+    Vec3f normal = Vec3f::Zero();  ///< outward head normal
+    float push = 0.f;              ///< distance moved out along the normal, m
+};
+
+/// Projection out of the head's signed distance φ, keeping `radius` clear:
+///   if φ(x) < r:  x ← x + (r - φ(x))·∇φ(x).
+Contact projectOut(const HeadQuery& head, float radius, Vec3f& x);
+
+/// Places a child vertex at exactly `length` from its parent and outside the
+/// head: follow-the-leader, then (if inside) projection out of φ and back onto
+/// the sphere of radius `length` about the parent, repeated a few times; the
+/// two sets (a sphere around the parent, the outside of the head) intersect
+/// whenever the parent is outside, so this converges to a point on both. If
+/// it cannot (parent deep inside), the head wins over the length.
+Contact placeSegment(const Vec3f& parent, Vec3f& child, float length, const HeadQuery* head, float radius);
+
+/// Coulomb friction for a vertex the head pushed out by `push` during the
+/// step (velocity level, relative to the surface velocity vs):
+///   v_rel = v - vs; the push added push/h along n, which is removed (no
+///   bounce); the normal part is clamped to ≥ 0 (no approach); Δv_n is what
+///   the contact removed; the tangential part shrinks by at most μ·Δv_n
+///   (static friction when that stops it).
+Vec3f contactFriction(const Vec3f& v, const Vec3f& vs, const Contact& contact, float mu, float h);
+
+/// Per-joint parameters of relaxJoints, for joint j (segment j relative to
+/// its parent segment, or to the root frame for j = 0).
+struct JointParams {
+    const float* restLength;    ///< l_j
+    const Vec3f* restDir;       ///< e_j: rest direction, root-local, unit
+    Vec3f* springDir;           ///< t_j: spring target direction, root-local, unit (e_j rotated by the pre-load)
+    const float* spring;        ///< f_j = springFraction(κ, I_j, h), I_j = m_{j+1}·l_j²
+    const float* limitSpring;   ///< the same for the limit spring
+    float limit = 0.f;          ///< bend limit, radians
+    float projection = 0.f;     ///< projection limit beyond it, radians
+};
+
+/// The rope's joint pass, root to tip, after a Bullet step. Joint j's frame
+/// Q_j is the root frame R carried along the strand (Q_0 = R, Q_{j+1} =
+/// transport(Q_j e_j → d_j)·Q_j), so springs and limits act on relative bends.
+/// At joint j, with d = direction of segment j:
+///  1. spring (implicit): move the segment's end toward the target
+///     x_j + l_j·Q_j t_j by the fraction f_j and renormalise — the XPBD step
+///     of a joint drive κ on the segment (inertia I_j), like a joint motor
+///     driving its child body;
+///  2. soft limit: beyond `limit` from the rest direction Q_j e_j the excess
+///     shrinks by the limit spring's fraction, and never exceeds
+///     limit + projection (limitBend);
+///  3. length: the vertex is placed at exactly l_j (follow-the-leader), then
+///     out of the head (placeSegment), which has the last word;
+///  4. the subtree beyond x_{j+1} is carried rigidly with the segment (the
+///     joint's rotation and the length shift), so every joint's correction
+///     moves what hangs from it, as a reduced-coordinate joint would.
+/// With `solvePreload` (the strand at rest, after one Bullet step from rest)
+/// the pass instead sets each t_j so that step 1 lands exactly on e_j:
+/// t_j solves normalize((1-f_j)·d + f_j·t_j) = e_j (at most 2·limit from e_j), which
+/// makes the rest shape an equilibrium under gravity (the pre-load).
+/// `contacts[i]` receives what the head did to vertex i (may be null).
+void relaxJoints(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& joints,
+                 const HeadQuery* head, float radius, Contact* contacts, bool solvePreload = false);
+
+/// Pushes two segments apart along `normal` (from B to A) by `depth` at the
+/// parameters s (on A: a0→a1) and t (on B), weighted by inverse masses w:
+///   Δa_k = +w_ak·α_k·λ·n, Δb_k = -w_bk·β_k·λ·n,  λ = depth / Σ w·(weight)²,
+/// with α = (1-s, s), β = (1-t, t) (position-based edge-edge contact).
+void separateSegments(Vec3f& a0, Vec3f& a1, Vec3f& b0, Vec3f& b1, float s, float t, const Vec3f& normal,
+                      float depth, const float w[4]);
+
+/// |l/l_rest - 1| of segment (a, b).
+inline float stretch(const Vec3f& a, const Vec3f& b, float rest) { return std::abs((b - a).norm() / rest - 1.f); }
+
+}  // namespace hp::strand
