@@ -7,6 +7,7 @@ void addSceneKeys(SchemaBuilder& b) {
     addShotKeys(b);
     addOutputKeys(b);
     addRenderKeys(b);
+    addSimKeys(b);
 }
 
 void addShotKeys(SchemaBuilder& b) {

@@ -11,5 +11,6 @@ void addSceneKeys(SchemaBuilder& b);
 void addShotKeys(SchemaBuilder& b);    // top level: name, frames, fps, seed
 void addOutputKeys(SchemaBuilder& b);  // output: directory, templates
 void addRenderKeys(SchemaBuilder& b);  // render: camera, lights, materials (scene_keys_render.cpp)
+void addSimKeys(SchemaBuilder& b);     // simulation.*, hair.guides shape, hair.radius (scene_keys_sim.cpp)
 
 }  // namespace hp

@@ -40,6 +40,10 @@ struct GuideSet {
     std::vector<float> jointInertia;  ///< per segment: m_{j+1}·l_j², the joint drive's inertia, kg·m²
     std::vector<float> mass;          ///< per vertex (0 for the kinematic root)
 
+    /// Bumped whenever x / v are written outside a group's own substep (a
+    /// reset, strand-strand contacts), so the groups reload their worlds.
+    unsigned version = 0;
+
     // State at the end of the last step and of the step before.
     std::vector<Vec3f> x, v;
     std::vector<Vec3f> xPrev, vPrev;
@@ -137,6 +141,10 @@ class StrandContacts {
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
+
+/// Lowers Bullet's global contact breaking threshold to hair scale (2 mm);
+/// called before any world that has contacts is built.
+void useHairScaleContactThreshold();
 
 /// Bend angle of every joint of guide g relative to its rest shape (rope
 /// measure: transported frames, no twist); returns the largest, radians.

@@ -215,6 +215,7 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
     if (s.strandCollision && s.formulation == GuideFormulation::Rope)
         m.contacts = std::make_unique<guides::StrandContacts>(set);
 
+    ++set.version;
     if (s.preload) {
         guides::SubstepContext ctx;
         ctx.h = s.timeStep / float(s.substeps);
@@ -258,6 +259,7 @@ const GuideStats& GuideSolver::step(const std::vector<SurfaceFrame>& roots, cons
     set.headTransform = T1;
     if (teleport) {
         m.forGroups([](guides::GuideGroup& grp) { grp.reset(); });
+        ++set.version;
         set.xPrev = set.x;
         set.vPrev = set.v;
     } else {
@@ -284,6 +286,7 @@ const GuideStats& GuideSolver::step(const std::vector<SurfaceFrame>& roots, cons
             if (m.contacts) {
                 const strand::HeadQuery* hq = ctx.headCollision && ctx.head.collider ? &ctx.head : nullptr;
                 strandContacts += m.contacts->solve(set, ctx.h, [&](size_t g) { m.relax(g, hq); });
+                ++set.version;
             }
         }
     }

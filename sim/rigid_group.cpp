@@ -53,8 +53,9 @@ btDefaultCollisionConstructionInfo pools(int segments) {
 }
 
 // The angles btGeneric6DofSpring2Constraint reports for RO_XYZ (its
-// matrixToEulerXYZ) of a relative rotation r = A⁻¹B of the joint frames:
-// r = Rx(x)·Ry(y)·Rz(z). fromEulerXYZ is the inverse.
+// matrixToEulerXYZ, which reads the matrix transposed) are those of
+// r = B⁻¹A for joint frames A, B: r = Rx(x)·Ry(y)·Rz(z) (checked against
+// getAngle on random poses). fromEulerXYZ is the inverse.
 Vec3f eulerXYZ(const Mat3f& r) {
     const float sy = std::clamp(r(0, 2), -1.f, 1.f);
     return Vec3f(std::atan2(-r(1, 2), r(2, 2)), std::asin(sy), std::atan2(-r(0, 1), r(0, 0)));
@@ -106,9 +107,9 @@ class RigidGroup final : public GuideGroup {
     RigidShared& shared_;
     btDefaultCollisionConfiguration config_{pools(set_.settings.strandsPerWorld * set_.segments)};
     btCollisionDispatcher dispatcher_{&config_};
-    btDbvtBroadphase broadphase_;
+    std::unique_ptr<bt32BitAxisSweep3> broadphase_;
     btSequentialImpulseConstraintSolver solver_;
-    btDiscreteDynamicsWorld world_{&dispatcher_, &broadphase_, &solver_, &config_};
+    std::unique_ptr<btDiscreteDynamicsWorld> world_;
     std::unique_ptr<btRigidBody> head_;
     std::vector<std::unique_ptr<btRigidBody>> roots_, segments_;
     std::vector<std::unique_ptr<btGeneric6DofSpring2Constraint>> joints_;
@@ -118,8 +119,19 @@ class RigidGroup final : public GuideGroup {
 RigidGroup::RigidGroup(GuideSet& set, size_t begin, size_t end, RigidShared& shared)
     : GuideGroup(set, begin, end), shared_(shared) {
     const GuideSettings& s = set.settings;
-    world_.setGravity(bt(s.gravity));
-    world_.getSolverInfo().m_numIterations = s.iterations;
+    // Sweep-and-prune: Bullet's AABB tree pads every box by 5 cm, pairing each
+    // 1 cm capsule with hundreds of others; SAP needs bounds, taken around the
+    // guides' start, wide enough for the head to travel (outside them it
+    // still works, only slower).
+    Eigen::AlignedBox3f box;
+    for (size_t g = begin; g < end; ++g) box.extend(set.x[set.vertex(g, 0)]);
+    box.extend(set.headTransform.translation());
+    const Vec3f pad = Vec3f::Constant(2.f * s.length + 10.f);
+    broadphase_ = std::make_unique<bt32BitAxisSweep3>(bt(Vec3f(box.min() - pad)), bt(Vec3f(box.max() + pad)),
+                                                      unsigned((end - begin) * (set.segments + 1) + 16), nullptr, true);
+    world_ = std::make_unique<btDiscreteDynamicsWorld>(&dispatcher_, broadphase_.get(), &solver_, &config_);
+    world_->setGravity(bt(s.gravity));
+    world_->getSolverInfo().m_numIterations = s.iterations;
     const float friction = std::sqrt(s.friction);  // Bullet multiplies the two bodies' coefficients
     const float lin = 1.f - std::exp(-s.damping);
     const float deg = float(M_PI / 180.0);
@@ -130,14 +142,20 @@ RigidGroup::RigidGroup(GuideSet& set, size_t begin, size_t end, RigidShared& sha
         head_->setCollisionFlags(head_->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
         head_->setActivationState(DISABLE_DEACTIVATION);
         head_->setFriction(friction);
-        world_.addRigidBody(head_.get(), kHeadGroup, kStrandGroup);
+        head_->setWorldTransform(bt(set.headTransform));  // posed before insertion, like every body here
+        head_->setInterpolationWorldTransform(bt(set.headTransform));
+        world_->addRigidBody(head_.get(), kHeadGroup, kStrandGroup);
     }
     for (size_t g = begin; g < end; ++g) {
         btRigidBody::btRigidBodyConstructionInfo rci(0, nullptr, &shared.rootShape);
         auto root = std::make_unique<btRigidBody>(rci);
         root->setCollisionFlags(root->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
         root->setActivationState(DISABLE_DEACTIVATION);
-        world_.addRigidBody(root.get(), 0, 0);
+        const Mat3f rootR = set.rootRot1[g].toRotationMatrix();
+        root->setWorldTransform(btTransform(bt(set.rootRot1[g]), bt(set.rootPos1[g])));
+        world_->addRigidBody(root.get(), 0, 0);
+        std::vector<Vec3f> rest(set.vertices);
+        set.restShape(g, set.rootPos1[g], rootR, rest.data());
         // Rest rotations: each segment's local Y along its rest direction, the
         // frame carried from the root by the minimal rotation (no twist).
         Mat3f R = Mat3f::Identity();
@@ -156,12 +174,20 @@ RigidGroup::RigidGroup(GuideSet& set, size_t begin, size_t end, RigidShared& sha
             btCapsuleShape* shape = shared.capsule(len, s.collisionRadius);
             btVector3 inertia;
             shape->calculateLocalInertia(m, inertia);
+            // A 1 mm capsule's inertia about its own axis is ~100× below the
+            // others; Bullet's joint solver then spins it up (twist at its
+            // limit, energy growing). The axial inertia is raised to the
+            // transverse one, as physics engines recommend for thin bodies.
+            inertia.setY(inertia.x());
             btRigidBody::btRigidBodyConstructionInfo ci(m, nullptr, shape, inertia);
             auto body = std::make_unique<btRigidBody>(ci);
             body->setActivationState(DISABLE_DEACTIVATION);
             body->setFriction(friction);
             body->setDamping(lin, lin);
-            world_.addRigidBody(body.get(), kStrandGroup, kHeadGroup | (s.strandCollision ? kStrandGroup : 0));
+            // Posed before insertion: bodies all at the origin would first
+            // pair every capsule with every other.
+            body->setWorldTransform(btTransform(bt(Quatf(rootR * R)), bt(Vec3f(0.5f * (rest[j] + rest[j + 1])))));
+            world_->addRigidBody(body.get(), kStrandGroup, kHeadGroup | (s.strandCollision ? kStrandGroup : 0));
             // Joint frames: at the parent's far end and this segment's near
             // end, oriented so the rest pose is the zero of every angle.
             btTransform frameA, frameB;
@@ -182,7 +208,7 @@ RigidGroup::RigidGroup(GuideSet& set, size_t begin, size_t end, RigidShared& sha
                 jt->setDamping(a, s.bendDamping);
                 jt->setEquilibriumPoint(a, 0);
             }
-            world_.addConstraint(jt.get(), true);
+            world_->addConstraint(jt.get(), true);
             parent = body.get();
             parentLength = len;
             parentRot = R;
@@ -195,10 +221,10 @@ RigidGroup::RigidGroup(GuideSet& set, size_t begin, size_t end, RigidShared& sha
 }
 
 RigidGroup::~RigidGroup() {
-    for (auto& j : joints_) world_.removeConstraint(j.get());
-    for (auto& b : segments_) world_.removeRigidBody(b.get());
-    for (auto& b : roots_) world_.removeRigidBody(b.get());
-    if (head_) world_.removeRigidBody(head_.get());
+    for (auto& j : joints_) world_->removeConstraint(j.get());
+    for (auto& b : segments_) world_->removeRigidBody(b.get());
+    for (auto& b : roots_) world_->removeRigidBody(b.get());
+    if (head_) world_->removeRigidBody(head_.get());
 }
 
 void RigidGroup::placeAtRest(size_t g) {
@@ -252,7 +278,7 @@ void RigidGroup::preload(const SubstepContext& ctx) {
     for (int round = 0; round < 3; ++round) {
         reset();
         moveKinematic(ctx);
-        for (int k = 0; k < 40; ++k) world_.stepSimulation(ctx.h, 0, ctx.h);
+        for (int k = 0; k < 40; ++k) world_->stepSimulation(ctx.h, 0, ctx.h);
         for (auto& jt : joints_) {
             jt->calculateTransforms();
             for (int a = 0; a < 3; ++a) {
@@ -270,7 +296,7 @@ void RigidGroup::preload(const SubstepContext& ctx) {
 
 void RigidGroup::substep(const SubstepContext& ctx) {
     moveKinematic(ctx);
-    world_.stepSimulation(ctx.h, 0, ctx.h);
+    world_->stepSimulation(ctx.h, 0, ctx.h);
     for (size_t g = begin_; g < end_; ++g) {
         project(g, ctx);
         readBack(g);
@@ -293,14 +319,14 @@ void RigidGroup::project(size_t g, const SubstepContext& ctx) {
         const btTransform fb = body->getWorldTransform() * jt->getFrameOffsetB();
         const Mat3f A = ei(fa.getRotation()).toRotationMatrix();
         const Mat3f B = ei(fb.getRotation()).toRotationMatrix();
-        const Vec3f angles = eulerXYZ(A.transpose() * B);
+        const Vec3f angles = eulerXYZ(B.transpose() * A);
         const Vec3f limit = Vec3f(s.bendLimit, s.twistLimit, s.bendLimit) * deg;
         const Vec3f reach = limit + Vec3f::Constant(s.projectionAngle * deg);
         const Vec3f clamped = angles.cwiseMax(-reach).cwiseMin(reach);
         const Vec3f anchorA = ei(fa.getOrigin());
         const bool bent = clamped != angles;
         if (bent || (ei(fb.getOrigin()) - anchorA).norm() > s.projectionDistance * len) {
-            const Mat3f Bp = bent ? Mat3f(A * fromEulerXYZ(clamped)) : B;
+            const Mat3f Bp = bent ? Mat3f(A * fromEulerXYZ(clamped).transpose()) : B;
             // Frame B has the identity rotation, so the body's rotation is Bp.
             const Vec3f centre = anchorA + Bp * Vec3f(0, 0.5f * len, 0);
             body->setWorldTransform(btTransform(bt(Quatf(Bp)), bt(centre)));
@@ -364,7 +390,8 @@ void RigidGroup::jointAngles(float& bend, float& twist) const {
 
 class RigidFormulation final : public Formulation {
   public:
-    RigidFormulation(const HeadPose& head) {
+    explicit RigidFormulation(const HeadPose& head) {
+        useHairScaleContactThreshold();
         if (head.mesh.triangles.empty()) return;
         const Eigen::Isometry3f toLocal = head.transform.inverse();
         for (const Vec3f& p : head.mesh.positions) shared_.headVertices.push_back(bt(toLocal * p));

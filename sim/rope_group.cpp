@@ -92,6 +92,7 @@ class RopeGroup final : public GuideGroup {
 
   private:
     void load(size_t g, float h, float alpha);
+    void loadAll(float h, float alpha);
     void relax(size_t g, const SubstepContext& ctx);
 
     btSoftBodyRigidBodyCollisionConfiguration config_{smallPools()};
@@ -104,6 +105,7 @@ class RopeGroup final : public GuideGroup {
     // Scratch for one guide, reused (groups run one at a time per thread).
     std::vector<Vec3f> x_;
     std::vector<strand::Contact> contact_;
+    unsigned loadedVersion_ = ~0u;  ///< set_.version the nodes were last synchronised with
 };
 
 RopeGroup::RopeGroup(GuideSet& set, size_t begin, size_t end) : GuideGroup(set, begin, end) {
@@ -163,14 +165,23 @@ void RopeGroup::reset() {
 
 void RopeGroup::load(size_t g, float h, float alpha) {
     btSoftBody* body = bodies_[g - begin_];
-    for (int i = 0; i < set_.vertices; ++i) {
-        btSoftBody::Node& node = body->m_nodes[i];
-        node.m_x = bt(set_.x[set_.vertex(g, i)]);
-        node.m_v = bt(set_.v[set_.vertex(g, i)]);
+    // The nodes already hold the state relax() stored, unless something else
+    // (a reset, strand-strand contacts) wrote the shared arrays since.
+    if (loadedVersion_ != set_.version) {
+        for (int i = 0; i < set_.vertices; ++i) {
+            btSoftBody::Node& node = body->m_nodes[i];
+            node.m_x = bt(set_.x[set_.vertex(g, i)]);
+            node.m_v = bt(set_.v[set_.vertex(g, i)]);
+        }
     }
     // The massless root moves to its target by velocity during
     // predictMotion, so head motion enters the strand as real velocity.
     body->m_nodes[0].m_v = bt((set_.rootPosition(g, alpha) - set_.x[set_.vertex(g, 0)]) / h);
+}
+
+void RopeGroup::loadAll(float h, float alpha) {
+    for (size_t g = begin_; g < end_; ++g) load(g, h, alpha);
+    loadedVersion_ = set_.version;
 }
 
 void RopeGroup::preload(const SubstepContext& ctx) {
@@ -180,8 +191,10 @@ void RopeGroup::preload(const SubstepContext& ctx) {
     // The targets are joint angles, like a pre-bent rod's, so they turn with
     // the parent segment; a push fixed in space instead (a follower load on
     // a cantilever) flutters (measured: ×4 energy per step).
-    for (size_t g = begin_; g < end_; ++g) load(g, ctx.h, ctx.alpha);
+    loadedVersion_ = ~set_.version;  // force a full load
+    loadAll(ctx.h, ctx.alpha);
     world_.stepSimulation(ctx.h, 0, ctx.h);
+    loadedVersion_ = ~set_.version;  // the nodes hold the probe step, not the state
     const int n = set_.vertices;
     for (size_t g = begin_; g < end_; ++g) {
         const btSoftBody* body = bodies_[g - begin_];
@@ -193,7 +206,7 @@ void RopeGroup::preload(const SubstepContext& ctx) {
 }
 
 void RopeGroup::substep(const SubstepContext& ctx) {
-    for (size_t g = begin_; g < end_; ++g) load(g, ctx.h, ctx.alpha);
+    loadAll(ctx.h, ctx.alpha);
     world_.stepSimulation(ctx.h, 0, ctx.h);
     for (size_t g = begin_; g < end_; ++g) relax(g, ctx);
 }
@@ -202,7 +215,7 @@ void RopeGroup::relax(size_t g, const SubstepContext& ctx) {
     const GuideSettings& s = set_.settings;
     const float h = ctx.h;
     const strand::HeadQuery* head = ctx.headCollision && ctx.head.collider ? &ctx.head : nullptr;
-    const btSoftBody* body = bodies_[g - begin_];
+    btSoftBody* body = bodies_[g - begin_];
     const int n = set_.vertices;
     for (int i = 0; i < n; ++i) x_[i] = ei(body->m_nodes[i].m_x);
     x_[0] = set_.rootPosition(g, ctx.alpha);
@@ -222,6 +235,8 @@ void RopeGroup::relax(size_t g, const SubstepContext& ctx) {
         }
         set_.x[k] = x_[i];
         set_.v[k] = v;
+        body->m_nodes[i].m_x = bt(x_[i]);
+        body->m_nodes[i].m_v = bt(v);
     }
 }
 

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 namespace hp::strand {
 
@@ -32,6 +30,16 @@ Quatf transport(const Vec3f& from, const Vec3f& to) {
     if (w < 1e-6f) return Quatf::FromTwoVectors(from, to);
     const Vec3f v = from.cross(to);
     return Quatf(w, v.x(), v.y(), v.z()).normalized();
+}
+
+Mat3f transportMatrix(const Vec3f& from, const Vec3f& to) {
+    // Rodrigues for unit vectors: R = I + [v]× + [v]×²/(1 + c), v = a×b, c = a·b.
+    const float c1 = 1.f + from.dot(to);
+    if (c1 < 1e-6f) return transport(from, to).toRotationMatrix();
+    const Vec3f v = from.cross(to);
+    Mat3f K;
+    K << 0.f, -v.z(), v.y(), v.z(), 0.f, -v.x(), -v.y(), v.x(), 0.f;
+    return Mat3f::Identity() + K + (K * K) / c1;
 }
 
 float angleBetween(const Vec3f& a, const Vec3f& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
@@ -84,9 +92,9 @@ float HeadQuery::distance(const Vec3f& x, Vec3f* normal) const {
 Contact projectOut(const HeadQuery& head, float radius, Vec3f& x) {
     Contact c;
     if (!head.collider) return c;
+    if (head.distance(x, nullptr) >= radius) return c;  // the common case: no normal needed
     Vec3f n;
     const float d = head.distance(x, &n);
-    if (d >= radius) return c;
     c.active = true;
     c.normal = n;
     c.push = radius - d;
@@ -131,12 +139,13 @@ Vec3f contactFriction(const Vec3f& v, const Vec3f& vs, const Contact& contact, f
 
 void relaxJoints(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& p, const HeadQuery* head,
                  float radius, Contact* contacts, bool solvePreload) {
-    Mat3f Q = rootFrame;
+    // Frames as quaternions: the pass composes two rotations per joint.
+    Quatf Q(rootFrame);
     if (contacts) contacts[0] = Contact{};
     // Carrying every subtree explicitly costs O(n²); instead the carries are
     // composed into one rigid map (C, c) applied to each vertex when its turn
     // comes: the vertex's current position is C·x + c.
-    Mat3f C = Mat3f::Identity();
+    Quatf C = Quatf::Identity();
     Vec3f c = Vec3f::Zero();
     const float cosLimit = std::cos(p.limit);
     for (int j = 0; j + 1 < vertexCount; ++j) {
@@ -163,7 +172,7 @@ void relaxJoints(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointP
                 // unstable; such a joint keeps some sag instead.
                 if (angleBetween(target, rest) > 2.f * p.limit) target = rotateToAngle(target, rest, 2.f * p.limit);
             }
-            p.springDir[j] = Q.transpose() * target;
+            p.springDir[j] = Q.conjugate() * target;
             dir = rest;
         } else {
             // The implicit spring on the segment's end, x ← x + f·(x* - x),
@@ -174,13 +183,14 @@ void relaxJoints(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointP
         Vec3f child = parent + length * dir;
         const Contact k = placeSegment(parent, child, length, head, radius);
         if (contacts) contacts[j + 1] = k;
-        const Vec3f dFinal = (child - parent) / (child - parent).norm();
+        const Vec3f dFinal = (child - parent).normalized();
         // Carry the subtree: rotate it with the segment, shift it with the length fix.
-        const Mat3f q = transport(d, dFinal).toRotationMatrix();
+        const Quatf q = transport(d, dFinal);
         C = q * C;
         c = child + q * (c - oldChild);
         x[j + 1] = child;
-        Q = transport(rest, dFinal).toRotationMatrix() * Q;
+        Q = transport(rest, dFinal) * Q;
+        Q.normalize();  // keep rounding from accumulating over the chain
     }
 }
 

@@ -40,6 +40,9 @@ float dampingFactor(float rate, float h);
 /// unit vector `from` to unit vector `to` (parallel transport along a bend).
 Quatf transport(const Vec3f& from, const Vec3f& to);
 
+/// The same rotation as a matrix (Rodrigues, no trigonometry).
+Mat3f transportMatrix(const Vec3f& from, const Vec3f& to);
+
 /// Angle between unit vectors, radians, accurate near 0 (atan2 of |a×b|, a·b).
 float angleBetween(const Vec3f& a, const Vec3f& b);
 
