@@ -37,6 +37,8 @@ struct GuideSet {
     std::vector<Vec3f> springDir;     ///< per segment: rope spring target t_j (e_j turned by the pre-load)
     std::vector<float> spring;        ///< per segment: rope joint spring fraction per Bullet step
     std::vector<float> limitSpring;   ///< per segment: rope limit spring fraction per Bullet step
+    std::vector<float> limitPerIteration;  ///< per segment: the same spread over Bullet's link iterations
+    std::vector<float> minSpan, maxSpan;   ///< per segment: rope bend limits as spans (strand::bendLimitSpan)
     std::vector<float> jointInertia;  ///< per segment: m_{j+1}·l_j², the joint drive's inertia, kg·m²
     std::vector<float> mass;          ///< per vertex (0 for the kinematic root)
 

@@ -156,6 +156,9 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
     set.springDir.assign(ns, Vec3f::UnitY());
     set.spring.assign(ns, 0.f);
     set.limitSpring.assign(ns, 0.f);
+    set.limitPerIteration.assign(ns, 0.f);
+    set.minSpan.assign(ns, 0.f);
+    set.maxSpan.assign(ns, 0.f);
     set.jointInertia.assign(ns, 0.f);
     set.mass.assign(nv, 0.f);
     set.x.assign(nv, Vec3f::Zero());
@@ -197,7 +200,11 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
             const float h = s.timeStep / float(s.substeps);
             set.spring[seg] = strand::springFraction(s.bendStiffness, inertia, h);
             set.limitSpring[seg] = strand::springFraction(s.limitStiffness, inertia, h);
+            set.limitPerIteration[seg] = 1.f - std::pow(1.f - set.limitSpring[seg], 1.f / float(s.iterations));
         }
+        strand::bendLimitSpan(&set.restLength[set.segment(g, 0)], &set.groomDir[set.segment(g, 0)], set.segments,
+                              s.bendLimit * float(M_PI / 180.0), &set.minSpan[set.segment(g, 0)],
+                              &set.maxSpan[set.segment(g, 0)]);
         set.restShape(g, set.rootPos1[g], R, &set.x[set.vertex(g, 0)]);
     }
     set.xPrev = set.x;

@@ -54,14 +54,21 @@ btDefaultCollisionConstructionInfo smallPools() {
     return info;
 }
 
-/// Bullet's default soft-body solver with one addition at its extension
-/// point: before the link solve, compressed segments are relieved root to tip
-/// (strand::relieveCompression), so Bullet's two-sided link solve handles
-/// tension only.
+/// Bullet's default soft-body solver with the joint kernels at its
+/// extension point: after predictMotion has integrated gravity and before
+/// the link solve, each rope's compressed segments are relieved and the
+/// Drive pass (springs, soft limits) turns its joints; Bullet's two-sided
+/// link solve then carries their reactions along the chain.
 class StrandSoftBodySolver final : public btDefaultSoftBodySolver {
   public:
-    explicit StrandSoftBodySolver(const GuideSet& set) : set_(set) {}
+    explicit StrandSoftBodySolver(GuideSet& set) : set_(set) {}
+    /// What the next solveConstraints does: the pass and the step's context.
+    void prepare(strand::JointPass pass, const SubstepContext& ctx) {
+        pass_ = pass;
+        ctx_ = &ctx;
+    }
     void solveConstraints(btScalar solverdt) override {
+        const int iterations = set_.settings.iterations;
         for (int b = 0; b < m_softBodySet.size(); ++b) {
             btSoftBody* body = m_softBodySet[b];
             const size_t g = size_t(body->getUserIndex());
@@ -69,13 +76,41 @@ class StrandSoftBodySolver final : public btDefaultSoftBodySolver {
             x_.resize(n);
             for (int i = 0; i < n; ++i) x_[i] = ei(body->m_nodes[i].m_x);
             strand::relieveCompression(x_.data(), &set_.restLength[set_.segment(g, 0)], size_t(n));
+            const Mat3f R = set_.rootRotation(g, ctx_->alpha).toRotationMatrix();
+            strand::relaxJoints(pass_, x_.data(), n, R, set_.joints(g), nullptr, 0.f, nullptr);
             for (int i = 1; i < n; ++i) body->m_nodes[i].m_x = bt(x_[i]);
+            // Bullet's link solve (its own Gauss-Seidel kernel), interleaved
+            // with the bend limits as spans so both sides of a stop move.
+            const size_t s0 = set_.segment(g, 0);
+            Vec3f follicle = x_[0] - R * (set_.restLength[s0] * set_.groomDir[s0]);
+            for (int it = 0; it < iterations; ++it) {
+                btSoftBody::PSolve_Links(body, 1, btScalar(it) / btScalar(iterations));
+                for (int j = 0; j < set_.segments; ++j) {
+                    btSoftBody::Node& child = body->m_nodes[j + 1];
+                    Vec3f b1 = ei(child.m_x);
+                    if (j == 0) {
+                        strand::limitSpan(follicle, b1, 0.f, child.m_im, set_.minSpan[s0], set_.maxSpan[s0],
+                                          set_.limitPerIteration[s0]);
+                    } else {
+                        btSoftBody::Node& grand = body->m_nodes[j - 1];
+                        Vec3f a = ei(grand.m_x);
+                        strand::limitSpan(a, b1, grand.m_im, child.m_im, set_.minSpan[s0 + j], set_.maxSpan[s0 + j],
+                                          set_.limitPerIteration[s0 + j]);
+                        grand.m_x = bt(a);
+                    }
+                    child.m_x = bt(b1);
+                }
+            }
         }
+        // Bullet's own pass: its position loop is off (piterations = 0), the
+        // rest (link and anchor preparation) runs as usual.
         btDefaultSoftBodySolver::solveConstraints(solverdt);
     }
 
   private:
-    const GuideSet& set_;
+    GuideSet& set_;
+    strand::JointPass pass_ = strand::JointPass::Drive;
+    const SubstepContext* ctx_ = nullptr;
     std::vector<Vec3f> x_;
 };
 
@@ -130,7 +165,7 @@ RopeGroup::RopeGroup(GuideSet& set, size_t begin, size_t end) : GuideGroup(set, 
         auto* body = new btSoftBody(&info, n, pos.data(), mass.data());
         for (int j = 0; j < set.segments; ++j) body->appendLink(j, j + 1);
         btSoftBody::Config& cfg = body->m_cfg;
-        cfg.piterations = s.iterations;
+        cfg.piterations = 0;  // the link iterations run in StrandSoftBodySolver, with the limits
         cfg.viterations = 0;
         cfg.diterations = 0;
         cfg.kDP = 0;          // damping is applied by the kernels, exp(-c·h)
@@ -185,28 +220,22 @@ void RopeGroup::loadAll(float h, float alpha) {
 }
 
 void RopeGroup::preload(const SubstepContext& ctx) {
-    // One Bullet step from rest shows how far gravity moves each joint; the
-    // joint pass then aims each spring past the rest direction by that much,
-    // so the rest shape is an exact equilibrium (see strand::relaxJoints).
+    // One Bullet step from rest with the pre-load pass in place of Drive:
+    // it sees exactly the prediction Drive will see at rest and aims each
+    // spring so that Drive lands on the rest shape, an exact equilibrium.
     // The targets are joint angles, like a pre-bent rod's, so they turn with
     // the parent segment; a push fixed in space instead (a follower load on
     // a cantilever) flutters (measured: ×4 energy per step).
     loadedVersion_ = ~set_.version;  // force a full load
     loadAll(ctx.h, ctx.alpha);
+    softSolver_.prepare(strand::JointPass::SolvePreload, ctx);
     world_.stepSimulation(ctx.h, 0, ctx.h);
     loadedVersion_ = ~set_.version;  // the nodes hold the probe step, not the state
-    const int n = set_.vertices;
-    for (size_t g = begin_; g < end_; ++g) {
-        const btSoftBody* body = bodies_[g - begin_];
-        for (int i = 0; i < n; ++i) x_[i] = ei(body->m_nodes[i].m_x);
-        x_[0] = set_.x[set_.vertex(g, 0)];
-        strand::relaxJoints(x_.data(), n, set_.rootRot1[g].toRotationMatrix(), set_.joints(g), nullptr, 0.f,
-                            nullptr, true);
-    }
 }
 
 void RopeGroup::substep(const SubstepContext& ctx) {
     loadAll(ctx.h, ctx.alpha);
+    softSolver_.prepare(strand::JointPass::Drive, ctx);
     world_.stepSimulation(ctx.h, 0, ctx.h);
     for (size_t g = begin_; g < end_; ++g) relax(g, ctx);
 }
@@ -219,8 +248,8 @@ void RopeGroup::relax(size_t g, const SubstepContext& ctx) {
     const int n = set_.vertices;
     for (int i = 0; i < n; ++i) x_[i] = ei(body->m_nodes[i].m_x);
     x_[0] = set_.rootPosition(g, ctx.alpha);
-    strand::relaxJoints(x_.data(), n, set_.rootRotation(g, ctx.alpha).toRotationMatrix(), set_.joints(g), head,
-                        s.collisionRadius, contact_.data());
+    strand::relaxJoints(strand::JointPass::Finish, x_.data(), n, set_.rootRotation(g, ctx.alpha).toRotationMatrix(),
+                        set_.joints(g), head, s.collisionRadius, contact_.data());
 
     // Velocities from positions (position-based dynamics), then friction
     // against the moving head and step-size independent damping.

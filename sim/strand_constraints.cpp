@@ -32,16 +32,6 @@ Quatf transport(const Vec3f& from, const Vec3f& to) {
     return Quatf(w, v.x(), v.y(), v.z()).normalized();
 }
 
-Mat3f transportMatrix(const Vec3f& from, const Vec3f& to) {
-    // Rodrigues for unit vectors: R = I + [v]× + [v]×²/(1 + c), v = a×b, c = a·b.
-    const float c1 = 1.f + from.dot(to);
-    if (c1 < 1e-6f) return transport(from, to).toRotationMatrix();
-    const Vec3f v = from.cross(to);
-    Mat3f K;
-    K << 0.f, -v.z(), v.y(), v.z(), 0.f, -v.x(), -v.y(), v.x(), 0.f;
-    return Mat3f::Identity() + K + (K * K) / c1;
-}
-
 float angleBetween(const Vec3f& a, const Vec3f& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
 Vec3f rotateToAngle(const Vec3f& d, const Vec3f& axis, float angle) {
@@ -51,13 +41,6 @@ Vec3f rotateToAngle(const Vec3f& d, const Vec3f& axis, float angle) {
     // angle > 0 is asked of a direction at angle 0 or π).
     perp = len > 1e-12f ? Vec3f(perp / len) : Vec3f(axis.unitOrthogonal());
     return std::cos(angle) * axis + std::sin(angle) * perp;
-}
-
-Vec3f limitBend(const Vec3f& d, const Vec3f& axis, float limit, float fraction, float projection) {
-    const float theta = angleBetween(d, axis);
-    if (theta <= limit) return d;
-    const float soft = theta - fraction * (theta - limit);
-    return rotateToAngle(d, axis, std::min(soft, limit + projection));
 }
 
 Vec3f followTheLeader(const Vec3f& parent, const Vec3f& child, float length) {
@@ -137,8 +120,8 @@ Vec3f contactFriction(const Vec3f& v, const Vec3f& vs, const Contact& contact, f
     return vs + vn * n + vt;
 }
 
-void relaxJoints(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& p, const HeadQuery* head,
-                 float radius, Contact* contacts, bool solvePreload) {
+void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& p,
+                 const HeadQuery* head, float radius, Contact* contacts) {
     // Frames as quaternions: the pass composes two rotations per joint.
     Quatf Q(rootFrame);
     if (contacts) contacts[0] = Contact{};
@@ -147,7 +130,7 @@ void relaxJoints(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointP
     // comes: the vertex's current position is C·x + c.
     Quatf C = Quatf::Identity();
     Vec3f c = Vec3f::Zero();
-    const float cosLimit = std::cos(p.limit);
+    const float cosReach = std::cos(p.limit + p.projection);
     for (int j = 0; j + 1 < vertexCount; ++j) {
         const Vec3f parent = x[j];
         const Vec3f oldChild = C * x[j + 1] + c;
@@ -157,8 +140,8 @@ void relaxJoints(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointP
         const float len = e.norm();
         const Vec3f d = len > 1e-12f ? Vec3f(e / len) : rest;
         const float f = p.spring[j];
-        Vec3f dir;
-        if (solvePreload) {
+        Vec3f dir = d;
+        if (pass == JointPass::SolvePreload) {
             // Aim past the rest direction r so that the spring step lands on
             // it: normalize((1-f)·d + f·t) = r with |t| = 1 gives
             // t = (λ·r - (1-f)·d)/f, λ the positive root of
@@ -174,24 +157,52 @@ void relaxJoints(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointP
             }
             p.springDir[j] = Q.conjugate() * target;
             dir = rest;
-        } else {
+        } else if (pass == JointPass::Drive) {
             // The implicit spring on the segment's end, x ← x + f·(x* - x),
             // renormalised onto the segment's length.
             dir = ((1.f - f) * d + f * (Q * p.springDir[j])).normalized();
-            if (dir.dot(rest) < cosLimit) dir = limitBend(dir, rest, p.limit, p.limitSpring[j], p.projection);
+        }
+        if (pass != JointPass::Finish) {
+            // Carry the subtree with the spring's turn and the length fix: a
+            // joint drive moves what hangs from it.
+            const Quatf q = transport(d, dir);
+            C = q * C;
+            c = parent + length * dir + q * (c - oldChild);
+        } else if (dir.dot(rest) < cosReach) {
+            // The projection limit moves this vertex alone.
+            dir = rotateToAngle(dir, rest, p.limit + p.projection);
         }
         Vec3f child = parent + length * dir;
         const Contact k = placeSegment(parent, child, length, head, radius);
         if (contacts) contacts[j + 1] = k;
-        const Vec3f dFinal = (child - parent).normalized();
-        // Carry the subtree: rotate it with the segment, shift it with the length fix.
-        const Quatf q = transport(d, dFinal);
-        C = q * C;
-        c = child + q * (c - oldChild);
         x[j + 1] = child;
-        Q = transport(rest, dFinal) * Q;
+        Q = transport(rest, (child - parent).normalized()) * Q;
         Q.normalize();  // keep rounding from accumulating over the chain
     }
+}
+
+void bendLimitSpan(const float* restLength, const Vec3f* restDir, int segments, float limit, float* minSpan,
+                   float* maxSpan) {
+    for (int j = 0; j < segments; ++j) {
+        const float l0 = restLength[j > 0 ? j - 1 : 0], l1 = restLength[j];
+        const float rest = j > 0 ? angleBetween(restDir[j - 1], restDir[j]) : 0.f;
+        auto span = [&](float angle) { return std::sqrt(l0 * l0 + l1 * l1 + 2.f * l0 * l1 * std::cos(angle)); };
+        minSpan[j] = span(std::min(rest + limit, float(M_PI)));
+        maxSpan[j] = span(std::max(rest - limit, 0.f));
+    }
+}
+
+void limitSpan(Vec3f& a, Vec3f& b, float wa, float wb, float minSpan, float maxSpan, float fraction) {
+    const Vec3f e = b - a;
+    const float d2 = e.squaredNorm();
+    if (d2 >= minSpan * minSpan && d2 <= maxSpan * maxSpan) return;  // the common case, no sqrt
+    const float w = wa + wb;
+    if (w <= 0.f || d2 <= 0.f) return;
+    const float d = std::sqrt(d2);
+    const float excess = d < minSpan ? d - minSpan : d - maxSpan;
+    const Vec3f corr = (fraction * excess / (d * w)) * e;
+    a += wa * corr;
+    b -= wb * corr;
 }
 
 void separateSegments(Vec3f& a0, Vec3f& a1, Vec3f& b0, Vec3f& b1, float s, float t, const Vec3f& normal,

@@ -40,9 +40,6 @@ float dampingFactor(float rate, float h);
 /// unit vector `from` to unit vector `to` (parallel transport along a bend).
 Quatf transport(const Vec3f& from, const Vec3f& to);
 
-/// The same rotation as a matrix (Rodrigues, no trigonometry).
-Mat3f transportMatrix(const Vec3f& from, const Vec3f& to);
-
 /// Angle between unit vectors, radians, accurate near 0 (atan2 of |a×b|, a·b).
 float angleBetween(const Vec3f& a, const Vec3f& b);
 
@@ -50,12 +47,6 @@ float angleBetween(const Vec3f& a, const Vec3f& b);
 /// between them is exactly `angle` (radians):
 ///   d' = cos(angle)·axis + sin(angle)·normalize(d - (d·axis)·axis).
 Vec3f rotateToAngle(const Vec3f& d, const Vec3f& axis, float angle);
-
-/// Soft cone limit of one joint (seed: soft ±limit with a spring pushing back,
-/// and a projection limit). θ = angle(d, axis); beyond `limit` the excess
-/// decays by the spring fraction f: θ' = θ - f·(θ - limit); then θ' is
-/// clamped to limit + projection. Returns the limited direction (unit).
-Vec3f limitBend(const Vec3f& d, const Vec3f& axis, float limit, float fraction, float projection);
 
 /// Follow-the-leader (Müller et al. 2012): places the child at exactly the rest
 /// length from its already-placed parent, along the current direction:
@@ -132,29 +123,51 @@ struct JointParams {
     float projection = 0.f;     ///< projection limit beyond it, radians
 };
 
-/// The rope's joint pass, root to tip, after a Bullet step. Joint j's frame
-/// Q_j is the root frame R carried along the strand (Q_0 = R, Q_{j+1} =
-/// transport(Q_j e_j → d_j)·Q_j), so springs and limits act on relative bends.
-/// At joint j, with d = direction of segment j:
-///  1. spring (implicit): move the segment's end toward the target
-///     x_j + l_j·Q_j t_j by the fraction f_j and renormalise — the XPBD step
-///     of a joint drive κ on the segment (inertia I_j), like a joint motor
-///     driving its child body;
-///  2. soft limit: beyond `limit` from the rest direction Q_j e_j the excess
-///     shrinks by the limit spring's fraction, and never exceeds
-///     limit + projection (limitBend);
-///  3. length: the vertex is placed at exactly l_j (follow-the-leader), then
-///     out of the head (placeSegment), which has the last word;
-///  4. the subtree beyond x_{j+1} is carried rigidly with the segment (the
-///     joint's rotation and the length shift), so every joint's correction
-///     moves what hangs from it, as a reduced-coordinate joint would.
-/// With `solvePreload` (the strand at rest, after one Bullet step from rest)
-/// the pass instead sets each t_j so that step 1 lands exactly on e_j:
-/// t_j solves normalize((1-f_j)·d + f_j·t_j) = e_j (at most 2·limit from e_j), which
-/// makes the rest shape an equilibrium under gravity (the pre-load).
+/// The rope's joint passes (see sim/rope_group.cpp for where each runs).
+enum class JointPass {
+    Drive,         ///< on Bullet's prediction, before its link solve: springs, soft limits, lengths
+    Finish,        ///< after Bullet's step: lengths, projection limit, head clearance
+    SolvePreload,  ///< at rest: sets each spring target so that Drive lands on the rest shape
+};
+
+/// One root-to-tip pass over a strand's joints. Joint j's frame Q_j is the
+/// root frame R carried along the strand (Q_0 = R, Q_{j+1} =
+/// transport(Q_j e_j → d_j)·Q_j), so springs and limits act on relative
+/// bends. At joint j, with d the direction of segment j:
+///  - Drive: the implicit spring moves the segment's end toward
+///    x_j + l_j·Q_j t_j by the fraction f_j and renormalises — the XPBD step
+///    of a joint drive κ on the segment (inertia I_j); the vertex is placed
+///    at exactly l_j (follow-the-leader) and what hangs beyond is carried
+///    rigidly with that turn (a joint drive moves its subtree). The soft
+///    limits are not here but in the link iterations (limitSpan).
+///  - Finish: no spring; the projection limit (a joint beyond limit +
+///    projection is turned back to it), exact length, and the head
+///    (placeSegment), which has the last word.
+///  - SolvePreload (the strand at rest, on the prediction of one step from
+///    rest): t_j solves normalize((1-f_j)·d + f_j·t_j) = e_j (at most
+///    2·limit from e_j), which makes the rest shape an equilibrium under
+///    gravity (the pre-load); the vertices are put back on the rest shape.
 /// `contacts[i]` receives what the head did to vertex i (may be null).
-void relaxJoints(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& joints,
-                 const HeadQuery* head, float radius, Contact* contacts, bool solvePreload = false);
+void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& joints,
+                 const HeadQuery* head, float radius, Contact* contacts);
+
+/// Bend limits as spans: the angle between consecutive segments of lengths
+/// l0, l1 fixes the distance between their outer ends,
+///   D(φ) = sqrt(l0² + l1² + 2·l0·l1·cos φ),
+/// which shrinks as the bend φ grows. A joint whose rest bend is φ_r stays
+/// within ±limit of it iff D(φ_r + limit) ≤ |x_{j+1} - x_{j-1}| ≤
+/// D(max(φ_r - limit, 0)) (the bend's magnitude; its plane is free). Fills
+/// those spans for joints 0..segments-1; joint 0 pairs the root segment with
+/// a virtual follicle segment on its own rest direction.
+void bendLimitSpan(const float* restLength, const Vec3f* restDir, int segments, float limit, float* minSpan,
+                   float* maxSpan);
+
+/// Unilateral distance constraint (position-based, two-sided in its
+/// masses): if |b - a| is outside [minSpan, maxSpan] the pair moves toward
+/// the nearest bound by `fraction` of the excess, split by inverse masses
+/// wa, wb. Run inside Bullet's link iterations, it is the soft bend limit:
+/// both sides of the joint move, so the stop's reaction reaches the chain.
+void limitSpan(Vec3f& a, Vec3f& b, float wa, float wb, float minSpan, float maxSpan, float fraction);
 
 /// Pushes two segments apart along `normal` (from B to A) by `depth` at the
 /// parameters s (on A: a0→a1) and t (on B), weighted by inverse masses w:
