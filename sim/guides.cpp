@@ -160,6 +160,7 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
     set.minSpan.assign(ns, 0.f);
     set.maxSpan.assign(ns, 0.f);
     set.jointInertia.assign(ns, 0.f);
+    set.restBend.assign(ns, 0.f);
     set.mass.assign(nv, 0.f);
     set.x.assign(nv, Vec3f::Zero());
     set.v.assign(nv, Vec3f::Zero());
@@ -197,10 +198,13 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
             const float inertia = set.mass[set.vertex(g, j + 1)] * set.restLength[seg] * set.restLength[seg];
             set.jointInertia[seg] = inertia;
             set.springDir[seg] = set.groomDir[seg];
+            if (j > 0) set.restBend[seg] = strand::angleBetween(set.groomDir[seg - 1], set.groomDir[seg]);
             const float h = s.timeStep / float(s.substeps);
             set.spring[seg] = strand::springFraction(s.bendStiffness, inertia, h);
             set.limitSpring[seg] = strand::springFraction(s.limitStiffness, inertia, h);
-            set.limitPerIteration[seg] = 1.f - std::pow(1.f - set.limitSpring[seg], 1.f / float(s.iterations));
+            // Spread over the limit checks inside Bullet's link iterations (one per 4).
+            const int checks = (s.iterations + 3) / 4;
+            set.limitPerIteration[seg] = 1.f - std::pow(1.f - set.limitSpring[seg], 1.f / float(checks));
         }
         strand::bendLimitSpan(&set.restLength[set.segment(g, 0)], &set.groomDir[set.segment(g, 0)], set.segments,
                               s.bendLimit * float(M_PI / 180.0), &set.minSpan[set.segment(g, 0)],

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace hp::strand {
 
@@ -120,8 +121,40 @@ Vec3f contactFriction(const Vec3f& v, const Vec3f& vs, const Contact& contact, f
     return vs + vn * n + vt;
 }
 
+namespace {
+
+/// The Finish pass needs no frames: the projection limit bounds the angle
+/// between consecutive segments to rest bend ± (limit + projection), the
+/// same cone as the frames give for a straight rest and its ring otherwise.
+void finish(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& p, const HeadQuery* head,
+            float radius, Contact* contacts) {
+    if (contacts) contacts[0] = Contact{};
+    const float reach = p.limit + p.projection;
+    Vec3f u = rootFrame * p.restDir[0];  // the virtual follicle segment's direction
+    for (int j = 0; j + 1 < vertexCount; ++j) {
+        const Vec3f& parent = x[j];
+        Vec3f e = x[j + 1] - parent;
+        const float len = e.norm();
+        Vec3f w = len > 1e-12f ? Vec3f(e / len) : u;
+        const float bend = p.restBend[j];
+        const float c = u.dot(w);
+        if (c < std::cos(std::min(bend + reach, float(M_PI))))
+            w = rotateToAngle(w, u, bend + reach);
+        else if (bend > reach && c > std::cos(bend - reach))
+            w = rotateToAngle(w, u, bend - reach);
+        Vec3f child = parent + p.restLength[j] * w;
+        const Contact k = placeSegment(parent, child, p.restLength[j], head, radius);
+        if (contacts) contacts[j + 1] = k;
+        x[j + 1] = child;
+        u = (child - parent).normalized();
+    }
+}
+
+}  // namespace
+
 void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& p,
                  const HeadQuery* head, float radius, Contact* contacts) {
+    if (pass == JointPass::Finish) return finish(x, vertexCount, rootFrame, p, head, radius, contacts);
     // Frames as quaternions: the pass composes two rotations per joint.
     Quatf Q(rootFrame);
     if (contacts) contacts[0] = Contact{};
@@ -130,7 +163,6 @@ void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFra
     // comes: the vertex's current position is C·x + c.
     Quatf C = Quatf::Identity();
     Vec3f c = Vec3f::Zero();
-    const float cosReach = std::cos(p.limit + p.projection);
     for (int j = 0; j + 1 < vertexCount; ++j) {
         const Vec3f parent = x[j];
         const Vec3f oldChild = C * x[j + 1] + c;
@@ -162,16 +194,11 @@ void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFra
             // renormalised onto the segment's length.
             dir = ((1.f - f) * d + f * (Q * p.springDir[j])).normalized();
         }
-        if (pass != JointPass::Finish) {
-            // Carry the subtree with the spring's turn and the length fix: a
-            // joint drive moves what hangs from it.
-            const Quatf q = transport(d, dir);
-            C = q * C;
-            c = parent + length * dir + q * (c - oldChild);
-        } else if (dir.dot(rest) < cosReach) {
-            // The projection limit moves this vertex alone.
-            dir = rotateToAngle(dir, rest, p.limit + p.projection);
-        }
+        // Carry the subtree with the spring's turn and the length fix: a
+        // joint drive moves what hangs from it.
+        const Quatf q = transport(d, dir);
+        C = q * C;
+        c = parent + length * dir + q * (c - oldChild);
         Vec3f child = parent + length * dir;
         const Contact k = placeSegment(parent, child, length, head, radius);
         if (contacts) contacts[j + 1] = k;
@@ -188,7 +215,9 @@ void bendLimitSpan(const float* restLength, const Vec3f* restDir, int segments, 
         const float rest = j > 0 ? angleBetween(restDir[j - 1], restDir[j]) : 0.f;
         auto span = [&](float angle) { return std::sqrt(l0 * l0 + l1 * l1 + 2.f * l0 * l1 * std::cos(angle)); };
         minSpan[j] = span(std::min(rest + limit, float(M_PI)));
-        maxSpan[j] = span(std::max(rest - limit, 0.f));
+        // A joint whose rest bend is within the limit may straighten fully:
+        // no upper bound (D(0) would also catch mere stretch mid-solve).
+        maxSpan[j] = rest > limit ? span(rest - limit) : std::numeric_limits<float>::infinity();
     }
 }
 

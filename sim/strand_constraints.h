@@ -116,6 +116,7 @@ Vec3f contactFriction(const Vec3f& v, const Vec3f& vs, const Contact& contact, f
 struct JointParams {
     const float* restLength;    ///< l_j
     const Vec3f* restDir;       ///< e_j: rest direction, root-local, unit
+    const float* restBend;      ///< φ_j: rest angle between segments j-1 and j (0 for j = 0)
     Vec3f* springDir;           ///< t_j: spring target direction, root-local, unit (e_j rotated by the pre-load)
     const float* spring;        ///< f_j = springFraction(κ, I_j, h), I_j = m_{j+1}·l_j²
     const float* limitSpring;   ///< the same for the limit spring
@@ -140,9 +141,10 @@ enum class JointPass {
 ///    at exactly l_j (follow-the-leader) and what hangs beyond is carried
 ///    rigidly with that turn (a joint drive moves its subtree). The soft
 ///    limits are not here but in the link iterations (limitSpan).
-///  - Finish: no spring; the projection limit (a joint beyond limit +
-///    projection is turned back to it), exact length, and the head
-///    (placeSegment), which has the last word.
+///  - Finish: no spring; the projection limit (the angle between consecutive
+///    segments kept within φ_j ± (limit + projection), the vertex turned back
+///    alone), exact length, and the head (placeSegment), which has the last
+///    word.
 ///  - SolvePreload (the strand at rest, on the prediction of one step from
 ///    rest): t_j solves normalize((1-f_j)·d + f_j·t_j) = e_j (at most
 ///    2·limit from e_j), which makes the rest shape an equilibrium under

@@ -147,8 +147,10 @@ TEST(StrandKernels, PreloadSolveMakesRestAnEquilibrium) {
     std::vector<float> len(n - 1, 0.0108f), spring(n - 1, 0.7f), limitSpring(n - 1, 0.9f);
     std::vector<Vec3f> restDir(n - 1), springDir(n - 1);
     for (int j = 0; j < n - 1; ++j) restDir[j] = Vec3f(std::sin(0.02f * j), std::cos(0.02f * j), 0).normalized();
-    JointParams p{len.data(), restDir.data(), springDir.data(), spring.data(), limitSpring.data(), 30 * kDeg,
-                  5 * kDeg};
+    std::vector<float> restBend(n - 1, 0.f);
+    for (int j = 1; j < n - 1; ++j) restBend[j] = angleBetween(restDir[j - 1], restDir[j]);
+    JointParams p{len.data(), restDir.data(), restBend.data(), springDir.data(), spring.data(), limitSpring.data(),
+                  30 * kDeg, 5 * kDeg};
     const Mat3f R = Eigen::AngleAxisf(0.3f, Vec3f(1, 0, 1).normalized()).toRotationMatrix();
     std::vector<Vec3f> rest(n);
     rest[0] = Vec3f(0.1f, 0.2f, 0.3f);
@@ -167,8 +169,9 @@ TEST(StrandKernels, FinishPassKeepsLengthsAndTheProjectionLimit) {
     const int n = 24;
     std::vector<float> len(n - 1, 0.0108f), spring(n - 1, 0.3f), limitSpring(n - 1, 0.5f);
     std::vector<Vec3f> restDir(n - 1, Vec3f::UnitY()), springDir(n - 1, Vec3f::UnitY());
-    JointParams p{len.data(), restDir.data(), springDir.data(), spring.data(), limitSpring.data(), 30 * kDeg,
-                  5 * kDeg};
+    std::vector<float> restBend(n - 1, 0.f);
+    JointParams p{len.data(), restDir.data(), restBend.data(), springDir.data(), spring.data(), limitSpring.data(),
+                  30 * kDeg, 5 * kDeg};
     std::mt19937 rng(11);
     for (int trial = 0; trial < 20; ++trial) {
         std::vector<Vec3f> x = randomChain(rng, n, 0.0108f, 0.03f);  // wildly bent and stretched
@@ -190,13 +193,17 @@ TEST(StrandKernels, BendLimitSpansMatchTheAngles) {
     float minSpan[3], maxSpan[3];
     bendLimitSpan(len, dirs, 3, 30 * kDeg, minSpan, maxSpan);
     // Joint 0 (virtual follicle on the root's own direction): rest bend 0.
-    EXPECT_NEAR(maxSpan[0], 0.02f, 1e-7f);
+    EXPECT_TRUE(std::isinf(maxSpan[0])) << "a straight rest may straighten fully: no upper bound";
     EXPECT_NEAR(minSpan[0], (Vec3f(0, 0.01f, 0) + 0.01f * Vec3f(std::sin(30 * kDeg), std::cos(30 * kDeg), 0)).norm(),
                 1e-7f);
     // Joint 1: rest bend 0.2 rad between lengths 0.01 and 0.02.
     auto span = [](float a) { return (Vec3f(0, 0.01f, 0) + 0.02f * Vec3f(std::sin(a), std::cos(a), 0)).norm(); };
     EXPECT_NEAR(minSpan[1], span(0.2f + 30 * kDeg), 1e-7f);
-    EXPECT_NEAR(maxSpan[1], span(0.f), 1e-7f) << "a rest bend below the limit may straighten fully";
+    EXPECT_TRUE(std::isinf(maxSpan[1])) << "a rest bend below the limit may straighten fully";
+    // A rest bend beyond the limit keeps a bend of at least rest - limit.
+    const Vec3f bent[2] = {Vec3f::UnitY(), Vec3f(std::sin(50 * kDeg), std::cos(50 * kDeg), 0)};
+    bendLimitSpan(len, bent, 2, 30 * kDeg, minSpan, maxSpan);
+    EXPECT_NEAR(maxSpan[1], span(20 * kDeg), 1e-7f);
     // The constraint moves both ends, by their inverse masses.
     Vec3f a(0, 0, 0), b(0.005f, 0, 0);
     limitSpan(a, b, 1.f, 3.f, 0.009f, 0.02f, 1.f);
