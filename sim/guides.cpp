@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 namespace hp {
 
@@ -61,6 +62,18 @@ void GuideStats::accumulate(const GuideStats& s) {
     msPerStep = (msPerStep * double(steps) + s.msPerStep * double(s.steps)) / double(steps + s.steps);
     steps += s.steps;
     reset = reset || s.reset;
+}
+
+std::string GuideStats::json(int frame, double time) const {
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "{\"frame\": %d, \"time\": %.6f, \"max_length_error\": %.3e, \"mean_length_error\": %.3e, "
+                  "\"penetrations\": %zu, \"max_penetration_m\": %.3e, \"kinetic_energy_j\": %.6e, "
+                  "\"nan\": %zu, \"strand_contacts\": %zu, \"ms_per_step\": %.3f, \"steps\": %zu, "
+                  "\"reset\": %s}",
+                  frame, time, maxLengthError, meanLengthError, penetrationCount, maxPenetration, kineticEnergy,
+                  nanCount, strandContacts, msPerStep, steps, reset ? "true" : "false");
+    return buf;
 }
 
 namespace guides {

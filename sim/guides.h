@@ -7,12 +7,12 @@
 // interface (see sim/guide_group.h for how each one maps onto Bullet):
 //
 // - `Rope` (default, production): each guide is a Bullet btSoftBody rope;
-//   Bullet integrates gravity and solves the stretch links; after every Bullet
-//   step the pure kernels of sim/strand_constraints.h add the joint springs
-//   toward the (gravity pre-loaded) rest shape, the soft ±bend limits, exact
-//   inextensibility (follow-the-leader) and projection out of the head's
-//   signed distance with Coulomb friction. Meets the length, penetration and
-//   speed goals; see sim/rope_group.cpp for the measurements behind it.
+//   Bullet integrates gravity and solves the stretch links, interleaved with
+//   the bend limits; the kernels of sim/strand_constraints.h turn the joints
+//   toward the (gravity pre-loaded) rest shape on Bullet's prediction and,
+//   after the step, restore exact lengths and push vertices out of the
+//   head's signed distance with Coulomb friction. Meets the length,
+//   penetration and speed goals; sim/rope_group.cpp says why it is built so.
 // - `Rigid`: the seed's own arrangement, kept faithful for comparison: capsule
 //   btRigidBody segments joined by btGeneric6DofSpring2Constraint (Unity's
 //   ConfigurableJoint): locked linear motion, soft ±bend/±twist limits,
@@ -100,9 +100,12 @@ struct GuideStats {
     double msPerStep = 0;           ///< wall-clock milliseconds of step()
     bool reset = false;             ///< a teleport / scene cut reset the guides this step
 
+    size_t steps = 1;               ///< steps folded in (for the running mean of msPerStep)
+
     /// Folds `s` into running maxima (kinetic energy: the last value; ms: the mean).
     void accumulate(const GuideStats& s);
-    size_t steps = 1;               ///< steps folded in (for the running mean of msPerStep)
+    /// One JSON object on one line (for a per-frame statistics file, JSON lines).
+    std::string json(int frame, double time) const;
 };
 
 /// Drives all guides of a shot. Not thread-safe itself; parallel inside.

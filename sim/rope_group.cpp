@@ -1,34 +1,50 @@
-// The production formulation: guides as Bullet soft-body ropes, corrected by
-// the kernels of sim/strand_constraints.h after every Bullet step.
+// The production formulation: each guide is a Bullet soft-body rope
+// (btSoftBody in a btSoftRigidDynamicsWorld, one world per group of guides),
+// with the kernels of sim/strand_constraints.h at Bullet's solver extension
+// point and after its step.
 //
-// Division of labour per Bullet step h (one world per group of guides):
-//  1. Bullet (btSoftRigidDynamicsWorld, btSoftBody::predictMotion and
-//     solveConstraints): integrates gravity and velocities, then solves the
-//     stretch links with `iterations` mass-weighted Gauss-Seidel passes. This
-//     is the two-sided part of the dynamics: tension pulls the root side by
-//     the tip side, which a one-way follow-the-leader pass cannot do. The root
-//     node has zero mass and is moved by velocity to its kinematic target, so
-//     head motion enters the strand as real velocity.
-//  2. Kernels, root to tip, on each vertex: the joint spring toward the rest
-//     shape (implicit, XPBD compliance with the joint's subtree inertia, so κ
-//     means N·m/rad as in the rigid formulation), the gravity pre-load (a
-//     head-fixed push that makes the groom an exact equilibrium), the soft
-//     bend limit with projection,
-//     follow-the-leader (exact segment lengths), projection out of the head's
-//     signed distance keeping the collision radius clear.
-//  3. Velocities from positions (Müller's FTL damping), Coulomb friction
-//     against the moving head surface, damping exp(-c·h) (step-size free).
+// One Bullet step h:
+//  1. Bullet predictMotion: integrates gravity and velocities. The root node
+//     has zero mass and moves by velocity to its kinematic target, so head
+//     motion enters the strand as real velocity.
+//  2. StrandSoftBodySolver (Bullet's default soft-body solver with one
+//     override): compressed segments are relieved root to tip, the Drive
+//     pass turns each joint toward its (gravity pre-loaded) rest direction —
+//     an implicit joint drive, carried to the subtree — then Bullet's own
+//     link kernel (btSoftBody::PSolve_Links, `iterations` mass-weighted
+//     Gauss-Seidel passes) runs interleaved with the bend limits expressed as
+//     spans between every other vertex, so both sides of a joint stop move
+//     and tension carries reactions along the chain.
+//  3. Finish pass: exact segment lengths (follow-the-leader), the projection
+//     limit, projection out of the head's signed distance keeping the
+//     collision radius clear; velocities from positions, Coulomb friction
+//     against the moving head, damping exp(-c·h).
 //
-// Why this arrangement (measurements in the report / BENCHMARKS notes, B-sim
-// on this 2-core machine): STACK.md's probes found btMultiBody exact but too
-// soft (explicit springs) and slow in a shared world, rigid 6-DoF chains
-// tearing at one step, and plain soft-body ropes colliding well but stretching
-// ~12% at one step. Keeping Bullet's rope and fixing the residual with a
-// follow-the-leader pass gives exact lengths at one Bullet step per 0.02 s;
-// taking head contact to the signed distance (instead of Bullet's soft-rigid
-// sparse SDF) keeps every vertex out even when a strand moves centimetres per
-// step, and costs one distance query per vertex; small worlds with no
-// broadphase pairs (collision mask 0) scale linearly and in parallel.
+// Why this arrangement (B-sim measurements on this 2-core machine are in the
+// report and in tools/bench/bench_sim.cpp's output):
+//  - STACK.md's probes: btMultiBody exact but its explicit springs far too
+//    soft at 0.02 s, and ~2 ms/step for 94 chains before any spring; rigid
+//    6-DoF chains tear at one step (reproduced here: a plain 23-link chain
+//    hung 0.6 m below its 0.25 m length, limits broken); soft-body ropes
+//    stretch ~12% at one step. Ropes are the cheapest Bullet primitive, and
+//    a follow-the-leader pass after the step makes lengths exact (measured:
+//    |l/l0 - 1| ≤ 2e-6) at one Bullet step per 0.02 s instead of 4–8 substeps.
+//  - Springs applied after Bullet's step fought the limp chain's response:
+//    under compression Gauss-Seidel folds a chain (8° zig-zags at the root of
+//    a standing strand), hence the compression relief; springs correcting
+//    Bullet's result left a 20° root kink per step that no pre-load could
+//    reach, hence springs on the prediction, before the link solve.
+//  - Limits corrected on one vertex ratchet the excess down the chain (limp
+//    strands curled at ±30° on every joint); carried rigidly, they held limp
+//    strands out like sticks. As spans inside the link iterations they hang
+//    correctly (30°, 30°, 30° then straight down from a horizontal root).
+//  - Head contact by projection out of the signed distance, not Bullet's
+//    soft-rigid collision: a deforming head needs no Bullet shape, fast
+//    strands cannot tunnel (measured: no vertex inside the head at 720°/s),
+//    and it costs one distance query per vertex.
+//  - Worlds whose ropes never pair in the broadphase (collision mask 0) cost
+//    linear time per guide and run in parallel; contact pools are shrunk
+//    (Bullet preallocates ~4 MB per world by default).
 #include "sim/guide_group.h"
 
 #include <BulletSoftBody/btDefaultSoftBodySolver.h>

@@ -314,6 +314,30 @@ TEST(Guides, MisuseIsReported) {
     EXPECT_THROW(GuideSolver{bad}, Error);
 }
 
+TEST(Guides, StatisticsAccumulateAndPrintAsJson) {
+    GuideStats a, b;
+    a.maxLengthError = 1e-6;
+    a.maxPenetration = 0;
+    a.msPerStep = 2;
+    b.maxLengthError = 5e-7;
+    b.maxPenetration = 2e-4;
+    b.penetrationCount = 3;
+    b.msPerStep = 4;
+    b.kineticEnergy = 0.5;
+    a.accumulate(b);
+    EXPECT_DOUBLE_EQ(a.maxLengthError, 1e-6);
+    EXPECT_DOUBLE_EQ(a.maxPenetration, 2e-4);
+    EXPECT_EQ(a.penetrationCount, 3u);
+    EXPECT_DOUBLE_EQ(a.msPerStep, 3.0);
+    EXPECT_EQ(a.steps, 2u);
+    EXPECT_DOUBLE_EQ(a.kineticEnergy, 0.5);
+    const std::string line = a.json(12, 0.5);
+    EXPECT_NE(line.find("\"frame\": 12"), std::string::npos) << line;
+    EXPECT_NE(line.find("\"penetrations\": 3"), std::string::npos) << line;
+    EXPECT_NE(line.find("\"reset\": false}"), std::string::npos) << line;
+    EXPECT_EQ(line.find('\n'), std::string::npos);
+}
+
 TEST(SimSettings, SceneKeysMapOntoGuideSettings) {
     const Scene scene = Scene::parse(
         "simulation:\n  formulation: rigid\n  substeps: 4\n  damping: 2.5\n  strand_collision: true\n"
