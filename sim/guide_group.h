@@ -35,6 +35,7 @@ struct GuideSet {
     std::vector<float> restLength;    ///< per segment
     std::vector<Vec3f> groomDir;      ///< per segment: unit rest direction e_j
     std::vector<float> restBend;      ///< per segment: rest angle to the previous segment (0 for the first)
+    std::vector<float> cosMostBend, cosLeastBend;  ///< per segment: projection limit bounds (strand::bendBounds)
     std::vector<Vec3f> springDir;     ///< per segment: rope spring target t_j (e_j turned by the pre-load)
     std::vector<float> spring;        ///< per segment: rope joint spring fraction per Bullet step
     std::vector<float> limitSpring;   ///< per segment: rope limit spring fraction per Bullet step
@@ -69,6 +70,8 @@ struct GuideSet {
         p.restLength = &restLength[s0];
         p.restDir = &groomDir[s0];
         p.restBend = &restBend[s0];
+        p.cosMostBend = &cosMostBend[s0];
+        p.cosLeastBend = &cosLeastBend[s0];
         p.springDir = &springDir[s0];
         p.spring = &spring[s0];
         p.limitSpring = &limitSpring[s0];

@@ -174,6 +174,8 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
     set.maxSpan.assign(ns, 0.f);
     set.jointInertia.assign(ns, 0.f);
     set.restBend.assign(ns, 0.f);
+    set.cosMostBend.assign(ns, 0.f);
+    set.cosLeastBend.assign(ns, 0.f);
     set.mass.assign(nv, 0.f);
     set.x.assign(nv, Vec3f::Zero());
     set.v.assign(nv, Vec3f::Zero());
@@ -211,7 +213,6 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
             const float inertia = set.mass[set.vertex(g, j + 1)] * set.restLength[seg] * set.restLength[seg];
             set.jointInertia[seg] = inertia;
             set.springDir[seg] = set.groomDir[seg];
-            if (j > 0) set.restBend[seg] = strand::angleBetween(set.groomDir[seg - 1], set.groomDir[seg]);
             const float h = s.timeStep / float(s.substeps);
             set.spring[seg] = strand::springFraction(s.bendStiffness, inertia, h);
             set.limitSpring[seg] = strand::springFraction(s.limitStiffness, inertia, h);
@@ -219,6 +220,9 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
             const int checks = (s.iterations + 3) / 4;
             set.limitPerIteration[seg] = 1.f - std::pow(1.f - set.limitSpring[seg], 1.f / float(checks));
         }
+        strand::bendBounds(&set.groomDir[set.segment(g, 0)], set.segments,
+                           (s.bendLimit + s.projectionAngle) * float(M_PI / 180.0), &set.restBend[set.segment(g, 0)],
+                           &set.cosMostBend[set.segment(g, 0)], &set.cosLeastBend[set.segment(g, 0)]);
         strand::bendLimitSpan(&set.restLength[set.segment(g, 0)], &set.groomDir[set.segment(g, 0)], set.segments,
                               s.bendLimit * float(M_PI / 180.0), &set.minSpan[set.segment(g, 0)],
                               &set.maxSpan[set.segment(g, 0)]);

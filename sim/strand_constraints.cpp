@@ -138,9 +138,9 @@ void finish(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams
         Vec3f w = len > 1e-12f ? Vec3f(e / len) : u;
         const float bend = p.restBend[j];
         const float c = u.dot(w);
-        if (c < std::cos(std::min(bend + reach, float(M_PI))))
+        if (c < p.cosMostBend[j])
             w = rotateToAngle(w, u, bend + reach);
-        else if (bend > reach && c > std::cos(bend - reach))
+        else if (c > p.cosLeastBend[j])
             w = rotateToAngle(w, u, bend - reach);
         Vec3f child = parent + p.restLength[j] * w;
         const Contact k = placeSegment(parent, child, p.restLength[j], head, radius);
@@ -157,7 +157,6 @@ void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFra
     if (pass == JointPass::Finish) return finish(x, vertexCount, rootFrame, p, head, radius, contacts);
     // Frames as quaternions: the pass composes two rotations per joint.
     Quatf Q(rootFrame);
-    if (contacts) contacts[0] = Contact{};
     // Carrying every subtree explicitly costs O(n²); instead the carries are
     // composed into one rigid map (C, c) applied to each vertex when its turn
     // comes: the vertex's current position is C·x + c.
@@ -199,12 +198,18 @@ void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFra
         const Quatf q = transport(d, dir);
         C = q * C;
         c = parent + length * dir + q * (c - oldChild);
-        Vec3f child = parent + length * dir;
-        const Contact k = placeSegment(parent, child, length, head, radius);
-        if (contacts) contacts[j + 1] = k;
-        x[j + 1] = child;
-        Q = transport(rest, (child - parent).normalized()) * Q;
+        x[j + 1] = parent + length * dir;
+        Q = transport(rest, dir) * Q;
         Q.normalize();  // keep rounding from accumulating over the chain
+    }
+}
+
+void bendBounds(const Vec3f* restDir, int segments, float reach, float* restBend, float* cosMostBend,
+                float* cosLeastBend) {
+    for (int j = 0; j < segments; ++j) {
+        restBend[j] = j > 0 ? angleBetween(restDir[j - 1], restDir[j]) : 0.f;
+        cosMostBend[j] = std::cos(std::min(restBend[j] + reach, float(M_PI)));
+        cosLeastBend[j] = restBend[j] > reach ? std::cos(restBend[j] - reach) : 2.f;  // 2: never
     }
 }
 

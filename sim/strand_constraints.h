@@ -117,6 +117,8 @@ struct JointParams {
     const float* restLength;    ///< l_j
     const Vec3f* restDir;       ///< e_j: rest direction, root-local, unit
     const float* restBend;      ///< φ_j: rest angle between segments j-1 and j (0 for j = 0)
+    const float* cosMostBend;   ///< cos(φ_j + limit + projection) (bendBounds)
+    const float* cosLeastBend;  ///< cos(φ_j - limit - projection), or 2 when no lower bound (bendBounds)
     Vec3f* springDir;           ///< t_j: spring target direction, root-local, unit (e_j rotated by the pre-load)
     const float* spring;        ///< f_j = springFraction(κ, I_j, h), I_j = m_{j+1}·l_j²
     const float* limitSpring;   ///< the same for the limit spring
@@ -130,6 +132,11 @@ enum class JointPass {
     Finish,        ///< after Bullet's step: lengths, projection limit, head clearance
     SolvePreload,  ///< at rest: sets each spring target so that Drive lands on the rest shape
 };
+
+/// Per-joint rest bends φ_j and the cosines bounding the Finish pass's
+/// projection limit, for a reach of limit + projection (radians).
+void bendBounds(const Vec3f* restDir, int segments, float reach, float* restBend, float* cosMostBend,
+                float* cosLeastBend);
 
 /// One root-to-tip pass over a strand's joints. Joint j's frame Q_j is the
 /// root frame R carried along the strand (Q_0 = R, Q_{j+1} =
@@ -149,7 +156,8 @@ enum class JointPass {
 ///    rest): t_j solves normalize((1-f_j)·d + f_j·t_j) = e_j (at most
 ///    2·limit from e_j), which makes the rest shape an equilibrium under
 ///    gravity (the pre-load); the vertices are put back on the rest shape.
-/// `contacts[i]` receives what the head did to vertex i (may be null).
+/// `head`, `radius` and `contacts` (what the head did to vertex i; may be
+/// null) concern Finish only.
 void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& joints,
                  const HeadQuery* head, float radius, Contact* contacts);
 

@@ -147,10 +147,10 @@ TEST(StrandKernels, PreloadSolveMakesRestAnEquilibrium) {
     std::vector<float> len(n - 1, 0.0108f), spring(n - 1, 0.7f), limitSpring(n - 1, 0.9f);
     std::vector<Vec3f> restDir(n - 1), springDir(n - 1);
     for (int j = 0; j < n - 1; ++j) restDir[j] = Vec3f(std::sin(0.02f * j), std::cos(0.02f * j), 0).normalized();
-    std::vector<float> restBend(n - 1, 0.f);
-    for (int j = 1; j < n - 1; ++j) restBend[j] = angleBetween(restDir[j - 1], restDir[j]);
-    JointParams p{len.data(), restDir.data(), restBend.data(), springDir.data(), spring.data(), limitSpring.data(),
-                  30 * kDeg, 5 * kDeg};
+    std::vector<float> restBend(n - 1), most(n - 1), least(n - 1);
+    bendBounds(restDir.data(), n - 1, 35 * kDeg, restBend.data(), most.data(), least.data());
+    JointParams p{len.data(), restDir.data(), restBend.data(), most.data(), least.data(), springDir.data(),
+                  spring.data(), limitSpring.data(), 30 * kDeg, 5 * kDeg};
     const Mat3f R = Eigen::AngleAxisf(0.3f, Vec3f(1, 0, 1).normalized()).toRotationMatrix();
     std::vector<Vec3f> rest(n);
     rest[0] = Vec3f(0.1f, 0.2f, 0.3f);
@@ -169,9 +169,10 @@ TEST(StrandKernels, FinishPassKeepsLengthsAndTheProjectionLimit) {
     const int n = 24;
     std::vector<float> len(n - 1, 0.0108f), spring(n - 1, 0.3f), limitSpring(n - 1, 0.5f);
     std::vector<Vec3f> restDir(n - 1, Vec3f::UnitY()), springDir(n - 1, Vec3f::UnitY());
-    std::vector<float> restBend(n - 1, 0.f);
-    JointParams p{len.data(), restDir.data(), restBend.data(), springDir.data(), spring.data(), limitSpring.data(),
-                  30 * kDeg, 5 * kDeg};
+    std::vector<float> restBend(n - 1), most(n - 1), least(n - 1);
+    bendBounds(restDir.data(), n - 1, 35 * kDeg, restBend.data(), most.data(), least.data());
+    JointParams p{len.data(), restDir.data(), restBend.data(), most.data(), least.data(), springDir.data(),
+                  spring.data(), limitSpring.data(), 30 * kDeg, 5 * kDeg};
     std::mt19937 rng(11);
     for (int trial = 0; trial < 20; ++trial) {
         std::vector<Vec3f> x = randomChain(rng, n, 0.0108f, 0.03f);  // wildly bent and stretched
