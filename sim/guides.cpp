@@ -105,6 +105,8 @@ struct GuideSolver::Impl {
     std::unique_ptr<guides::StrandContacts> contacts;
     std::unique_ptr<tbb::task_arena> arena;
     double time = 0, prevTime = 0;
+    double startTime = 0;  ///< head.time at initialize
+    long steps = 0;        ///< steps since; time = startTime + steps·timeStep (no drift)
     Eigen::Isometry3f headTransform = Eigen::Isometry3f::Identity();
     GuideStats last;
     bool initialized = false;
@@ -251,7 +253,8 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
         ctx.headCollision = false;
         m.forGroups([&](guides::GuideGroup& grp) { grp.preload(ctx); });
     }
-    m.time = m.prevTime = head.time;
+    m.time = m.prevTime = m.startTime = head.time;
+    m.steps = 0;
     m.headTransform = head.transform;
     m.last = GuideStats{};
     m.initialized = true;
@@ -264,7 +267,7 @@ const GuideStats& GuideSolver::step(const std::vector<SurfaceFrame>& roots, cons
     if (!m.initialized) throw Error("guide solver: step() before initialize()");
     if (roots.size() != set.count)
         throw Error(cat("guide solver: ", roots.size(), " root frames for ", set.count, " guides"));
-    const double expected = m.time + s.timeStep;
+    const double expected = m.startTime + double(m.steps + 1) * double(s.timeStep);
     if (std::abs(head.time - expected) > 1e-6 * std::max(1.0, std::abs(expected)))
         throw Error(cat("guide solver: head pose at t = ", head.time, " s, expected the step's end t = ", expected,
                         " s"));
@@ -325,6 +328,7 @@ const GuideStats& GuideSolver::step(const std::vector<SurfaceFrame>& roots, cons
     m.headTransform = head.transform;
     m.prevTime = m.time;
     m.time = expected;
+    ++m.steps;
 
     m.last = m.measure(head.collider.get());
     m.last.reset = teleport;
@@ -417,6 +421,9 @@ void GuideSolver::write(StrandFrame& frame, double time) const {
 }
 
 double GuideSolver::time() const { return impl_->time; }
+double GuideSolver::nextTime() const {
+    return impl_->startTime + double(impl_->steps + 1) * double(impl_->set.settings.timeStep);
+}
 size_t GuideSolver::guideCount() const { return impl_->set.count; }
 const GuideSettings& GuideSolver::settings() const { return impl_->set.settings; }
 const GuideStats& GuideSolver::lastStats() const { return impl_->last; }

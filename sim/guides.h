@@ -123,9 +123,9 @@ class GuideSolver {
     void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head,
                     const std::vector<std::vector<Vec3f>>* groom = nullptr);
 
-    /// Advances one step to time() + timeStep. `roots` are the root frames at
-    /// the end of the step (same order as initialize), `head` the head posed at
-    /// the end of the step (head.time must be time() + timeStep; its collider
+    /// Advances one step to nextTime(). `roots` are the root frames at the end
+    /// of the step (same order as initialize), `head` the head posed at the
+    /// end of the step (head.time must be nextTime() within 1e-6 s; its collider
     /// may be null; its mesh is used only by the rigid formulation). A jump of
     /// the head transform or of a root beyond the teleport limits resets the
     /// guides to their rest shape at the new roots.
@@ -138,7 +138,10 @@ class GuideSolver {
     /// between the last two steps, segment lengths restored exactly.
     void write(StrandFrame& frame, double time) const;
 
+    /// Time of the state now: start time + steps · timeStep (no accumulated rounding).
     double time() const;
+    /// Time the next step ends at: where to sample the head and the roots.
+    double nextTime() const;
     size_t guideCount() const;
     const GuideSettings& settings() const;
     /// Statistics of the last step (all zero before the first).

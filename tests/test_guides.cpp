@@ -44,7 +44,7 @@ void runSphere(GuideSolver& solver, const std::vector<Vec3f>& dirs, float rate, 
     HeadPose pose = head.sample(0.0);
     solver.initialize(sphereRoots(dirs, 0.1f, pose), pose);
     for (int k = 1; k <= steps; ++k) {
-        pose = head.sample(k * double(solver.settings().timeStep));
+        pose = head.sample(solver.nextTime());
         check(solver.step(sphereRoots(dirs, 0.1f, pose), pose), pose, k);
     }
 }
