@@ -15,6 +15,7 @@ void addSceneKeys(SchemaBuilder& b) {
     addReferenceKeys(b);
     addVdbKeys(b);
     addCompareKeys(b);
+    addSimKeys(b);
 }
 
 void addShotKeys(SchemaBuilder& b) {

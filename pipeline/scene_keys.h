@@ -19,5 +19,6 @@ void addHairKeys(SchemaBuilder& b);    // hair: root counts and placement (scene
 void addReferenceKeys(SchemaBuilder& b);  // reference: Embree reference renderer (scene_keys_reference.cpp)
 void addVdbKeys(SchemaBuilder& b);     // vdb: OpenVDB density caches (scene_keys_vdb.cpp)
 void addCurlyKeys(SchemaBuilder& b);   // hair.model, hair.curly, hair.wet: the curly/wet model (scene_keys_curly.cpp)
+void addSimKeys(SchemaBuilder& b);     // simulation.*, hair.guides shape, hair.radius (scene_keys_sim.cpp)
 
 }  // namespace hp

@@ -1,0 +1,56 @@
+// simulation.*: the guide solver (sim/guides.h, mapped by pipeline/sim_settings.h),
+// and the guide shape keys hair.guides.segments / length / collision_radius
+// and hair.radius.* (the guides' render radii).
+#include "pipeline/scene_keys.h"
+
+namespace hp {
+
+void addSimKeys(SchemaBuilder& b) {
+    b.section("hair.guides", "Guide strands: the simulated hairs followers are built from (seed 000).")
+        .integer("hair.guides.segments", 23, 1, 200, "", "Segments per guide (vertices = segments + 1).")
+        .number("hair.guides.length", 0.25, 1e-4, 100, "m", "Rest length of a guide.")
+        .number("hair.guides.collision_radius", 0.001, 0, 0.1, "m",
+                "Radius kept clear of the head, and capsule radius for strand-strand collision.");
+    b.section("hair.radius", "Render radius of every strand, tapering linearly from root to tip.")
+        .number("hair.radius.root", 0.00004, 0, 0.01, "m", "Radius at the root.")
+        .number("hair.radius.tip", 0.00001, 0, 0.01, "m", "Radius at the tip.");
+
+    b.section("simulation",
+              "Guide dynamics with Bullet. `rope` (default): Bullet soft-body ropes with joint springs, limits, "
+              "exact lengths and head projection after each Bullet step; `rigid`: the seed's capsule rigid bodies "
+              "and 6-DoF spring joints, kept for comparison.")
+        .choice("simulation.formulation", "rope", {"rope", "rigid"}, "Which Bullet arrangement simulates the guides.")
+        .number("simulation.time_step", 0.02, 1e-4, 1, "s", "Fixed simulation step (seed: 0.02 s).")
+        .integer("simulation.substeps", 1, 1, 64, "", "Bullet steps per simulation step.")
+        .integer("simulation.iterations", 20, 1, 1000, "", "Bullet solver iterations per Bullet step (seed: 20).")
+        .number("simulation.friction", 0.2, 0, 10, "", "Coulomb friction against the head and between strands.")
+        .number("simulation.damping", 1, 0, 1000, "1/s",
+                "Velocity decay rate: v·exp(-damping·t), the same whatever the time step.")
+        .vec3("simulation.gravity", 0, -9.81, 0, "m/s²", "Gravity.")
+        .number("simulation.mass_per_length", 0.005, 1e-9, 100, "kg/m", "Mass of a guide per metre.")
+        .number("simulation.bend_stiffness", 5e-5, 0, 1e3, "N·m/rad",
+                "Joint spring toward the rest shape (both formulations; rigid: Bullet caps it for stability).")
+        .number("simulation.bend_damping", 0, 0, 1e3, "N·m·s/rad", "Rigid only: damping of the joint springs.")
+        .flag("simulation.preload", true,
+              "Pre-load the joint springs so the rest shape is an equilibrium under gravity at the first frame.")
+        .flag("simulation.head_collision", true,
+              "Project vertices out of the head's signed distance (with friction) after every Bullet step.")
+        .flag("simulation.strand_collision", false,
+              "Strand-strand collision (seed table row 7): couples all guides, so it costs speed.")
+        .integer("simulation.strands_per_world", 16, 1, 100000, "",
+                 "Guides per Bullet world; worlds run in parallel. A fixed partition: results do not depend on "
+                 "the thread count.");
+    b.section("simulation.limits", "Joint limits (seed: ±30° bend, ±10° twist, soft, with a projection limit).")
+        .number("simulation.limits.bend", 30, 0.1, 179, "deg", "Bend limit about the two bending axes.")
+        .number("simulation.limits.twist", 10, 0.1, 89, "deg", "Rigid only: twist limit about the segment.")
+        .number("simulation.limits.stiffness", 1e-3, 0, 1e3, "N·m/rad", "Spring pushing a joint back inside its limit.")
+        .number("simulation.limits.projection_angle", 5, 0, 180, "deg",
+                "A joint beyond its limit by more than this is snapped back.")
+        .number("simulation.limits.projection_distance", 0.1, 0, 10, "",
+                "Rigid only: a joint pulled apart by more than this fraction of a segment is snapped back.");
+    b.section("simulation.teleport", "Scene cuts: a jump beyond these in one step resets the guides to rest.")
+        .number("simulation.teleport.distance", 0.1, 0, 1e6, "m", "Largest head or root move per step.")
+        .number("simulation.teleport.angle", 45, 0, 180, "deg", "Largest head turn per step.");
+}
+
+}  // namespace hp

@@ -1,0 +1,256 @@
+#include "sim/strand_constraints.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace hp::strand {
+
+Mat3f rootRotation(const SurfaceFrame& frame) {
+    const Vec3f n = frame.normal.normalized();
+    Vec3f t = frame.tangent - n * n.dot(frame.tangent);
+    t = t.squaredNorm() > 1e-12f ? Vec3f(t.normalized()) : Vec3f(n.unitOrthogonal());
+    Mat3f r;
+    r.col(0) = t;
+    r.col(1) = n;
+    r.col(2) = t.cross(n);
+    return r;
+}
+
+float springFraction(float stiffness, float inertia, float h) {
+    const float k = stiffness * h * h;
+    return k > 0.f ? k / (inertia + k) : 0.f;
+}
+
+float dampingFactor(float rate, float h) { return std::exp(-rate * h); }
+
+Quatf transport(const Vec3f& from, const Vec3f& to) {
+    // For unit a, b the half-way quaternion (1 + a·b, a×b), normalised, is the
+    // minimal rotation; only the antiparallel case needs Eigen's general path.
+    const float w = 1.f + from.dot(to);
+    if (w < 1e-6f) return Quatf::FromTwoVectors(from, to);
+    const Vec3f v = from.cross(to);
+    return Quatf(w, v.x(), v.y(), v.z()).normalized();
+}
+
+float angleBetween(const Vec3f& a, const Vec3f& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
+
+Vec3f rotateToAngle(const Vec3f& d, const Vec3f& axis, float angle) {
+    Vec3f perp = d - axis * axis.dot(d);
+    const float len = perp.norm();
+    // d parallel to the axis: any perpendicular will do (only reached when
+    // angle > 0 is asked of a direction at angle 0 or π).
+    perp = len > 1e-12f ? Vec3f(perp / len) : Vec3f(axis.unitOrthogonal());
+    return std::cos(angle) * axis + std::sin(angle) * perp;
+}
+
+Vec3f followTheLeader(const Vec3f& parent, const Vec3f& child, float length) {
+    const Vec3f e = child - parent;
+    const float len = e.norm();
+    // A collapsed segment keeps its length along an arbitrary (deterministic) axis.
+    return len > 1e-12f ? Vec3f(parent + e * (length / len)) : Vec3f(parent + Vec3f::UnitY() * length);
+}
+
+void followTheLeader(Vec3f* x, const float* restLength, size_t vertexCount, Vec3f* correction) {
+    if (correction && vertexCount > 0) correction[0] = Vec3f::Zero();
+    for (size_t i = 0; i + 1 < vertexCount; ++i) {
+        const Vec3f placed = followTheLeader(x[i], x[i + 1], restLength[i]);
+        if (correction) correction[i + 1] = placed - x[i + 1];
+        x[i + 1] = placed;
+    }
+}
+
+void relieveCompression(Vec3f* x, const float* restLength, size_t vertexCount) {
+    for (size_t i = 0; i + 1 < vertexCount; ++i)
+        if ((x[i + 1] - x[i]).squaredNorm() < restLength[i] * restLength[i])
+            x[i + 1] = followTheLeader(x[i], x[i + 1], restLength[i]);
+}
+
+float HeadQuery::distance(const Vec3f& x, Vec3f* normal) const {
+    Vec3f n;
+    const float d = collider->signedDistance(toCollider * x, &n);
+    if (normal) *normal = normalToWorld * n;
+    return d;
+}
+
+Contact projectOut(const HeadQuery& head, float radius, Vec3f& x) {
+    Contact c;
+    if (!head.collider) return c;
+    if (head.distance(x, nullptr) >= radius) return c;  // the common case: no normal needed
+    Vec3f n;
+    const float d = head.distance(x, &n);
+    c.active = true;
+    c.normal = n;
+    c.push = radius - d;
+    x += c.push * n;
+    return c;
+}
+
+Contact placeSegment(const Vec3f& parent, Vec3f& child, float length, const HeadQuery* head, float radius) {
+    child = followTheLeader(parent, child, length);
+    Contact total;
+    if (!head || !head->collider) return total;
+    const Vec3f start = child;
+    for (int iter = 0; iter < 4; ++iter) {
+        const Contact c = projectOut(*head, radius, child);
+        if (!c.active) break;
+        total.active = true;
+        total.normal = c.normal;
+        child = followTheLeader(parent, child, length);
+    }
+    if (total.active) {
+        // A last projection guarantees the clearance; it can only cost length
+        // when the parent itself sits inside the clearance band.
+        const Contact c = projectOut(*head, radius, child);
+        if (c.active) total.normal = c.normal;
+        total.push = std::max(0.f, (child - start).dot(total.normal));
+    }
+    return total;
+}
+
+Vec3f contactFriction(const Vec3f& v, const Vec3f& vs, const Contact& contact, float mu, float h) {
+    if (!contact.active) return v;
+    const Vec3f& n = contact.normal;
+    const Vec3f rel = v - vs;
+    const float vnRaw = rel.dot(n) - contact.push / h;  // what it would have been without the push
+    const float vn = std::max(vnRaw, 0.f);
+    const float removed = vn - vnRaw;                    // ≥ 0: approach speed the contact stopped
+    Vec3f vt = rel - rel.dot(n) * n;
+    const float vtLen = vt.norm();
+    if (vtLen > 0.f) vt *= std::max(0.f, 1.f - mu * removed / vtLen);
+    return vs + vn * n + vt;
+}
+
+namespace {
+
+/// The Finish pass needs no frames: the projection limit bounds the angle
+/// between consecutive segments to rest bend ± (limit + projection), the
+/// same cone as the frames give for a straight rest and its ring otherwise.
+void finish(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& p, const HeadQuery* head,
+            float radius, Contact* contacts) {
+    if (contacts) contacts[0] = Contact{};
+    const float reach = p.limit + p.projection;
+    Vec3f u = rootFrame * p.restDir[0];  // the virtual follicle segment's direction
+    for (int j = 0; j + 1 < vertexCount; ++j) {
+        const Vec3f& parent = x[j];
+        Vec3f e = x[j + 1] - parent;
+        const float len = e.norm();
+        Vec3f w = len > 1e-12f ? Vec3f(e / len) : u;
+        const float bend = p.restBend[j];
+        const float c = u.dot(w);
+        if (c < p.cosMostBend[j])
+            w = rotateToAngle(w, u, bend + reach);
+        else if (c > p.cosLeastBend[j])
+            w = rotateToAngle(w, u, bend - reach);
+        Vec3f child = parent + p.restLength[j] * w;
+        const Contact k = placeSegment(parent, child, p.restLength[j], head, radius);
+        if (contacts) contacts[j + 1] = k;
+        x[j + 1] = child;
+        u = (child - parent).normalized();
+    }
+}
+
+}  // namespace
+
+void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& p,
+                 const HeadQuery* head, float radius, Contact* contacts) {
+    if (pass == JointPass::Finish) return finish(x, vertexCount, rootFrame, p, head, radius, contacts);
+    // Frames as quaternions: the pass composes two rotations per joint.
+    Quatf Q(rootFrame);
+    // Carrying every subtree explicitly costs O(n²); instead the carries are
+    // composed into one rigid map (C, c) applied to each vertex when its turn
+    // comes: the vertex's current position is C·x + c.
+    Quatf C = Quatf::Identity();
+    Vec3f c = Vec3f::Zero();
+    for (int j = 0; j + 1 < vertexCount; ++j) {
+        const Vec3f parent = x[j];
+        const Vec3f oldChild = C * x[j + 1] + c;
+        const float length = p.restLength[j];
+        const Vec3f rest = Q * p.restDir[j];
+        const Vec3f e = oldChild - parent;
+        const float len = e.norm();
+        const Vec3f d = len > 1e-12f ? Vec3f(e / len) : rest;
+        const float f = p.spring[j];
+        Vec3f dir = d;
+        if (pass == JointPass::SolvePreload) {
+            // Aim past the rest direction r so that the spring step lands on
+            // it: normalize((1-f)·d + f·t) = r with |t| = 1 gives
+            // t = (λ·r - (1-f)·d)/f, λ the positive root of
+            // λ² - 2λ(1-f)(r·d) + (1-f)² - f² = 0.
+            Vec3f target = rest;
+            if (f > 0.f) {
+                const float g = 1.f - f, cd = rest.dot(d);
+                const float lambda = g * cd + std::sqrt(std::max(0.f, g * g * cd * cd - g * g + f * f));
+                target = ((lambda * rest - g * d) / f).normalized();
+                // A pre-bend far beyond the joint's limit makes a soft joint
+                // unstable; such a joint keeps some sag instead.
+                if (angleBetween(target, rest) > 2.f * p.limit) target = rotateToAngle(target, rest, 2.f * p.limit);
+            }
+            p.springDir[j] = Q.conjugate() * target;
+            dir = rest;
+        } else if (pass == JointPass::Drive) {
+            // The implicit spring on the segment's end, x ← x + f·(x* - x),
+            // renormalised onto the segment's length.
+            dir = ((1.f - f) * d + f * (Q * p.springDir[j])).normalized();
+        }
+        // Carry the subtree with the spring's turn and the length fix: a
+        // joint drive moves what hangs from it.
+        const Quatf q = transport(d, dir);
+        C = q * C;
+        c = parent + length * dir + q * (c - oldChild);
+        x[j + 1] = parent + length * dir;
+        Q = transport(rest, dir) * Q;
+        Q.normalize();  // keep rounding from accumulating over the chain
+    }
+}
+
+void bendBounds(const Vec3f* restDir, int segments, float reach, float* restBend, float* cosMostBend,
+                float* cosLeastBend) {
+    for (int j = 0; j < segments; ++j) {
+        restBend[j] = j > 0 ? angleBetween(restDir[j - 1], restDir[j]) : 0.f;
+        cosMostBend[j] = std::cos(std::min(restBend[j] + reach, float(M_PI)));
+        cosLeastBend[j] = restBend[j] > reach ? std::cos(restBend[j] - reach) : 2.f;  // 2: never
+    }
+}
+
+void bendLimitSpan(const float* restLength, const Vec3f* restDir, int segments, float limit, float* minSpan,
+                   float* maxSpan) {
+    for (int j = 0; j < segments; ++j) {
+        const float l0 = restLength[j > 0 ? j - 1 : 0], l1 = restLength[j];
+        const float rest = j > 0 ? angleBetween(restDir[j - 1], restDir[j]) : 0.f;
+        auto span = [&](float angle) { return std::sqrt(l0 * l0 + l1 * l1 + 2.f * l0 * l1 * std::cos(angle)); };
+        minSpan[j] = span(std::min(rest + limit, float(M_PI)));
+        // A joint whose rest bend is within the limit may straighten fully:
+        // no upper bound (D(0) would also catch mere stretch mid-solve).
+        maxSpan[j] = rest > limit ? span(rest - limit) : std::numeric_limits<float>::infinity();
+    }
+}
+
+void limitSpan(Vec3f& a, Vec3f& b, float wa, float wb, float minSpan, float maxSpan, float fraction) {
+    const Vec3f e = b - a;
+    const float d2 = e.squaredNorm();
+    if (d2 >= minSpan * minSpan && d2 <= maxSpan * maxSpan) return;  // the common case, no sqrt
+    const float w = wa + wb;
+    if (w <= 0.f || d2 <= 0.f) return;
+    const float d = std::sqrt(d2);
+    const float excess = d < minSpan ? d - minSpan : d - maxSpan;
+    const Vec3f corr = (fraction * excess / (d * w)) * e;
+    a += wa * corr;
+    b -= wb * corr;
+}
+
+void separateSegments(Vec3f& a0, Vec3f& a1, Vec3f& b0, Vec3f& b1, float s, float t, const Vec3f& normal,
+                      float depth, const float w[4]) {
+    const float alpha[2] = {1.f - s, s};
+    const float beta[2] = {1.f - t, t};
+    const float denom = w[0] * alpha[0] * alpha[0] + w[1] * alpha[1] * alpha[1] + w[2] * beta[0] * beta[0] +
+                        w[3] * beta[1] * beta[1];
+    if (denom <= 0.f) return;
+    const float lambda = depth / denom;
+    a0 += w[0] * alpha[0] * lambda * normal;
+    a1 += w[1] * alpha[1] * lambda * normal;
+    b0 -= w[2] * beta[0] * lambda * normal;
+    b1 -= w[3] * beta[1] * lambda * normal;
+}
+
+}  // namespace hp::strand

@@ -1,0 +1,372 @@
+// The guide solver (sim/guides.h) in both formulations, and the scene mapping
+// (pipeline/sim_settings.h). Falling chains are chaotic, so the tests assert
+// stable quantities — lengths, limits, clearance, energy — not trajectories.
+#include "core/errors.h"
+#include "pipeline/scene.h"
+#include "pipeline/sim_settings.h"
+#include "sim/fibonacci.h"
+#include "sim/guides.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace hp;
+
+namespace {
+
+/// Root frames of guides on a sphere head of `radius` posed by `pose`.
+std::vector<SurfaceFrame> sphereRoots(const std::vector<Vec3f>& dirs, float radius, const HeadPose& pose) {
+    std::vector<SurfaceFrame> roots(dirs.size());
+    for (size_t i = 0; i < dirs.size(); ++i) {
+        const Vec3f& n = dirs[i];
+        Vec3f t = Vec3f::UnitY().cross(n);
+        t = t.squaredNorm() > 1e-8f ? Vec3f(t.normalized()) : Vec3f(n.unitOrthogonal());
+        roots[i].position = pose.transform * (radius * n);
+        roots[i].normal = pose.transform.linear() * n;
+        roots[i].tangent = pose.transform.linear() * t;
+    }
+    return roots;
+}
+
+/// A head pose with no mesh or collider (free strands).
+HeadPose noHead(double time, const Eigen::Isometry3f& transform = Eigen::Isometry3f::Identity()) {
+    HeadPose p;
+    p.time = time;
+    p.transform = transform;
+    return p;
+}
+
+/// Runs `steps` steps of guides on a spinning sphere; `check` sees each step.
+template <typename Check>
+void runSphere(GuideSolver& solver, const std::vector<Vec3f>& dirs, float rate, int steps, Check&& check) {
+    SpinningSphere head(0.1f, rate);
+    HeadPose pose = head.sample(0.0);
+    solver.initialize(sphereRoots(dirs, 0.1f, pose), pose);
+    for (int k = 1; k <= steps; ++k) {
+        pose = head.sample(solver.nextTime());
+        check(solver.step(sphereRoots(dirs, 0.1f, pose), pose), pose, k);
+    }
+}
+
+float maxSegmentError(const StrandFrame& f, float rest) {
+    float worst = 0;
+    for (size_t s = 0; s < f.strandCount(); ++s)
+        for (uint32_t i = f.first(s); i + 1 < f.offsets[s + 1]; ++i)
+            worst = std::max(worst, std::abs((f.positions[i + 1] - f.positions[i]).norm() / rest - 1.f));
+    return worst;
+}
+
+}  // namespace
+
+TEST(Guides, LengthErrorBelowATenthOfAPercent) {
+    GuideSettings s;  // the default (rope) formulation
+    GuideSolver solver(s);
+    const float rest = s.length / float(s.segments);
+    runSphere(solver, fibonacciCap(24), 360.f, 150, [&](const GuideStats& st, const HeadPose&, int k) {
+        ASSERT_LE(st.maxLengthError, 1e-3) << "step " << k;
+        ASSERT_EQ(st.nanCount, 0u);
+    });
+    StrandFrame f;
+    solver.write(f);
+    EXPECT_LE(maxSegmentError(f, rest), 1e-3f) << "measured independently of the solver's statistics";
+    EXPECT_EQ(f.guideCount, 24u);
+    EXPECT_NO_THROW(f.validate());
+}
+
+TEST(Guides, StrandUnderGravitySettlesAndHangsDown) {
+    GuideSettings s;
+    s.preload = false;
+    s.bendStiffness = 1e-7f;  // nearly limp: gravity wins over the joint springs
+    GuideSolver solver(s);
+    SurfaceFrame root;
+    root.position = Vec3f(0.1f, 0, 0);
+    root.normal = Vec3f::UnitX();  // straight out sideways at t = 0
+    root.tangent = Vec3f::UnitZ();
+    const std::vector<SurfaceFrame> roots{root};
+    solver.initialize(roots, noHead(0.0));
+    double peak = 0, last = 0;
+    for (int k = 1; k <= 1000; ++k) {
+        const GuideStats& st = solver.step(roots, noHead(k * 0.02));
+        ASSERT_EQ(st.nanCount, 0u);
+        peak = std::max(peak, st.kineticEnergy);
+        last = st.kineticEnergy;
+    }
+    EXPECT_GT(peak, 1e-4) << "it fell";
+    EXPECT_LT(last, 1e-3 * peak) << "and came to rest";
+    StrandFrame f;
+    solver.write(f);
+    const Vec3f tip = f.positions.back();
+    // Bend limits of ±30° over 23 joints allow hanging straight down.
+    EXPECT_LT(tip.y(), -0.2f) << "tip " << tip.transpose();
+    EXPECT_LT(std::abs(tip.x() - 0.1f), 0.05f);
+}
+
+TEST(Guides, PreloadHoldsTheRestShapeUnderGravity) {
+    GuideSettings s;  // preload on by default
+    GuideSolver solver(s);
+    const std::vector<Vec3f> dirs = fibonacciCap(16);
+    SpinningSphere head(0.1f, 0.f);  // still head: nothing should move
+    const HeadPose pose = head.sample(0.0);
+    solver.initialize(sphereRoots(dirs, 0.1f, pose), pose);
+    StrandFrame start, end;
+    solver.write(start);
+    for (int k = 1; k <= 100; ++k) solver.step(sphereRoots(dirs, 0.1f, head.sample(k * 0.02)), head.sample(k * 0.02));
+    solver.write(end);
+    float drift = 0;
+    for (size_t i = 0; i < start.positions.size(); ++i)
+        drift = std::max(drift, (end.positions[i] - start.positions[i]).norm());
+    EXPECT_LT(drift, 1e-4f) << "no sag at t = 0 (0.1 mm)";
+
+    GuideSettings off = s;
+    off.preload = false;
+    GuideSolver sagging(off);
+    sagging.initialize(sphereRoots(dirs, 0.1f, pose), pose);
+    for (int k = 1; k <= 100; ++k)
+        sagging.step(sphereRoots(dirs, 0.1f, head.sample(k * 0.02)), head.sample(k * 0.02));
+    sagging.write(end);
+    drift = 0;
+    for (size_t i = 0; i < start.positions.size(); ++i)
+        drift = std::max(drift, (end.positions[i] - start.positions[i]).norm());
+    EXPECT_GT(drift, 1e-3f) << "without the pre-load the same guides sag";
+}
+
+TEST(Guides, RopeBendingStaysWithinLimits) {
+    GuideSettings s;
+    s.preload = false;
+    s.bendStiffness = 1e-7f;  // soft: gravity and the spin push joints onto their limits
+    s.headCollision = false;  // the head would force its own bends
+    GuideSolver solver(s);
+    float worst = 0;
+    runSphere(solver, fibonacciCap(12), 720.f, 200, [&](const GuideStats&, const HeadPose&, int) {
+        float bend, twist;
+        solver.jointAngles(bend, twist);
+        worst = std::max(worst, bend);
+    });
+    EXPECT_GT(worst, s.bendLimit - 1.f) << "the limits were reached";
+    EXPECT_LE(worst, s.bendLimit + s.projectionAngle + 0.1f);
+}
+
+TEST(Guides, RigidBendingAndTwistStayWithinLimits) {
+    GuideSettings s;
+    s.formulation = GuideFormulation::Rigid;
+    s.preload = false;
+    GuideSolver solver(s);
+    float bend = 0, twist = 0;
+    runSphere(solver, fibonacciCap(4), 180.f, 60, [&](const GuideStats& st, const HeadPose&, int) {
+        ASSERT_EQ(st.nanCount, 0u);
+        float b, t;
+        solver.jointAngles(b, t);
+        bend = std::max(bend, b);
+        twist = std::max(twist, t);
+    });
+    EXPECT_GT(bend, 1.f) << "the chains moved";
+    EXPECT_LE(bend, s.bendLimit + s.projectionAngle + 0.1f);
+    EXPECT_LE(twist, s.twistLimit + s.projectionAngle + 0.1f);
+}
+
+TEST(Guides, StableOverTenThousandStepsWithATeleport) {
+    GuideSettings s;
+    GuideSolver solver(s);
+    const std::vector<Vec3f> dirs = fibonacciCap(8);
+    SpinningSphere spin(0.1f, 180.f);
+    Eigen::Isometry3f offset = Eigen::Isometry3f::Identity();
+    auto poseAt = [&](int k) {
+        HeadPose p = spin.sample(k * 0.02);
+        p.transform = offset * p.transform;
+        for (Vec3f& v : p.mesh.positions) v = offset * v;
+        p.collider = std::make_shared<SphereCollider>(offset.translation(), 0.1f);
+        return p;
+    };
+    HeadPose pose = poseAt(0);
+    solver.initialize(sphereRoots(dirs, 0.1f, pose), pose);
+    double peak = 0;
+    int resets = 0;
+    for (int k = 1; k <= 10000; ++k) {
+        if (k == 5000) offset.translation() = Vec3f(2.f, 0.5f, -1.f);  // a scene cut
+        pose = poseAt(k);
+        const GuideStats& st = solver.step(sphereRoots(dirs, 0.1f, pose), pose);
+        ASSERT_EQ(st.nanCount, 0u) << "step " << k;
+        ASSERT_LE(st.maxLengthError, 1e-3) << "step " << k;
+        ASSERT_LE(st.maxPenetration, 1e-3) << "step " << k;
+        if (st.reset) {
+            ++resets;
+            EXPECT_EQ(k, 5000);
+            EXPECT_EQ(st.kineticEnergy, 0.0) << "restarted at rest";
+        }
+        peak = std::max(peak, st.kineticEnergy);
+    }
+    EXPECT_EQ(resets, 1);
+    // Rigid rotation at 180°/s of 8 guides of 1.25 g is ~2e-4 J; bounded means
+    // it never runs away from that scale.
+    EXPECT_LT(peak, 1e-2);
+    StrandFrame f;
+    solver.write(f);
+    EXPECT_LT((f.positions[0] - offset * (pose.transform.linear() * (0.1f * dirs[0]))).norm(), 0.2f)
+        << "the guides followed the head to its new place";
+}
+
+TEST(Guides, NoVertexSinksIntoAFastTurningHead) {
+    GuideSettings s;
+    s.preload = false;
+    s.bendStiffness = 0;  // limp hair lies on the head and is dragged over it
+    GuideSolver solver(s);
+    const SphereCollider sphere(Vec3f::Zero(), 0.1f);
+    size_t touching = 0;
+    double deepest = 0;
+    runSphere(solver, fibonacciCap(48), 720.f, 200, [&](const GuideStats& st, const HeadPose&, int k) {
+        ASSERT_EQ(st.nanCount, 0u);
+        deepest = std::max(deepest, st.maxPenetration);
+        if (k == 200) {
+            StrandFrame f;
+            solver.write(f);
+            for (const Vec3f& p : f.positions) touching += sphere.signedDistance(p) < 2.f * s.collisionRadius;
+        }
+    });
+    EXPECT_GT(touching, 100u) << "the hair does lie on the head, so the test exercises the contacts";
+    EXPECT_LE(deepest, 1e-3) << "goal: no vertex deeper than 1 mm";
+    EXPECT_EQ(deepest, 0.0) << "measured: none inside the head at all";
+}
+
+TEST(Guides, IdenticalResultsForOneAndTwoThreads) {
+    for (bool strandCollision : {false, true}) {
+        std::vector<StrandFrame> frames(2);
+        for (int threads : {1, 2}) {
+            GuideSettings s;
+            s.threads = threads;
+            s.strandsPerWorld = 4;
+            s.strandCollision = strandCollision;
+            GuideSolver solver(s);
+            runSphere(solver, fibonacciCap(32), 360.f, 40, [](const GuideStats&, const HeadPose&, int) {});
+            solver.write(frames[threads - 1]);
+        }
+        ASSERT_EQ(frames[0].positions.size(), frames[1].positions.size());
+        for (size_t i = 0; i < frames[0].positions.size(); ++i) {
+            ASSERT_EQ(frames[0].positions[i], frames[1].positions[i]) << "vertex " << i;
+            ASSERT_EQ(frames[0].velocities[i], frames[1].velocities[i]) << "vertex " << i;
+        }
+    }
+}
+
+TEST(Guides, StrandCollisionSeparatesCrossingGuides) {
+    // Two groomed guides crossing 0.5 mm apart, no gravity: with strand
+    // collision they end at least two collision radii apart.
+    GuideSettings s;
+    s.gravity = Vec3f::Zero();
+    s.strandCollision = true;
+    s.segments = 20;
+    s.length = 0.2f;
+    std::vector<SurfaceFrame> roots(2);
+    roots[0].position = Vec3f(-0.1f, 0, 0);
+    roots[0].normal = Vec3f::UnitX();
+    roots[0].tangent = Vec3f::UnitY();
+    roots[1].position = Vec3f(0, -0.1f, 0.0005f);
+    roots[1].normal = Vec3f::UnitY();
+    roots[1].tangent = Vec3f::UnitX();
+    std::vector<std::vector<Vec3f>> groom(2);
+    for (int i = 0; i <= 20; ++i) {
+        groom[0].push_back(roots[0].position + Vec3f(0.01f * i, 0, 0));
+        groom[1].push_back(roots[1].position + Vec3f(0, 0.01f * i, 0));
+    }
+    GuideSolver solver(s);
+    solver.initialize(roots, noHead(0.0), &groom);
+    size_t contacts = 0;
+    for (int k = 1; k <= 5; ++k) contacts += solver.step(roots, noHead(k * 0.02)).strandContacts;
+    EXPECT_GT(contacts, 0u);
+    StrandFrame f;
+    solver.write(f);
+    // The crossing is near the middle of both: closest vertex-to-segment distance.
+    float closest = 1e9f;
+    for (uint32_t i = f.first(0); i < f.offsets[1]; ++i)
+        for (uint32_t j = f.first(1); j + 1 < f.offsets[2]; ++j) {
+            const Vec3f a = f.positions[j], b = f.positions[j + 1], p = f.positions[i];
+            const float t = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.f, 1.f);
+            closest = std::min(closest, (p - (a + t * (b - a))).norm());
+        }
+    EXPECT_GE(closest, 2.f * s.collisionRadius * 0.95f);
+    EXPECT_LE(solver.lastStats().maxLengthError, 1e-3);
+}
+
+TEST(Guides, WriteBetweenStepsInterpolatesWithExactLengths) {
+    GuideSettings s;
+    GuideSolver solver(s);
+    runSphere(solver, fibonacciCap(6), 720.f, 10, [](const GuideStats&, const HeadPose&, int) {});
+    StrandFrame mid, end;
+    solver.write(mid, solver.time() - 0.5 * s.timeStep);
+    solver.write(end);
+    EXPECT_NEAR(mid.time, solver.time() - 0.01, 1e-9);
+    EXPECT_LE(maxSegmentError(mid, s.length / s.segments), 1e-5f);
+    EXPECT_NE(mid.positions.back(), end.positions.back());
+    EXPECT_NEAR(mid.radii.front(), s.rootRadius, 1e-9f);
+    EXPECT_NEAR(mid.radii[s.segments], s.tipRadius, 1e-9f);
+    EXPECT_THROW(solver.write(mid, solver.time() + 0.1), Error);
+}
+
+TEST(Guides, MisuseIsReported) {
+    GuideSolver solver(GuideSettings{});
+    SurfaceFrame root;
+    EXPECT_THROW(solver.step({root}, noHead(0.02)), Error);
+    solver.initialize({root}, noHead(0.0));
+    EXPECT_THROW(solver.step({root}, noHead(0.5)), Error) << "not the step's end time";
+    EXPECT_THROW(solver.step({root, root}, noHead(0.02)), Error) << "root count changed";
+    GuideSettings bad;
+    bad.substeps = 0;
+    EXPECT_THROW(GuideSolver{bad}, Error);
+}
+
+TEST(Guides, StatisticsAccumulateAndPrintAsJson) {
+    GuideStats a, b;
+    a.maxLengthError = 1e-6;
+    a.maxPenetration = 0;
+    a.msPerStep = 2;
+    b.maxLengthError = 5e-7;
+    b.maxPenetration = 2e-4;
+    b.penetrationCount = 3;
+    b.msPerStep = 4;
+    b.kineticEnergy = 0.5;
+    a.accumulate(b);
+    EXPECT_DOUBLE_EQ(a.maxLengthError, 1e-6);
+    EXPECT_DOUBLE_EQ(a.maxPenetration, 2e-4);
+    EXPECT_EQ(a.penetrationCount, 3u);
+    EXPECT_DOUBLE_EQ(a.msPerStep, 3.0);
+    EXPECT_EQ(a.steps, 2u);
+    EXPECT_DOUBLE_EQ(a.kineticEnergy, 0.5);
+    const std::string line = a.json(12, 0.5);
+    EXPECT_NE(line.find("\"frame\": 12"), std::string::npos) << line;
+    EXPECT_NE(line.find("\"penetrations\": 3"), std::string::npos) << line;
+    EXPECT_NE(line.find("\"reset\": false}"), std::string::npos) << line;
+    EXPECT_EQ(line.find('\n'), std::string::npos);
+}
+
+TEST(SimSettings, SceneKeysMapOntoGuideSettings) {
+    const Scene scene = Scene::parse(
+        "simulation:\n  formulation: rigid\n  substeps: 4\n  damping: 2.5\n  strand_collision: true\n"
+        "  limits: {bend: 20, twist: 5}\n  gravity: [0, -1, 0]\nhair:\n  guides: {segments: 10, length: 0.3}\n",
+        "test.yaml", ".");
+    const GuideSettings s = guideSettings(scene);
+    EXPECT_EQ(s.formulation, GuideFormulation::Rigid);
+    EXPECT_EQ(s.substeps, 4);
+    EXPECT_FLOAT_EQ(s.damping, 2.5f);
+    EXPECT_TRUE(s.strandCollision);
+    EXPECT_FLOAT_EQ(s.bendLimit, 20.f);
+    EXPECT_FLOAT_EQ(s.twistLimit, 5.f);
+    EXPECT_EQ(s.gravity, Vec3f(0, -1, 0));
+    EXPECT_EQ(s.segments, 10);
+    EXPECT_FLOAT_EQ(s.length, 0.3f);
+    EXPECT_FLOAT_EQ(s.timeStep, 0.02f) << "defaults fill the rest";
+    EXPECT_EQ(s.iterations, 20);
+    EXPECT_FLOAT_EQ(s.friction, 0.2f);
+    EXPECT_FLOAT_EQ(s.rootRadius, 0.00004f);
+}
+
+TEST(SimSettings, CollisionRadiusMustFitASegment) {
+    const Scene scene =
+        Scene::parse("hair:\n  guides: {segments: 100, length: 0.1, collision_radius: 0.001}\n", "test.yaml", ".");
+    try {
+        guideSettings(scene);
+        FAIL() << "expected a SceneError";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(e.key(), "hair.guides.collision_radius");
+        EXPECT_NE(std::string(e.what()).find("half a segment"), std::string::npos) << e.what();
+    }
+}

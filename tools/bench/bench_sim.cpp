@@ -1,0 +1,150 @@
+// B-sim (BENCHMARKS.md): guide simulation on a sphere head.
+//
+// Head: sphere r = 0.1 m at the origin spinning about +Y at 90°/s for the
+// whole run. Guides: N = 94 and 845, roots on a Fibonacci lattice over the
+// upper hemisphere, straight along the normal, 0.25 m, 24 vertices, collision
+// radius 1 mm; gravity -9.81; one step = 0.02 s. 20 warm-up steps, then 250
+// timed steps. Reports steps/s (median of --runs runs, with min-max), the
+// largest segment stretch |len/rest - 1| and the deepest vertex penetration
+// over the timed steps, NaN count, threads — for both formulations, with and
+// without strand-strand collision, on 1 and 2 threads.
+//
+//   bench_sim [--guides 94,845] [--formulation rope,rigid] [--strand-collision off,on]
+//             [--threads 1,2] [--runs 3] [--warmup 20] [--steps 250]
+//             [--substeps 1] [--iterations 20] [--per-world 16] [--rate 90]
+#include "sim/fibonacci.h"
+#include "sim/guides.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace hp;
+
+namespace {
+
+std::vector<std::string> split(const std::string& s) {
+    std::vector<std::string> out;
+    std::stringstream in(s);
+    for (std::string item; std::getline(in, item, ',');) out.push_back(item);
+    return out;
+}
+
+/// Root frames of the B-sim head at time t: the lattice directions carried by
+/// the head's rotation (a root bound to a rigid head moves with it).
+std::vector<SurfaceFrame> rootsAt(const std::vector<Vec3f>& dirs, float radius, const HeadPose& pose) {
+    std::vector<SurfaceFrame> roots(dirs.size());
+    for (size_t i = 0; i < dirs.size(); ++i) {
+        const Vec3f& n = dirs[i];
+        Vec3f t = Vec3f::UnitY().cross(n);
+        t = t.squaredNorm() > 1e-8f ? Vec3f(t.normalized()) : Vec3f(n.unitOrthogonal());
+        roots[i].position = pose.transform * (radius * n);
+        roots[i].normal = pose.transform.linear() * n;
+        roots[i].tangent = pose.transform.linear() * t;
+    }
+    return roots;
+}
+
+struct RunResult {
+    double stepsPerSecond = 0;
+    GuideStats stats;
+};
+
+RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int warmup, int steps) {
+    const float radius = 0.1f;
+    SpinningSphere head(radius, rate);
+    const std::vector<Vec3f> dirs = fibonacciCap(guides);
+    GuideSolver solver(settings);
+    HeadPose pose = head.sample(0.0);
+    solver.initialize(rootsAt(dirs, radius, pose), pose);
+    RunResult r;
+    std::chrono::steady_clock::time_point start;
+    for (int k = 1; k <= warmup + steps; ++k) {
+        if (k == warmup + 1) start = std::chrono::steady_clock::now();
+        pose = head.sample(double(k) * settings.timeStep);
+        const GuideStats& s = solver.step(rootsAt(dirs, radius, pose), pose);
+        if (k > warmup) {
+            if (k == warmup + 1) r.stats = s;
+            else r.stats.accumulate(s);
+        }
+    }
+    // Head sampling and root evaluation are inside the timed loop on purpose:
+    // a shot driver pays them too (they are small next to the step).
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    r.stepsPerSecond = steps / seconds;
+    return r;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::vector<std::string> guideList{"94", "845"}, formList{"rope", "rigid"}, collList{"off", "on"},
+        threadList{"1", "2"};
+    int runs = 3, warmup = 20, steps = 250, substeps = 1, iterations = 20, perWorld = 16;
+    float rate = 90.f;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto next = [&]() -> std::string {
+            if (i + 1 >= argc) {
+                std::fprintf(stderr, "bench_sim: %s needs a value\n", a.c_str());
+                std::exit(1);
+            }
+            return argv[++i];
+        };
+        if (a == "--guides") guideList = split(next());
+        else if (a == "--formulation") formList = split(next());
+        else if (a == "--strand-collision") collList = split(next());
+        else if (a == "--threads") threadList = split(next());
+        else if (a == "--runs") runs = std::stoi(next());
+        else if (a == "--warmup") warmup = std::stoi(next());
+        else if (a == "--steps") steps = std::stoi(next());
+        else if (a == "--substeps") substeps = std::stoi(next());
+        else if (a == "--iterations") iterations = std::stoi(next());
+        else if (a == "--per-world") perWorld = std::stoi(next());
+        else if (a == "--rate") rate = std::stof(next());
+        else {
+            std::fprintf(stderr, "bench_sim: unknown option %s\n", a.c_str());
+            return 1;
+        }
+    }
+    std::printf("B-sim: sphere r=0.1 m spinning %.0f deg/s about Y; %d warm-up + %d timed steps of 0.02 s; "
+                "24 vertices, 0.25 m, collision radius 1 mm; substeps %d, iterations %d, %d guides per world; "
+                "median of %d runs (min-max)\n\n",
+                rate, warmup, steps, substeps, iterations, perWorld, runs);
+    std::printf("| guides | formulation | strand coll. | threads | steps/s median (min-max) | max stretch | "
+                "max penetration mm | NaN | ms/step |\n");
+    std::printf("|---:|---|---|---:|---|---:|---:|---:|---:|\n");
+    for (const std::string& gs : guideList)
+        for (const std::string& form : formList)
+            for (const std::string& coll : collList)
+                for (const std::string& th : threadList) {
+                    GuideSettings s;
+                    s.formulation = parseFormulation(form);
+                    s.strandCollision = coll == "on";
+                    s.threads = std::stoi(th);
+                    s.substeps = substeps;
+                    s.iterations = iterations;
+                    s.strandsPerWorld = perWorld;
+                    std::vector<RunResult> results;
+                    for (int r = 0; r < runs; ++r) results.push_back(runOnce(s, std::stoul(gs), rate, warmup, steps));
+                    std::vector<double> sps;
+                    GuideStats worst = results[0].stats;
+                    for (const RunResult& r : results) {
+                        sps.push_back(r.stepsPerSecond);
+                        worst.accumulate(r.stats);
+                    }
+                    std::sort(sps.begin(), sps.end());
+                    const double median = sps[sps.size() / 2];
+                    std::printf("| %s | %s | %s | %s | %.1f (%.1f-%.1f) | %.2e | %.3f | %zu | %.3f |\n", gs.c_str(),
+                                form.c_str(), coll.c_str(), th.c_str(), median, sps.front(), sps.back(),
+                                worst.maxLengthError, worst.maxPenetration * 1000.0, worst.nanCount,
+                                1000.0 / median);
+                    std::fflush(stdout);
+                }
+    return 0;
+}
