@@ -1,5 +1,6 @@
-// Internal to sim/followers*.cpp: the state a Followers object builds once
-// and reads every step. Not for other modules (include sim/followers.h).
+// Internal to sim/followers*.cpp and sim/follower_step.cpp: the state a
+// Followers object builds once and the tables each step fills. Not for other
+// modules (include sim/followers.h).
 #pragma once
 
 #include "sim/follower_kernels.h"
@@ -14,23 +15,40 @@ namespace hp {
 /// Longest strand the follower tables accept (stack scratch is sized by it).
 constexpr uint32_t kMaxFollowerVertices = 256;
 
-/// Followers sharing one segment count S; their guide tables are resampled
-/// to S segments, padded to P (a multiple of 8) so every loop over segments
-/// runs over whole vectors.
+/// Two guides read together by some followers: guide 1 leads, guide 2's
+/// rotations are turned about y into guide 1's frame by K = (twistC, twistS).
+struct GuidePair {
+    uint32_t guide1 = 0, guide2 = 0;
+    float twistC = 1.f, twistS = 0.f;
+};
+
+/// Followers sharing one segment count S. Every table is in slots: rows of P
+/// floats (P a multiple of 8, P >= S + 1) where slot j is vertex j and
+/// segment j - 1, the segment ending at vertex j; slot 0 (the root) and the
+/// padding hold zero directions, so a row runs over whole vectors and a
+/// prefix sum of slot directions gives vertex positions.
 struct FollowerClass {
     uint32_t segments = 0;
     uint32_t pad = 0;
-    /// Per guide, kHot rows of P floats: qw qx qy qz (rotation of the guide
-    /// segment mapped to follower segment y), speed (m/s, the segment's
-    /// centre), rx ry rz (the guide's unit rest direction, static).
+    /// Per guide, kHot rows: qw qx qy qz (rotation of the guide segment
+    /// mapped to the slot's segment; identity outside), speed (m/s, the
+    /// segment's centre), rx ry rz (the guide's unit rest direction, static).
     std::vector<float> hot;
-    /// Per guide, S + 1 mapped vertices × kCold floats: x y z (world),
-    /// clearance (signed distance to the head), vx vy vz, unused.
+    /// Per guide, kCold rows, slot = vertex: x y z (world), bound (see
+    /// collisionBound), vx vy vz, unused.
     std::vector<float> cold;
-    std::vector<float> radii;  ///< S + 1 tapered radii
-    std::vector<float> df;     ///< Algorithm 1's d_f(y), P values (exact at root and tip)
+    /// Guide pairs of this class's followers and, per pair, kPair rows
+    /// rebuilt every step: θ and d_v (Algorithm 1's clamped guide-1 speed),
+    /// then either A, B - A, D of follower_kernels.h's (2) for the guides'
+    /// rest direction (followers without own rest shapes) or the quaternions
+    /// a and e of (1) (own rest shapes).
+    std::vector<GuidePair> pairs;
+    std::vector<float> pairTable;
+    std::vector<float> radii;          ///< S + 1 tapered radii
+    std::vector<float> weightedCurve;  ///< fixedOffset · d_f(j - 1) per slot, 0 at slot 0 and in the padding
     static constexpr int kHot = 8;
     static constexpr int kCold = 8;
+    static constexpr int kPair = 11;
 
     /// Guide segment read by follower segment y: the one covering the same
     /// fraction of the strand, floor((y + 1/2) Sg / S); y itself when Sg = S.
@@ -54,12 +72,14 @@ struct Followers::Impl {
     // Followers, structure of arrays.
     std::vector<FollowerNeighbours> neighbours;
     std::vector<uint8_t> classOf;
+    std::vector<uint32_t> pairOf;          ///< index into the class's pairs
     std::vector<float> weight;             ///< interpolation weight d1 / (d1 + d2)
     std::vector<float> alignC, alignS;     ///< follower frame turned about its normal by φ_f
-    std::vector<float> twistC, twistS;     ///< guide 2's rotations turned into guide 1's frame
     std::vector<float> segmentLength;      ///< followers without own rest shapes
     std::vector<uint32_t> ownRest;         ///< offset into ownRestData, or kNone
-    std::vector<float> ownRestData;        ///< per follower: dx[P] dy[P] dz[P] length[P], aligned frame
+    /// Per follower 3 rows of P slots: its rest segments (direction × length)
+    /// in its aligned frame; zero at slot 0 and in the padding.
+    std::vector<float> ownRestData;
     std::vector<uint32_t> vertexOffset;    ///< follower vertex offsets, relative to the follower block
     std::vector<uint32_t> ids;
     std::vector<uint32_t> order;           ///< processing order: by class, then index (streams memory)
@@ -70,4 +90,38 @@ struct Followers::Impl {
     size_t lastVertexCount = 0;
 };
 
+namespace follower {
+
+/// Collision bound of a guide vertex for follower vertices near it: the
+/// signed distance is 1-Lipschitz, so a follower vertex p with
+/// |p - g|² < bound is outside the head by more than the root radius (the
+/// largest follower radius) and needs no query. bound = (clearance(g) -
+/// rootRadius)² when that is positive, -1 (never) otherwise.
+inline float collisionBound(float clearance, float rootRadius) {
+    const float clear = clearance - rootRadius;
+    return clear > 0.f ? clear * clear : -1.f;
+}
+
+/// What one step of the followers reads and writes (follower_step.cpp).
+struct StepContext {
+    const Followers::Impl* im;
+    const SurfaceFrame* roots;
+    const Collider* collider;  ///< null: no collision
+    Vec3f* positions;          ///< the follower block of the output
+    Vec3f* velocities;
+    bool difference;           ///< finite-difference velocities
+    float invDt;
+};
+
+struct Counters {
+    size_t projected = 0, queries = 0;
+};
+
+/// Rebuilds the pair rows [begin, end) of class `c` from its guide rows.
+void buildPairs(const Followers::Impl& im, FollowerClass& c, size_t begin, size_t end);
+
+/// Followers order[begin, end) of this step: shapes, collision, output.
+void processFollowers(const StepContext& ctx, size_t begin, size_t end, Counters& counters);
+
+}  // namespace follower
 }  // namespace hp
