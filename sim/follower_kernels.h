@@ -20,6 +20,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -175,7 +176,10 @@ HP_FOLLOWER_KERNEL void slerpArc(const Quat& a, Quat b, float& theta, Quat& e) {
     const float rw = b.w * sign - d * a.w, rx = b.x * sign - d * a.x;
     const float ry = b.y * sign - d * a.y, rz = b.z * sign - d * a.z;
     const float sinTheta = std::sqrt(rw * rw + rx * rx + ry * ry + rz * rz);
-    const float inv = sinTheta > 1e-20f ? 1.f / sinTheta : 0.f;
+    // Divide unconditionally, then select: a division under a condition
+    // could trap, and the compiler would not vectorize the loop around it.
+    const float reciprocal = 1.f / std::max(sinTheta, 1e-20f);
+    const float inv = sinTheta > 1e-20f ? reciprocal : 0.f;
     e = {rw * inv, rx * inv, ry * inv, rz * inv};
     theta = atan2Positive(sinTheta, d);
 }

@@ -40,31 +40,67 @@ template <bool Own>
     const float maxVelocity = im.settings.maxVelocity;
     for (size_t p = begin; p < end; ++p) {
         const GuidePair& gp = c.pairs[p];
-        const float* __restrict h1 = c.hot.data() + size_t(gp.guide1) * FollowerClass::kHot * P;
-        const float* __restrict h2 = c.hot.data() + size_t(gp.guide2) * FollowerClass::kHot * P;
-        float* __restrict row = c.pairTable.data() + p * FollowerClass::kPair * P;
+        // One pointer per row: the loop below then reads and writes
+        // contiguous rows and vectorizes over the slots.
+        const float* h1 = c.hot.data() + size_t(gp.guide1) * FollowerClass::kHot * P;
+        const float* h2 = c.hot.data() + size_t(gp.guide2) * FollowerClass::kHot * P;
+        const float* __restrict aW = h1;
+        const float* __restrict aX = h1 + P;
+        const float* __restrict aY = h1 + 2 * P;
+        const float* __restrict aZ = h1 + 3 * P;
+        const float* __restrict speed = h1 + 4 * P;
+        const float* __restrict fX = h1 + 5 * P;
+        const float* __restrict fY = h1 + 6 * P;
+        const float* __restrict fZ = h1 + 7 * P;
+        const float* __restrict bW = h2;
+        const float* __restrict bX = h2 + P;
+        const float* __restrict bY = h2 + 2 * P;
+        const float* __restrict bZ = h2 + 3 * P;
+        float* const row = c.pairTable.data() + p * FollowerClass::kPair * P;
+        float* __restrict o0 = row;
+        float* __restrict o1 = row + P;
+        float* __restrict o2 = row + 2 * P;
+        float* __restrict o3 = row + 3 * P;
+        float* __restrict o4 = row + 4 * P;
+        float* __restrict o5 = row + 5 * P;
+        float* __restrict o6 = row + 6 * P;
+        float* __restrict o7 = row + 7 * P;
+        float* __restrict o8 = row + 8 * P;
+        float* __restrict o9 = row + 9 * P;
+        float* __restrict o10 = row + 10 * P;
         const float kc = gp.twistC, ks = gp.twistS;
+        // Rows never overlap; restrict alone does not tell GCC once inlined here.
+#pragma GCC ivdep
         for (size_t j = 0; j < P; ++j) {
-            const Quat a{h1[j], h1[P + j], h1[2 * P + j], h1[3 * P + j]};
+            const Quat a{aW[j], aX[j], aY[j], aZ[j]};
             // Guide 2's rotation turned into guide 1's frame: K q2 K⁻¹, K about y.
-            const Quat b{h2[j], kc * h2[P + j] + ks * h2[3 * P + j], h2[2 * P + j], -ks * h2[P + j] + kc * h2[3 * P + j]};
+            const Quat b{bW[j], kc * bX[j] + ks * bZ[j], bY[j], -ks * bX[j] + kc * bZ[j]};
             float theta;
             Quat e;
             slerpArc(a, b, theta, e);
-            row[j] = theta;
-            row[P + j] = variableOffset(h1[4 * P + j], maxVelocity);
+            o0[j] = theta;
+            o1[j] = variableOffset(speed[j], maxVelocity);
             if constexpr (Own) {
-                const float q[8] = {a.w, a.x, a.y, a.z, e.w, e.x, e.y, e.z};
-                for (int k = 0; k < 8; ++k) row[(2 + k) * P + j] = q[k];
+                o2[j] = a.w;
+                o3[j] = a.x;
+                o4[j] = a.y;
+                o5[j] = a.z;
+                o6[j] = e.w;
+                o7[j] = e.x;
+                o8[j] = e.y;
+                o9[j] = e.z;
             } else {
-                const Eigen::Vector3f f(h1[5 * P + j], h1[6 * P + j], h1[7 * P + j]);
                 Eigen::Vector3f A, BminusA, D;
-                slerpedDirection(a, e, f, A, BminusA, D);
-                for (int k = 0; k < 3; ++k) {
-                    row[(2 + k) * P + j] = A[k];
-                    row[(5 + k) * P + j] = BminusA[k];
-                    row[(8 + k) * P + j] = D[k];
-                }
+                slerpedDirection(a, e, Eigen::Vector3f(fX[j], fY[j], fZ[j]), A, BminusA, D);
+                o2[j] = A.x();
+                o3[j] = A.y();
+                o4[j] = A.z();
+                o5[j] = BminusA.x();
+                o6[j] = BminusA.y();
+                o7[j] = BminusA.z();
+                o8[j] = D.x();
+                o9[j] = D.y();
+                o10[j] = D.z();
             }
         }
     }
@@ -76,19 +112,22 @@ HP_SIMD bool anyLane(i8 m) {
     return (q[0] | q[1] | q[2] | q[3]) != 0;
 }
 
-/// Follow the leader from vertex 1 on (positions px/py/pz, slots = vertices):
-/// a vertex the bound cannot clear is queried; one inside is projected out
-/// keeping its segment's length, and every later vertex moves by the same
-/// shift, so segment directions are kept elsewhere.
-void collide(const StepContext& ctx, const FollowerClass& c, const float* g1, const float* segmentLengths,
-             float segmentLength, float* px, float* py, float* pz, Counters& counters) {
+/// Follow the leader (positions px/py/pz, slots = vertices): a vertex the
+/// bound cannot clear is queried; one inside is projected out keeping its
+/// segment's length, and every later vertex moves by the same shift, so
+/// segment directions are kept elsewhere. `cleared[v]` is the vector pass's
+/// bound test of the unshifted vertex, valid until the first projection;
+/// after it, shifted vertices are tested again.
+void collide(const StepContext& ctx, const FollowerClass& c, const float* g1, const int32_t* cleared,
+             const float* segmentLengths, float segmentLength, float* px, float* py, float* pz, Counters& counters) {
     const size_t P = c.pad;
     float sx = 0.f, sy = 0.f, sz = 0.f;
     bool shifted = false;
     for (uint32_t v = 1; v <= c.segments; ++v) {
+        if (!shifted && cleared[v]) continue;
         const float qx = px[v] + sx, qy = py[v] + sy, qz = pz[v] + sz;
         const float gx = qx - g1[v], gy = qy - g1[P + v], gz = qz - g1[2 * P + v];
-        if (!(gx * gx + gy * gy + gz * gz < g1[3 * P + v])) {
+        if (!shifted || !(gx * gx + gy * gy + gz * gz < g1[3 * P + v])) {
             ++counters.queries;
             Vec3f p(qx, qy, qz), normal;
             const float d = ctx.collider->signedDistance(p, &normal);
@@ -132,9 +171,13 @@ template <FollowerMode M, bool Own>
     const Vec3f z = t.cross(n);
     const float ac = im.alignC[f], as = im.alignS[f], scale = Own ? 1.f : im.segmentLength[f];
     const Vec3f e0 = scale * (ac * t - as * z), e1 = scale * n, e2 = scale * (as * t + ac * z);
+    const f8 m00 = splat(e0.x()), m01 = splat(e1.x()), m02 = splat(e2.x());
+    const f8 m10 = splat(e0.y()), m11 = splat(e1.y()), m12 = splat(e2.y());
+    const f8 m20 = splat(e0.z()), m21 = splat(e1.z()), m22 = splat(e2.z());
 
     alignas(32) float px[kMaxFollowerVertices], py[kMaxFollowerVertices], pz[kMaxFollowerVertices],
         w[kMaxFollowerVertices];
+    alignas(32) int32_t cleared[kMaxFollowerVertices];
     f8 carryX = splat(root.position.x()), carryY = splat(root.position.y()), carryZ = splat(root.position.z());
     const u8 hash = splat(followerHash(im.settings.seed, f));
     const f8 weight = splat(im.weight[f]);
@@ -172,16 +215,18 @@ template <FollowerMode M, bool Own>
             rotate(q[0], q[1], q[2], q[3], load(own + j), load(own + P + j), load(own + 2 * P + j), vx, vy, vz);
         }
         // World space, then positions: a running sum from the root.
-        const f8 wx = splat(e0.x()) * vx + splat(e1.x()) * vy + splat(e2.x()) * vz;
-        const f8 wy = splat(e0.y()) * vx + splat(e1.y()) * vy + splat(e2.y()) * vz;
-        const f8 wz = splat(e0.z()) * vx + splat(e1.z()) * vy + splat(e2.z()) * vz;
+        const f8 wx = m00 * vx + m01 * vy + m02 * vz;
+        const f8 wy = m10 * vx + m11 * vy + m12 * vz;
+        const f8 wz = m20 * vx + m21 * vy + m22 * vz;
         const f8 x = prefixSum(wx, carryX), y = prefixSum(wy, carryY), zz = prefixSum(wz, carryZ);
         store(px + j, x);
         store(py + j, y);
         store(pz + j, zz);
         if (ctx.collider) {
             const f8 dx = x - load(g1 + j), dy = y - load(g1 + P + j), dz = zz - load(g1 + 2 * P + j);
-            outside &= dx * dx + dy * dy + dz * dz < load(g1 + 3 * P + j);
+            const i8 ok = dx * dx + dy * dy + dz * dz < load(g1 + 3 * P + j);
+            std::memcpy(cleared + j, &ok, sizeof ok);
+            outside &= ok;
         }
     }
     if (ctx.collider && anyLane(~outside)) {
@@ -189,27 +234,29 @@ template <FollowerMode M, bool Own>
         if constexpr (Own)
             for (uint32_t v = 1; v <= S; ++v)
                 lengths[v] = std::sqrt(own[v] * own[v] + own[P + v] * own[P + v] + own[2 * P + v] * own[2 * P + v]);
-        collide(ctx, c, g1, Own ? lengths : nullptr, im.segmentLength[f], px, py, pz, counters);
+        collide(ctx, c, g1, cleared, Own ? lengths : nullptr, im.segmentLength[f], px, py, pz, counters);
     }
 
-    // Output: x y z per vertex, with velocities.
+    // Output: x y z per vertex, with velocities; 8 vertices (24 floats) a block.
     float* __restrict pos = ctx.positions[0].data() + 3 * size_t(im.vertexOffset[f]);
     float* __restrict vel = ctx.velocities[0].data() + 3 * size_t(im.vertexOffset[f]);
     const size_t n3 = 3 * size_t(S + 1);
     const f8 invDt = splat(ctx.invDt);
-    alignas(32) float xyz[24];
     for (size_t j = 0; 3 * j < n3; j += 8) {
+        f8 xyz[3];
         interleave3(load(px + j), load(py + j), load(pz + j), xyz);
-        for (size_t k = 0, i = 3 * j; k < 24 && i < n3; k += 8, i += 8) {
-            if (i + 8 <= n3) {
-                const f8 x = load(xyz + k);
-                if (ctx.difference) store(vel + i, (x - load(pos + i)) * invDt);
-                store(pos + i, x);
-            } else {
-                for (size_t r = 0; r < n3 - i; ++r) {
-                    if (ctx.difference) vel[i + r] = (xyz[k + r] - pos[i + r]) * ctx.invDt;
-                    pos[i + r] = xyz[k + r];
-                }
+        float* __restrict p = pos + 3 * j;
+        float* __restrict u = vel + 3 * j;
+        if (3 * j + 24 <= n3) {
+            for (int k = 0; k < 3; ++k) {
+                if (ctx.difference) store(u + 8 * k, (xyz[k] - load(p + 8 * k)) * invDt);
+                store(p + 8 * k, xyz[k]);
+            }
+        } else {  // the strand's last, partial block
+            const float* x = reinterpret_cast<const float*>(xyz);
+            for (size_t r = 0; r < n3 - 3 * j; ++r) {
+                if (ctx.difference) u[r] = (x[r] - p[r]) * ctx.invDt;
+                p[r] = x[r];
             }
         }
     }
