@@ -1,6 +1,6 @@
 // @brief 8-lane float and integer vectors for the follower update (GCC vector
-// extensions) and the few shuffles it needs: a prefix sum across lanes and
-// the interleave of x, y, z lanes into x y z triples.
+// extensions) and the one shuffle it needs, an 8 × 8 transpose (lanes are
+// followers; tables and outputs are per follower).
 //
 // Internal to sim/follower_*.cpp. Why vector extensions rather than
 // intrinsics: the same source compiles to AVX2 (one instruction per
@@ -21,12 +21,12 @@ typedef float f8 __attribute__((vector_size(32)));
 typedef int32_t i8 __attribute__((vector_size(32)));
 typedef uint32_t u8 __attribute__((vector_size(32)));
 
-HP_SIMD f8 load(const float* p) {
-    f8 v;
-    std::memcpy(&v, p, sizeof v);  // unaligned load
-    return v;
-}
-HP_SIMD void store(float* p, f8 v) { std::memcpy(p, &v, sizeof v); }
+/// The same vector at float alignment: what load and store access through
+/// (a 32-byte memcpy into an array element is split into 16-byte moves).
+typedef float f8u __attribute__((vector_size(32), aligned(4), may_alias));
+
+HP_SIMD f8 load(const float* p) { return *reinterpret_cast<const f8u*>(p); }
+HP_SIMD void store(float* p, f8 v) { *reinterpret_cast<f8u*>(p) = v; }
 // Broadcasts as a permutation of lane 0, which GCC emits as one broadcast
 // instruction; an initializer list of copies (or x - f8{}) it often
 // assembles lane by lane.
@@ -37,32 +37,44 @@ HP_SIMD f8 select(i8 mask, f8 a, f8 b) { return mask ? a : b; }
 /// A 32-bit hash read as a signed integer, times 2^-31: [-1, 1).
 HP_SIMD f8 toSignedUnit(u8 h) { return __builtin_convertvector(i8(h), f8) * (1.f / 2147483648.f); }
 
-/// Inclusive prefix sum across the lanes plus `carry` (a splat), in three
-/// shift-and-add rounds; `carry` becomes the last lane for the next block.
-HP_SIMD f8 prefixSum(f8 x, f8& carry) {
-    const f8 zero{};
-    x += __builtin_shuffle(x, zero, i8{8, 0, 1, 2, 3, 4, 5, 6});
-    x += __builtin_shuffle(x, zero, i8{8, 8, 0, 1, 2, 3, 4, 5});
-    x += __builtin_shuffle(x, zero, i8{8, 8, 8, 8, 0, 1, 2, 3});
-    x += carry;
-    carry = __builtin_shuffle(x, i8{7, 7, 7, 7, 7, 7, 7, 7});
-    return x;
+HP_SIMD bool anyLane(i8 m) {
+    uint64_t q[4];
+    std::memcpy(q, &m, sizeof q);
+    return (q[0] | q[1] | q[2] | q[3]) != 0;
 }
 
-/// Lanes x0..x7, y0..y7, z0..z7 as x0 y0 z0 x1 y1 z1 ... z7 (24 floats) in
-/// out[0..2]: each output vector takes three lane-repeating permutations and
-/// two blends.
-HP_SIMD void interleave3(f8 x, f8 y, f8 z, f8* out) {
-    const i8 p0{0, 0, 0, 1, 1, 1, 2, 2}, p1{2, 3, 3, 3, 4, 4, 4, 5}, p2{5, 5, 6, 6, 6, 7, 7, 7};
-    // Output lane i holds component i mod 3 (offset by the vector's start).
-    const i8 xy0{0, 9, 2, 3, 12, 5, 6, 15}, xy1{8, 1, 10, 11, 4, 13, 14, 7};
-    const f8 a0 = __builtin_shuffle(x, p0), b0 = __builtin_shuffle(y, p0), c0 = __builtin_shuffle(z, p0);
-    const f8 a1 = __builtin_shuffle(x, p1), b1 = __builtin_shuffle(y, p1), c1 = __builtin_shuffle(z, p1);
-    const f8 a2 = __builtin_shuffle(x, p2), b2 = __builtin_shuffle(y, p2), c2 = __builtin_shuffle(z, p2);
-    // Vector 0: x y z x y z x y;  1: z x y z x y z x;  2: y z x y z x y z.
-    out[0] = __builtin_shuffle(__builtin_shuffle(a0, b0, xy0), c0, i8{0, 1, 10, 3, 4, 13, 6, 7});
-    out[1] = __builtin_shuffle(__builtin_shuffle(a1, b1, xy1), c1, i8{8, 1, 2, 11, 4, 5, 14, 7});
-    out[2] = __builtin_shuffle(__builtin_shuffle(b2, c2, i8{0, 9, 2, 3, 12, 5, 6, 15}), a2, i8{0, 1, 10, 3, 4, 13, 6, 7});
+/// Lane-wise square root (a loop GCC turns into one vector instruction;
+/// vector extensions have no sqrt of their own).
+HP_SIMD f8 sqrt8(f8 x) {
+    f8 r;
+    for (int k = 0; k < 8; ++k) r[k] = __builtin_sqrtf(x[k]);
+    return r;
+}
+
+/// 8 × 8 transpose in place: afterwards lane i of r_k is the former lane k
+/// of r_i. Three rounds (unpack pairs, combine pairs, swap 128-bit halves):
+/// 24 shuffles, each one instruction in the AVX2 build. Separate variables,
+/// not an array: GCC keeps those in registers.
+HP_SIMD void transpose8(f8& r0, f8& r1, f8& r2, f8& r3, f8& r4, f8& r5, f8& r6, f8& r7) {
+    const i8 lo{0, 8, 1, 9, 4, 12, 5, 13}, hi{2, 10, 3, 11, 6, 14, 7, 15};
+    const i8 lo2{0, 1, 8, 9, 4, 5, 12, 13}, hi2{2, 3, 10, 11, 6, 7, 14, 15};
+    const i8 lowHalves{0, 1, 2, 3, 8, 9, 10, 11}, highHalves{4, 5, 6, 7, 12, 13, 14, 15};
+    const f8 t0 = __builtin_shuffle(r0, r1, lo), t1 = __builtin_shuffle(r0, r1, hi);
+    const f8 t2 = __builtin_shuffle(r2, r3, lo), t3 = __builtin_shuffle(r2, r3, hi);
+    const f8 t4 = __builtin_shuffle(r4, r5, lo), t5 = __builtin_shuffle(r4, r5, hi);
+    const f8 t6 = __builtin_shuffle(r6, r7, lo), t7 = __builtin_shuffle(r6, r7, hi);
+    const f8 u0 = __builtin_shuffle(t0, t2, lo2), u1 = __builtin_shuffle(t0, t2, hi2);
+    const f8 u2 = __builtin_shuffle(t1, t3, lo2), u3 = __builtin_shuffle(t1, t3, hi2);
+    const f8 u4 = __builtin_shuffle(t4, t6, lo2), u5 = __builtin_shuffle(t4, t6, hi2);
+    const f8 u6 = __builtin_shuffle(t5, t7, lo2), u7 = __builtin_shuffle(t5, t7, hi2);
+    r0 = __builtin_shuffle(u0, u4, lowHalves);
+    r1 = __builtin_shuffle(u1, u5, lowHalves);
+    r2 = __builtin_shuffle(u2, u6, lowHalves);
+    r3 = __builtin_shuffle(u3, u7, lowHalves);
+    r4 = __builtin_shuffle(u0, u4, highHalves);
+    r5 = __builtin_shuffle(u1, u5, highHalves);
+    r6 = __builtin_shuffle(u2, u6, highHalves);
+    r7 = __builtin_shuffle(u3, u7, highHalves);
 }
 
 }  // namespace hp::follower::simd

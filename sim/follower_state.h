@@ -22,33 +22,34 @@ struct GuidePair {
     float twistC = 1.f, twistS = 0.f;
 };
 
-/// Followers sharing one segment count S. Every table is in slots: rows of P
-/// floats (P a multiple of 8, P >= S + 1) where slot j is vertex j and
+/// Followers sharing one segment count S. Every table is in slots: P
+/// slots (P a multiple of 8, P >= S + 1) where slot j is vertex j and
 /// segment j - 1, the segment ending at vertex j; slot 0 (the root) and the
-/// padding hold zero directions, so a row runs over whole vectors and a
-/// prefix sum of slot directions gives vertex positions.
+/// padding hold identity rotations and zero directions.
 struct FollowerClass {
     uint32_t segments = 0;
     uint32_t pad = 0;
-    /// Per guide, kHot rows: qw qx qy qz (rotation of the guide segment
-    /// mapped to the slot's segment; identity outside), speed (m/s, the
-    /// segment's centre), rx ry rz (the guide's unit rest direction, static).
+    /// Per guide, kHot rows of P slots: qw qx qy qz (rotation of the guide
+    /// segment mapped to the slot's segment), speed (m/s, the segment's
+    /// centre), rx ry rz (unit rest direction, static), then per step
+    /// Ax Ay Az (A of follower_kernels.h's (2): the rest direction turned by
+    /// q) and d_v (Algorithm 1's clamped speed).
     std::vector<float> hot;
-    /// Per guide, kCold rows, slot = vertex: x y z (world), bound (see
-    /// collisionBound), vx vy vz, unused.
+    /// Per guide, kCold rows of P slots, slot = vertex: x y z (world), bound
+    /// (collisionBound; +inf at the root and in the padding), vx vy vz, unused.
     std::vector<float> cold;
-    /// Guide pairs of this class's followers and, per pair, kPair rows
-    /// rebuilt every step: θ and d_v (Algorithm 1's clamped guide-1 speed),
-    /// then either A, B - A, D of follower_kernels.h's (2) for the guides'
-    /// rest direction (followers without own rest shapes) or the quaternions
-    /// a and e of (1) (own rest shapes).
+    /// Guide pairs of this class's followers and, per pair and slot, one
+    /// record of 8 floats rebuilt every step: θ, B - A, D of (2) (followers
+    /// with the guides' rest shape) or θ and the quaternion e of (1) (own
+    /// rest shapes), zero-padded. A record per slot lets a packet of 8
+    /// followers read its lanes' pairs with 8 loads and one transpose.
     std::vector<GuidePair> pairs;
-    std::vector<float> pairTable;
+    std::vector<float> pairRecords;
     std::vector<float> radii;          ///< S + 1 tapered radii
     std::vector<float> weightedCurve;  ///< fixedOffset · d_f(j - 1) per slot, 0 at slot 0 and in the padding
-    static constexpr int kHot = 8;
+    static constexpr int kHot = 12;
     static constexpr int kCold = 8;
-    static constexpr int kPair = 11;
+    static constexpr int kRecord = 8;
 
     /// Guide segment read by follower segment y: the one covering the same
     /// fraction of the strand, floor((y + 1/2) Sg / S); y itself when Sg = S.
@@ -56,6 +57,24 @@ struct FollowerClass {
         const uint32_t s = ((2 * y + 1) * guideSegments) / (2 * followerSegments);
         return s < guideSegments ? s : guideSegments - 1;
     }
+};
+
+/// Eight followers of one class with the same guide 1, computed together
+/// in the 8 lanes of a vector (lanes = followers): everything of guide 1 is
+/// one broadcast, per-lane values are loads of the fields below. A class's
+/// followers are sorted by (guide 1, guide 2, index) and cut into packets;
+/// the last packet of a guide repeats its last follower in the unused lanes
+/// (computed, never written).
+struct alignas(32) FollowerPacket {
+    static constexpr int kLanes = 8;
+    float alignC[kLanes], alignS[kLanes];  ///< follower frame turned about its normal by φ_f
+    float scale[kLanes];    ///< segment length (1 with own rest shapes: their segments carry it)
+    float weight[kLanes];   ///< interpolation weight d1 / (d1 + d2)
+    uint32_t hash[kLanes];  ///< followerHash(seed, follower)
+    uint32_t follower[kLanes], pair[kLanes];
+    uint32_t vertexOffset[kLanes];  ///< first output vertex, relative to the follower block
+    uint32_t guide1 = 0, count = 0, cls = 0;
+    uint32_t own = 0;  ///< offset of the packet's own rest segments: P slots × 3 × 8 lanes
 };
 
 struct Followers::Impl {
@@ -68,6 +87,7 @@ struct Followers::Impl {
     std::vector<Eigen::Vector3f> guideRestDirs;  ///< unit, root-frame coordinates
 
     std::vector<FollowerClass> classes;
+    std::vector<FollowerPacket> packets;  ///< all classes, class by class
 
     // Followers, structure of arrays.
     std::vector<FollowerNeighbours> neighbours;
@@ -76,14 +96,11 @@ struct Followers::Impl {
     std::vector<float> weight;             ///< interpolation weight d1 / (d1 + d2)
     std::vector<float> alignC, alignS;     ///< follower frame turned about its normal by φ_f
     std::vector<float> segmentLength;      ///< followers without own rest shapes
-    std::vector<uint32_t> ownRest;         ///< offset into ownRestData, or kNone
-    /// Per follower 3 rows of P slots: its rest segments (direction × length)
-    /// in its aligned frame; zero at slot 0 and in the padding.
+    /// Own rest segments (direction × length, in the aligned frame), per
+    /// packet P slots × (x, y, z) × 8 lanes; zero at slot 0 and in the padding.
     std::vector<float> ownRestData;
     std::vector<uint32_t> vertexOffset;    ///< follower vertex offsets, relative to the follower block
     std::vector<uint32_t> ids;
-    std::vector<uint32_t> order;           ///< processing order: by class, then index (streams memory)
-    static constexpr uint32_t kNone = ~0u;
 
     // What the previous update wrote (finite-difference velocities).
     const Vec3f* lastPositions = nullptr;
@@ -117,11 +134,11 @@ struct Counters {
     size_t projected = 0, queries = 0;
 };
 
-/// Rebuilds the pair rows [begin, end) of class `c` from its guide rows.
+/// Rebuilds the pair records [begin, end) of class `c` from its guide rows.
 void buildPairs(const Followers::Impl& im, FollowerClass& c, size_t begin, size_t end);
 
-/// Followers order[begin, end) of this step: shapes, collision, output.
-void processFollowers(const StepContext& ctx, size_t begin, size_t end, Counters& counters);
+/// Packets [begin, end) of this step: shapes, collision, output.
+void processPackets(const StepContext& ctx, size_t begin, size_t end, Counters& counters);
 
 }  // namespace follower
 }  // namespace hp

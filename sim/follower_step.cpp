@@ -1,27 +1,29 @@
 // The per-step work of the followers that scales with their number: the
-// guide-pair tables, then every follower's shape, head collision and output
-// (sim/followers.h explains the model, sim/follower_kernels.h has the
-// equations, sim/follower_update.cpp the step around it).
+// guide-pair records, then every packet of 8 followers (shapes, head
+// collision, output). sim/followers.h explains the model,
+// sim/follower_kernels.h has the equations, sim/follower_update.cpp the
+// step around this.
 //
 // Performance (100k followers × 24 vertices: ~2.3M segments per step):
-// - Everything that depends only on a follower's two guides is computed once
-//   per guide pair and segment (slerp arc θ, e and the quadratic form (2) of
-//   the guide's rotated rest direction), a few thousand pairs against 100k
-//   followers. Per segment a follower then evaluates its weight t (hash,
-//   Algorithm 1), sin and cos of tθ (polynomials), (2) and its root frame:
-//   about 40 vector operations for 8 segments.
-// - A follower's segments run 8 at a time in vector lanes (slots, see
-//   FollowerClass); the positions are a prefix sum across lanes, the output
-//   an interleave of the x, y, z lanes; no per-segment scalar work.
-// - Collision: one vector test per 8 vertices against guide 1's bound
-//   (collisionBound); only followers with a vertex that fails it take the
-//   sequential follow-the-leader loop, from that vertex on.
+// - What depends only on a follower's guides is computed once per guide or
+//   guide pair and segment: A and d_v per guide (fillGuide), the slerp arc θ
+//   and B - A, D of (2) per pair (a few thousand pairs against 100k
+//   followers). Per segment a follower then evaluates its weight t (hash,
+//   Algorithm 1), sin and cos of tθ (polynomials), (2) and its root frame.
+// - Lanes are followers: a packet of 8 followers with the same guide 1 runs
+//   down the strand together, so guide 1's rows are broadcasts, positions
+//   are a running sum per lane (no shuffles), and the per-follower setup
+//   (frame) is vector work too. The lanes' pair records (one per slot) are
+//   8 loads and a transpose; the output is a transpose back per 8 floats.
+// - Collision: one vector test per vertex against guide 1's bound
+//   (collisionBound); only followers with a vertex the bound cannot clear
+//   take the sequential follow-the-leader loop, from that vertex on.
 // - Built twice, for x86-64-v3 (AVX2 + FMA) and baseline x86-64, picked at
 //   load time. Multiply-adds contract into FMA in the v3 build
 //   (-ffp-contract=fast on this file), so the two builds differ in the last
-//   bits; within one machine every follower runs the same code whatever the
-//   thread count or partition, which is the determinism the project needs.
-#include "core/errors.h"
+//   bits; within one machine every follower runs the same code in whatever
+//   lane, packet or thread, which is the determinism the project needs
+//   (bits identical across CPU generations are not promised).
 #include "sim/follower_simd.h"
 #include "sim/follower_state.h"
 
@@ -33,43 +35,24 @@ namespace {
 
 using namespace simd;
 using Impl = Followers::Impl;
+constexpr int kLanes = FollowerPacket::kLanes;
 
 template <bool Own>
-[[gnu::always_inline]] inline void buildPairRows(const Impl& im, FollowerClass& c, size_t begin, size_t end) {
+[[gnu::always_inline]] inline void buildPairRecords(const Impl& im, FollowerClass& c, size_t begin, size_t end) {
     const size_t P = c.pad;
-    const float maxVelocity = im.settings.maxVelocity;
+    alignas(32) float rows[7][kMaxFollowerVertices];
     for (size_t p = begin; p < end; ++p) {
         const GuidePair& gp = c.pairs[p];
-        // One pointer per row: the loop below then reads and writes
-        // contiguous rows and vectorizes over the slots.
+        // One pointer per row: the slot loop reads and writes contiguous
+        // rows and vectorizes (ivdep: rows never overlap; restrict alone is
+        // lost once this is inlined).
         const float* h1 = c.hot.data() + size_t(gp.guide1) * FollowerClass::kHot * P;
         const float* h2 = c.hot.data() + size_t(gp.guide2) * FollowerClass::kHot * P;
-        const float* __restrict aW = h1;
-        const float* __restrict aX = h1 + P;
-        const float* __restrict aY = h1 + 2 * P;
-        const float* __restrict aZ = h1 + 3 * P;
-        const float* __restrict speed = h1 + 4 * P;
-        const float* __restrict fX = h1 + 5 * P;
-        const float* __restrict fY = h1 + 6 * P;
-        const float* __restrict fZ = h1 + 7 * P;
-        const float* __restrict bW = h2;
-        const float* __restrict bX = h2 + P;
-        const float* __restrict bY = h2 + 2 * P;
-        const float* __restrict bZ = h2 + 3 * P;
-        float* const row = c.pairTable.data() + p * FollowerClass::kPair * P;
-        float* __restrict o0 = row;
-        float* __restrict o1 = row + P;
-        float* __restrict o2 = row + 2 * P;
-        float* __restrict o3 = row + 3 * P;
-        float* __restrict o4 = row + 4 * P;
-        float* __restrict o5 = row + 5 * P;
-        float* __restrict o6 = row + 6 * P;
-        float* __restrict o7 = row + 7 * P;
-        float* __restrict o8 = row + 8 * P;
-        float* __restrict o9 = row + 9 * P;
-        float* __restrict o10 = row + 10 * P;
+        const float *aW = h1, *aX = h1 + P, *aY = h1 + 2 * P, *aZ = h1 + 3 * P;
+        const float *fX = h1 + 5 * P, *fY = h1 + 6 * P, *fZ = h1 + 7 * P;
+        const float *bW = h2, *bX = h2 + P, *bY = h2 + 2 * P, *bZ = h2 + 3 * P;
+        float *o0 = rows[0], *o1 = rows[1], *o2 = rows[2], *o3 = rows[3], *o4 = rows[4], *o5 = rows[5], *o6 = rows[6];
         const float kc = gp.twistC, ks = gp.twistS;
-        // Rows never overlap; restrict alone does not tell GCC once inlined here.
 #pragma GCC ivdep
         for (size_t j = 0; j < P; ++j) {
             const Quat a{aW[j], aX[j], aY[j], aZ[j]};
@@ -79,61 +62,63 @@ template <bool Own>
             Quat e;
             slerpArc(a, b, theta, e);
             o0[j] = theta;
-            o1[j] = variableOffset(speed[j], maxVelocity);
             if constexpr (Own) {
-                o2[j] = a.w;
-                o3[j] = a.x;
-                o4[j] = a.y;
-                o5[j] = a.z;
-                o6[j] = e.w;
-                o7[j] = e.x;
-                o8[j] = e.y;
-                o9[j] = e.z;
+                o1[j] = e.w;
+                o2[j] = e.x;
+                o3[j] = e.y;
+                o4[j] = e.z;
+                o5[j] = 0.f;
+                o6[j] = 0.f;
             } else {
                 Eigen::Vector3f A, BminusA, D;
                 slerpedDirection(a, e, Eigen::Vector3f(fX[j], fY[j], fZ[j]), A, BminusA, D);
-                o2[j] = A.x();
-                o3[j] = A.y();
-                o4[j] = A.z();
-                o5[j] = BminusA.x();
-                o6[j] = BminusA.y();
-                o7[j] = BminusA.z();
-                o8[j] = D.x();
-                o9[j] = D.y();
-                o10[j] = D.z();
+                o1[j] = BminusA.x();
+                o2[j] = BminusA.y();
+                o3[j] = BminusA.z();
+                o4[j] = D.x();
+                o5[j] = D.y();
+                o6[j] = D.z();
             }
+        }
+        // Rows to one record of 8 floats per slot.
+        float* out = c.pairRecords.data() + p * P * FollowerClass::kRecord;
+        for (size_t j = 0; j < P; j += 8) {
+            f8 r0 = load(rows[0] + j), r1 = load(rows[1] + j), r2 = load(rows[2] + j), r3 = load(rows[3] + j);
+            f8 r4 = load(rows[4] + j), r5 = load(rows[5] + j), r6 = load(rows[6] + j), r7{};
+            transpose8(r0, r1, r2, r3, r4, r5, r6, r7);
+            const f8 r[8] = {r0, r1, r2, r3, r4, r5, r6, r7};
+            for (int k = 0; k < 8; ++k) store(out + (j + k) * FollowerClass::kRecord, r[k]);
         }
     }
 }
 
-HP_SIMD bool anyLane(i8 m) {
-    uint64_t q[4];
-    std::memcpy(q, &m, sizeof q);
-    return (q[0] | q[1] | q[2] | q[3]) != 0;
-}
-
-/// Follow the leader (positions px/py/pz, slots = vertices): a vertex the
-/// bound cannot clear is queried; one inside is projected out keeping its
-/// segment's length, and every later vertex moves by the same shift, so
-/// segment directions are kept elsewhere. `cleared[v]` is the vector pass's
-/// bound test of the unshifted vertex, valid until the first projection;
-/// after it, shifted vertices are tested again.
-void collide(const StepContext& ctx, const FollowerClass& c, const float* g1, const int32_t* cleared,
-             const float* segmentLengths, float segmentLength, float* px, float* py, float* pz, Counters& counters) {
+/// Follow the leader for lane k of a packet (positions pos[3v + c], lanes =
+/// followers): a vertex the bound cannot clear is queried; one inside is
+/// projected out keeping its segment's length, and every later vertex moves
+/// by the same shift, so segment directions are kept elsewhere.
+/// `cleared[v]` is the vector pass's bound test of the unshifted vertex,
+/// valid until the first projection; after it shifted vertices are tested again.
+void collideLane(const StepContext& ctx, const FollowerClass& c, const float* g1, const i8* cleared, int k,
+                 const float* ownRest, float segmentLength, f8* pos, Counters& counters) {
     const size_t P = c.pad;
     float sx = 0.f, sy = 0.f, sz = 0.f;
     bool shifted = false;
     for (uint32_t v = 1; v <= c.segments; ++v) {
-        if (!shifted && cleared[v]) continue;
-        const float qx = px[v] + sx, qy = py[v] + sy, qz = pz[v] + sz;
+        if (!shifted && cleared[v][k]) continue;
+        float &px = pos[3 * v][k], &py = pos[3 * v + 1][k], &pz = pos[3 * v + 2][k];
+        const float qx = px + sx, qy = py + sy, qz = pz + sz;
         const float gx = qx - g1[v], gy = qy - g1[P + v], gz = qz - g1[2 * P + v];
         if (!shifted || !(gx * gx + gy * gy + gz * gz < g1[3 * P + v])) {
             ++counters.queries;
             Vec3f p(qx, qy, qz), normal;
             const float d = ctx.collider->signedDistance(p, &normal);
             if (d < c.radii[v]) {
-                const Vec3f previous(px[v - 1], py[v - 1], pz[v - 1]);
-                const float length = segmentLengths ? segmentLengths[v] : segmentLength;
+                const Vec3f previous(pos[3 * v - 3][k], pos[3 * v - 2][k], pos[3 * v - 1][k]);
+                float length = segmentLength;
+                if (ownRest) {
+                    const float* r = ownRest + size_t(v) * 3 * kLanes + k;
+                    length = std::sqrt(r[0] * r[0] + r[kLanes] * r[kLanes] + r[2 * kLanes] * r[2 * kLanes]);
+                }
                 projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p);
                 sx += p.x() - qx;
                 sy += p.y() - qy;
@@ -143,137 +128,192 @@ void collide(const StepContext& ctx, const FollowerClass& c, const float* g1, co
             }
         }
         if (shifted) {
-            px[v] += sx;
-            py[v] += sy;
-            pz[v] += sz;
+            px += sx;
+            py += sy;
+            pz += sz;
         }
     }
 }
 
 template <FollowerMode M, bool Own>
-[[gnu::always_inline]] inline void processFollower(const StepContext& ctx, uint32_t f, Counters& counters) {
+[[gnu::always_inline]] inline void processPacket(const StepContext& ctx, const FollowerPacket& pk, Counters& counters) {
     const Impl& im = *ctx.im;
-    const FollowerClass& c = im.classes[im.classOf[f]];
+    const FollowerClass& c = im.classes[pk.cls];
     const size_t P = c.pad;
     const uint32_t S = c.segments;
-    const float* __restrict T = c.pairTable.data() + size_t(im.pairOf[f]) * FollowerClass::kPair * P;
-    const float* __restrict own = Own ? im.ownRestData.data() + im.ownRest[f] : nullptr;
-    const FollowerNeighbours& nb = im.neighbours[f];
-    const float* g1 = c.cold.data() + size_t(nb.guide1) * FollowerClass::kCold * P;
+    const float* hot = c.hot.data() + size_t(pk.guide1) * FollowerClass::kHot * P;
+    const float* g1 = c.cold.data() + size_t(pk.guide1) * FollowerClass::kCold * P;
+    const float* ownRest = Own ? im.ownRestData.data() + pk.own : nullptr;
+    const float* rec[kLanes];
+    for (int k = 0; k < kLanes; ++k) rec[k] = c.pairRecords.data() + size_t(pk.pair[k]) * P * FollowerClass::kRecord;
 
-    // Effective root frame E = [t', n, z']: the current frame, orthonormalised,
+    // Root frames of the lanes: E = [t', n, z'] per lane, orthonormalised and
     // turned about n by the rest twist toward guide 1 (see followers.h);
     // times the segment length for followers with the guides' rest shape.
-    const SurfaceFrame& root = ctx.roots[f];
-    const Vec3f n = root.normal / root.normal.norm();
-    Vec3f t = root.tangent - n * n.dot(root.tangent);
-    t /= t.norm();
-    const Vec3f z = t.cross(n);
-    const float ac = im.alignC[f], as = im.alignS[f], scale = Own ? 1.f : im.segmentLength[f];
-    const Vec3f e0 = scale * (ac * t - as * z), e1 = scale * n, e2 = scale * (as * t + ac * z);
-    const f8 m00 = splat(e0.x()), m01 = splat(e1.x()), m02 = splat(e2.x());
-    const f8 m10 = splat(e0.y()), m11 = splat(e1.y()), m12 = splat(e2.y());
-    const f8 m20 = splat(e0.z()), m21 = splat(e1.z()), m22 = splat(e2.z());
+    alignas(32) float root[9][kLanes];
+    for (int k = 0; k < kLanes; ++k) {
+        const SurfaceFrame& r = ctx.roots[pk.follower[k]];
+        for (int i = 0; i < 3; ++i) {
+            root[i][k] = r.position[i];
+            root[3 + i][k] = r.normal[i];
+            root[6 + i][k] = r.tangent[i];
+        }
+    }
+    f8 nx = load(root[3]), ny = load(root[4]), nz = load(root[5]);
+    f8 tx = load(root[6]), ty = load(root[7]), tz = load(root[8]);
+    const f8 invN = splat(1.f) / sqrt8(nx * nx + ny * ny + nz * nz);
+    nx *= invN;
+    ny *= invN;
+    nz *= invN;
+    const f8 nt = nx * tx + ny * ty + nz * tz;
+    tx -= nt * nx;
+    ty -= nt * ny;
+    tz -= nt * nz;
+    const f8 invT = splat(1.f) / sqrt8(tx * tx + ty * ty + tz * tz);
+    tx *= invT;
+    ty *= invT;
+    tz *= invT;
+    const f8 zx = ty * nz - tz * ny, zy = tz * nx - tx * nz, zz = tx * ny - ty * nx;
+    const f8 ac = load(pk.alignC), as = load(pk.alignS), scale = load(pk.scale);
+    const f8 m00 = scale * (ac * tx - as * zx), m10 = scale * (ac * ty - as * zy), m20 = scale * (ac * tz - as * zz);
+    const f8 m01 = scale * nx, m11 = scale * ny, m21 = scale * nz;
+    const f8 m02 = scale * (as * tx + ac * zx), m12 = scale * (as * ty + ac * zy), m22 = scale * (as * tz + ac * zz);
 
-    alignas(32) float px[kMaxFollowerVertices], py[kMaxFollowerVertices], pz[kMaxFollowerVertices],
-        w[kMaxFollowerVertices];
-    alignas(32) int32_t cleared[kMaxFollowerVertices];
-    f8 carryX = splat(root.position.x()), carryY = splat(root.position.y()), carryZ = splat(root.position.z());
-    const u8 hash = splat(followerHash(im.settings.seed, f));
-    const f8 weight = splat(im.weight[f]);
+    // Down the strand: positions pos[3v + c] (so 8 consecutive entries are 8
+    // consecutive output floats of every lane), weights, bound tests.
+    alignas(32) f8 pos[3 * kMaxFollowerVertices];
+    alignas(32) f8 weights[kMaxFollowerVertices];
+    alignas(32) i8 cleared[kMaxFollowerVertices];
+    f8 x = load(root[0]), y = load(root[1]), z = load(root[2]);
+    pos[0] = x;
+    pos[1] = y;
+    pos[2] = z;
+    const u8 hash = *reinterpret_cast<const u8*>(pk.hash);
+    const f8 weight = load(pk.weight);
     i8 outside = i8{} - 1;
-    for (size_t j = 0; j < P; j += 8) {
-        // Slerp weight t (Algorithm 1: d_r = fixedOffset d_f + rand_xy d_v),
-        // then sin and cos of φ = tθ.
-        f8 s{}, co = splat(1.f), tw{};
+    for (uint32_t j = 1; j <= S; ++j) {
+        f8 vx, vy, vz, t{};
+        f8 s{}, co = splat(1.f);
+        f8 r0{}, r1{}, r2{}, r3{}, r4{}, r5{}, r6{}, r7{};
         if constexpr (M != FollowerMode::Cluster) {
+            // Slerp weight t (Algorithm 1: d_r = fixedOffset d_f + rand_xy d_v),
+            // then the lanes' pair records (θ, ...) and sin, cos of φ = tθ.
             if constexpr (M == FollowerMode::Interpolate) {
-                tw = weight;
+                t = weight;
             } else {
-                const u8 y = u8{0u - 1u, 0, 1, 2, 3, 4, 5, 6} + uint32_t(j);  // segment j - 1
-                tw = load(c.weightedCurve.data() + j) + toSignedUnit(segmentHash(hash, y)) * load(T + P + j);
+                const f8 random = toSignedUnit(segmentHash(hash, splat(uint32_t(j - 1))));
+                t = splat(c.weightedCurve[j]) + random * splat(hot[11 * P + j]);
             }
-            sinCos(reduceHalfTurns(tw * load(T + j)), s, co);
+            r0 = load(rec[0] + j * 8), r1 = load(rec[1] + j * 8), r2 = load(rec[2] + j * 8), r3 = load(rec[3] + j * 8);
+            r4 = load(rec[4] + j * 8), r5 = load(rec[5] + j * 8), r6 = load(rec[6] + j * 8), r7 = load(rec[7] + j * 8);
+            transpose8(r0, r1, r2, r3, r4, r5, r6, r7);
+            sinCos(reduceHalfTurns(t * r0), s, co);
         }
-        store(w + j, tw);
-        // Rotated rest direction in guide 1's root frame.
-        f8 vx, vy, vz;
-        if constexpr (!Own) {
-            vx = load(T + 2 * P + j);
-            vy = load(T + 3 * P + j);
-            vz = load(T + 4 * P + j);
-            if constexpr (M != FollowerMode::Cluster) {  // (2): A + s² (B - A) + cs D
+        weights[j] = t;
+        if constexpr (!Own) {  // (2): A + s² (B - A) + cs D, A of guide 1
+            vx = splat(hot[8 * P + j]);
+            vy = splat(hot[9 * P + j]);
+            vz = splat(hot[10 * P + j]);
+            if constexpr (M != FollowerMode::Cluster) {
                 const f8 ss = s * s, cs = co * s;
-                vx += ss * load(T + 5 * P + j) + cs * load(T + 8 * P + j);
-                vy += ss * load(T + 6 * P + j) + cs * load(T + 9 * P + j);
-                vz += ss * load(T + 7 * P + j) + cs * load(T + 10 * P + j);
+                vx += ss * r1 + cs * r4;
+                vy += ss * r2 + cs * r5;
+                vz += ss * r3 + cs * r6;
             }
-        } else {  // (1): q = cos φ a + sin φ e, then q f q*
-            f8 q[4];
-            for (int k = 0; k < 4; ++k)
-                q[k] = co * load(T + (2 + k) * P + j) + s * load(T + (6 + k) * P + j);
-            rotate(q[0], q[1], q[2], q[3], load(own + j), load(own + P + j), load(own + 2 * P + j), vx, vy, vz);
+        } else {  // (1): q = cos φ a + sin φ e, then q f q* of the lane's own rest segment
+            const f8 qw = co * splat(hot[j]) + s * r1, qx = co * splat(hot[P + j]) + s * r2;
+            const f8 qy = co * splat(hot[2 * P + j]) + s * r3, qz = co * splat(hot[3 * P + j]) + s * r4;
+            const float* f = ownRest + size_t(j) * 3 * kLanes;
+            rotate(qw, qx, qy, qz, load(f), load(f + kLanes), load(f + 2 * kLanes), vx, vy, vz);
         }
-        // World space, then positions: a running sum from the root.
-        const f8 wx = m00 * vx + m01 * vy + m02 * vz;
-        const f8 wy = m10 * vx + m11 * vy + m12 * vz;
-        const f8 wz = m20 * vx + m21 * vy + m22 * vz;
-        const f8 x = prefixSum(wx, carryX), y = prefixSum(wy, carryY), zz = prefixSum(wz, carryZ);
-        store(px + j, x);
-        store(py + j, y);
-        store(pz + j, zz);
+        // World space (scaled frame), then the running sum from the root.
+        x += m00 * vx + m01 * vy + m02 * vz;
+        y += m10 * vx + m11 * vy + m12 * vz;
+        z += m20 * vx + m21 * vy + m22 * vz;
+        pos[3 * j] = x;
+        pos[3 * j + 1] = y;
+        pos[3 * j + 2] = z;
         if (ctx.collider) {
-            const f8 dx = x - load(g1 + j), dy = y - load(g1 + P + j), dz = zz - load(g1 + 2 * P + j);
-            const i8 ok = dx * dx + dy * dy + dz * dz < load(g1 + 3 * P + j);
-            std::memcpy(cleared + j, &ok, sizeof ok);
-            outside &= ok;
+            const f8 dx = x - splat(g1[j]), dy = y - splat(g1[P + j]), dz = z - splat(g1[2 * P + j]);
+            cleared[j] = dx * dx + dy * dy + dz * dz < splat(g1[3 * P + j]);
+            outside &= cleared[j];
         }
     }
+    for (size_t v = S + 1; v < P; ++v) pos[3 * v] = pos[3 * v + 1] = pos[3 * v + 2] = f8{};  // never written out
+
     if (ctx.collider && anyLane(~outside)) {
-        float lengths[kMaxFollowerVertices];
-        if constexpr (Own)
-            for (uint32_t v = 1; v <= S; ++v)
-                lengths[v] = std::sqrt(own[v] * own[v] + own[P + v] * own[P + v] + own[2 * P + v] * own[2 * P + v]);
-        collide(ctx, c, g1, cleared, Own ? lengths : nullptr, im.segmentLength[f], px, py, pz, counters);
+        alignas(32) int32_t clear[kLanes];
+        std::memcpy(clear, &outside, sizeof clear);
+        for (uint32_t k = 0; k < pk.count; ++k)
+            if (!clear[k]) collideLane(ctx, c, g1, cleared, int(k), ownRest, pk.scale[k], pos, counters);
     }
 
-    // Output: x y z per vertex, with velocities; 8 vertices (24 floats) a block.
-    float* __restrict pos = ctx.positions[0].data() + 3 * size_t(im.vertexOffset[f]);
-    float* __restrict vel = ctx.velocities[0].data() + 3 * size_t(im.vertexOffset[f]);
+    // Output: per 8 floats, a transpose turns lanes back into followers.
     const size_t n3 = 3 * size_t(S + 1);
+    const uint32_t count = pk.count;
+    const bool difference = ctx.difference;
     const f8 invDt = splat(ctx.invDt);
-    for (size_t j = 0; 3 * j < n3; j += 8) {
-        f8 xyz[3];
-        interleave3(load(px + j), load(py + j), load(pz + j), xyz);
-        float* __restrict p = pos + 3 * j;
-        float* __restrict u = vel + 3 * j;
-        if (3 * j + 24 <= n3) {
-            for (int k = 0; k < 3; ++k) {
-                if (ctx.difference) store(u + 8 * k, (xyz[k] - load(p + 8 * k)) * invDt);
-                store(p + 8 * k, xyz[k]);
+    float* outPos[kLanes];
+    float* outVel[kLanes];
+    for (int k = 0; k < kLanes; ++k) {
+        outPos[k] = ctx.positions[0].data() + 3 * size_t(pk.vertexOffset[k]);
+        outVel[k] = ctx.velocities[0].data() + 3 * size_t(pk.vertexOffset[k]);
+    }
+    for (size_t i = 0; i < n3; i += 8) {
+        f8 o0 = pos[i], o1 = pos[i + 1], o2 = pos[i + 2], o3 = pos[i + 3];
+        f8 o4 = pos[i + 4], o5 = pos[i + 5], o6 = pos[i + 6], o7 = pos[i + 7];
+        transpose8(o0, o1, o2, o3, o4, o5, o6, o7);
+        const f8 o[kLanes] = {o0, o1, o2, o3, o4, o5, o6, o7};
+        if (i + 8 <= n3) {
+            for (uint32_t k = 0; k < count; ++k) {
+                if (difference) store(outVel[k] + i, (o[k] - load(outPos[k] + i)) * invDt);
+                store(outPos[k] + i, o[k]);
             }
-        } else {  // the strand's last, partial block
-            const float* x = reinterpret_cast<const float*>(xyz);
-            for (size_t r = 0; r < n3 - 3 * j; ++r) {
-                if (ctx.difference) u[r] = (x[r] - p[r]) * ctx.invDt;
-                p[r] = x[r];
-            }
+        } else {  // the strands' last, partial 8 floats
+            for (uint32_t k = 0; k < count; ++k)
+                for (size_t r = 0; r < n3 - i; ++r) {
+                    if (difference) outVel[k][i + r] = (o[k][r] - outPos[k][i + r]) * ctx.invDt;
+                    outPos[k][i + r] = o[k][r];
+                }
         }
     }
     if (!ctx.difference) {
         // No previous positions: the slerp-weighted blend of the guides' vertex velocities.
-        const float* g2 = c.cold.data() + size_t(nb.guide2) * FollowerClass::kCold * P;
-        for (uint32_t v = 0; v <= S; ++v) {
-            const float b = w[v > 0 ? v : 1];
-            for (int k = 0; k < 3; ++k) vel[3 * v + k] = (1.f - b) * g1[(4 + k) * P + v] + b * g2[(4 + k) * P + v];
+        for (uint32_t k = 0; k < pk.count; ++k) {
+            const float* g2 = c.cold.data() + size_t(c.pairs[pk.pair[k]].guide2) * FollowerClass::kCold * P;
+            float* vel = outVel[k];
+            for (uint32_t v = 0; v <= S; ++v) {
+                const float b = weights[v > 0 ? v : 1][k];
+                for (int i = 0; i < 3; ++i) vel[3 * v + i] = (1.f - b) * g1[(4 + i) * P + v] + b * g2[(4 + i) * P + v];
+            }
+        }
+    }
+}
+
+/// Asks for the cache lines packet `pk` will read and write: its roots and
+/// output vertices lie anywhere in memory (followers are packed by guide,
+/// the output is in follower order), and a packet's arithmetic takes longer
+/// than a memory access, so one packet ahead hides the latency.
+[[gnu::always_inline]] inline void prefetchPacket(const StepContext& ctx, const FollowerPacket& pk) {
+    const size_t bytes = 3 * sizeof(float) * (ctx.im->classes[pk.cls].segments + 1);
+    for (uint32_t k = 0; k < pk.count; ++k) {
+        __builtin_prefetch(ctx.roots + pk.follower[k]);
+        const char* p = reinterpret_cast<const char*>(ctx.positions + pk.vertexOffset[k]);
+        const char* v = reinterpret_cast<const char*>(ctx.velocities + pk.vertexOffset[k]);
+        for (size_t b = 0; b < bytes + 63; b += 64) {
+            __builtin_prefetch(p + b, 1);
+            __builtin_prefetch(v + b, 1);
         }
     }
 }
 
 template <FollowerMode M, bool Own>
 [[gnu::always_inline]] inline void processRangeT(const StepContext& ctx, size_t begin, size_t end, Counters& counters) {
-    const uint32_t* order = ctx.im->order.data();
-    for (size_t i = begin; i < end; ++i) processFollower<M, Own>(ctx, order[i], counters);
+    const FollowerPacket* packets = ctx.im->packets.data();
+    for (size_t i = begin; i < end; ++i) {
+        if (i + 1 < end) prefetchPacket(ctx, packets[i + 1]);
+        processPacket<M, Own>(ctx, packets[i], counters);
+    }
 }
 
 [[gnu::target_clones("arch=x86-64-v3", "default")]] void processRange(const StepContext& ctx, size_t begin,
@@ -294,15 +334,15 @@ template <FollowerMode M, bool Own>
 
 [[gnu::target_clones("arch=x86-64-v3", "default")]] void pairRange(const Impl& im, FollowerClass& c, size_t begin,
                                                                    size_t end) {
-    if (im.ownRestData.empty()) buildPairRows<false>(im, c, begin, end);
-    else buildPairRows<true>(im, c, begin, end);
+    if (im.ownRestData.empty()) buildPairRecords<false>(im, c, begin, end);
+    else buildPairRecords<true>(im, c, begin, end);
 }
 
 }  // namespace
 
 void buildPairs(const Impl& im, FollowerClass& c, size_t begin, size_t end) { pairRange(im, c, begin, end); }
 
-void processFollowers(const StepContext& ctx, size_t begin, size_t end, Counters& counters) {
+void processPackets(const StepContext& ctx, size_t begin, size_t end, Counters& counters) {
     processRange(ctx, begin, end, counters);
 }
 

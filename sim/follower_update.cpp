@@ -79,6 +79,12 @@ void fillGuide(Impl& im, const FollowerStep& step, const Collider* collider, siz
             const uint32_t s = same ? j - 1 : FollowerClass::guideSegment(j - 1, S, gs);
             for (int k = 0; k < 4; ++k) row[k * P + j] = q[s][k];
             row[4 * P + j] = speed[s];
+            // A = q r q* (the rest direction turned) and Algorithm 1's d_v:
+            // shared by every follower led by this guide.
+            const Vec3f a = follower::sandwich({q[s][0], q[s][1], q[s][2], q[s][3]},
+                                               Vec3f(row[5 * P + j], row[6 * P + j], row[7 * P + j]));
+            for (int k = 0; k < 3; ++k) row[(8 + k) * P + j] = a[k];
+            row[11 * P + j] = follower::variableOffset(speed[s], im.settings.maxVelocity);
         }
         float* cold = c.cold.data() + g * FollowerClass::kCold * P;
         for (uint32_t j = 0; j < P; ++j) {
@@ -175,24 +181,25 @@ FollowerStats Followers::update(const FollowerStep& step, StrandFrame& out) {
                               out.velocities.data() + guideVertices, stats.differenceVelocities,
                               step.dt > 0.0 ? float(1.0 / step.dt) : 0.f};
     std::atomic<size_t> projected{0}, queries{0};
-    auto followersLoop = [&](const tbb::blocked_range<size_t>& r) {
+    auto packetsLoop = [&](const tbb::blocked_range<size_t>& r) {
         follower::Counters counters;
-        follower::processFollowers(ctx, r.begin(), r.end(), counters);
+        follower::processPackets(ctx, r.begin(), r.end(), counters);
         projected += counters.projected;
         queries += counters.queries;
     };
     // Each pair and each follower depends only on the tables before it, so
     // any partition gives the same bits; the counters are integer sums.
+    const size_t packets = im.packets.size();
     if (im.settings.parallel) {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, G, 16), guidesLoop);
         for (FollowerClass& c : im.classes)
             tbb::parallel_for(tbb::blocked_range<size_t>(0, c.pairs.size(), 64),
                               [&](const tbb::blocked_range<size_t>& r) { follower::buildPairs(im, c, r.begin(), r.end()); });
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, F, 256), followersLoop);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, packets, 32), packetsLoop);
     } else {
         guidesLoop(tbb::blocked_range<size_t>(0, G));
         for (FollowerClass& c : im.classes) follower::buildPairs(im, c, 0, c.pairs.size());
-        followersLoop(tbb::blocked_range<size_t>(0, F));
+        packetsLoop(tbb::blocked_range<size_t>(0, packets));
     }
     stats.projected = projected;
     stats.collisionQueries = queries;

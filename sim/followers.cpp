@@ -86,6 +86,58 @@ void checkShape(const RestShapes& shapes, size_t i, const char* what) {
 template <typename T>
 T perFollower(const std::vector<T>& values, size_t i) { return values.size() == 1 ? values[0] : values[i]; }
 
+/// Cuts each class's followers, sorted by (guide 1, guide 2, index), into
+/// packets of 8 with one guide 1; fills the lanes' fields and own rest
+/// segments. Unused lanes repeat the packet's last follower.
+void buildPackets(Followers::Impl& im, const std::vector<size_t>& ownStart, const std::vector<float>& ownRows) {
+    constexpr int L = FollowerPacket::kLanes;
+    const bool own = !ownRows.empty();
+    size_t ownTotal = 0;
+    for (uint32_t cls = 0; cls < im.classes.size(); ++cls) {
+        std::vector<uint32_t> members;
+        for (uint32_t f = 0; f < im.followers; ++f)
+            if (im.classOf[f] == cls) members.push_back(f);
+        std::sort(members.begin(), members.end(), [&](uint32_t a, uint32_t b) {
+            const FollowerNeighbours &na = im.neighbours[a], &nb = im.neighbours[b];
+            if (na.guide1 != nb.guide1) return na.guide1 < nb.guide1;
+            return na.guide2 != nb.guide2 ? na.guide2 < nb.guide2 : a < b;
+        });
+        const uint32_t P = im.classes[cls].pad;
+        for (size_t i = 0; i < members.size();) {
+            const uint32_t g1 = im.neighbours[members[i]].guide1;
+            size_t n = 1;
+            while (n < size_t(L) && i + n < members.size() && im.neighbours[members[i + n]].guide1 == g1) ++n;
+            FollowerPacket pk;
+            pk.guide1 = g1;
+            pk.count = uint32_t(n);
+            pk.cls = cls;
+            pk.own = uint32_t(ownTotal);
+            for (int k = 0; k < L; ++k) {
+                const uint32_t f = members[i + std::min(size_t(k), n - 1)];
+                pk.follower[k] = f;
+                pk.vertexOffset[k] = im.vertexOffset[f];
+                pk.pair[k] = im.pairOf[f];
+                pk.alignC[k] = im.alignC[f];
+                pk.alignS[k] = im.alignS[f];
+                pk.scale[k] = own ? 1.f : im.segmentLength[f];
+                pk.weight[k] = im.weight[f];
+                pk.hash[k] = follower::followerHash(im.settings.seed, f);
+            }
+            if (own) {
+                im.ownRestData.resize(ownTotal + size_t(P) * 3 * L);
+                for (int k = 0; k < L; ++k)
+                    for (uint32_t j = 0; j < P; ++j)
+                        for (int c = 0; c < 3; ++c)
+                            im.ownRestData[ownTotal + (size_t(j) * 3 + c) * L + k] = ownRows[ownStart[pk.follower[k]] + c * P + j];
+                ownTotal += size_t(P) * 3 * L;
+                if (ownTotal > 0xffffffffu) throw Error("followers: too many follower rest vertices");
+            }
+            im.packets.push_back(pk);
+            i += n;
+        }
+    }
+}
+
 }  // namespace
 
 Followers::Followers(const FollowerGroom& groom, const FollowerSettings& settings) : impl_(std::make_unique<Impl>()) {
@@ -196,18 +248,16 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
     im.alignC.resize(F);
     im.alignS.resize(F);
     im.segmentLength.assign(F, 0.f);
-    im.ownRest.assign(F, Impl::kNone);
     im.vertexOffset.resize(F + 1);
     im.vertexOffset[0] = 0;
     for (size_t f = 0; f < F; ++f) im.vertexOffset[f + 1] = im.vertexOffset[f] + followerSegments(f) + 1;
+    // Own rest segments per follower (3 rows of P slots), moved into the
+    // packets' lane layout once those are formed.
+    std::vector<size_t> ownStart(own ? F + 1 : 0);
+    std::vector<float> ownRows;
     if (own) {
-        size_t total = 0;
-        for (size_t f = 0; f < F; ++f) {
-            im.ownRest[f] = uint32_t(total);
-            total += 3 * size_t(im.classes[im.classOf[f]].pad);
-        }
-        if (total > 0xffffffffu) throw Error("followers: too many follower rest vertices");
-        im.ownRestData.assign(total, 0.f);
+        for (size_t f = 0; f < F; ++f) ownStart[f + 1] = ownStart[f] + 3 * size_t(im.classes[im.classOf[f]].pad);
+        ownRows.assign(ownStart[F], 0.f);
     }
 
     // Mean squared difference of unit rest directions, `b` carried into `a`'s
@@ -290,7 +340,7 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
             if (own) {
                 // Rest segments (direction × length) in the effective frame:
                 // f' = R_y(φ)ᵀ f, slot y + 1 for segment y.
-                float* out = im.ownRestData.data() + im.ownRest[f];
+                float* out = ownRows.data() + ownStart[f];
                 const uint32_t a = groom.followerShapes.offsets[f];
                 for (uint32_t y = 0; y < segs; ++y) {
                     const Vec3d d = (groom.followerShapes.points[a + y + 1] - groom.followerShapes.points[a + y]).cast<double>();
@@ -320,19 +370,12 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
             }
             im.pairOf[f] = it->second;
         }
-        for (FollowerClass& c : im.classes) c.pairTable.assign(c.pairs.size() * FollowerClass::kPair * c.pad, 0.f);
+        for (FollowerClass& c : im.classes) c.pairRecords.assign(c.pairs.size() * c.pad * FollowerClass::kRecord, 0.f);
     }
 
     im.ids.resize(F);
     for (size_t f = 0; f < F; ++f) im.ids[f] = groom.followerIds.empty() ? uint32_t(G + f) : groom.followerIds[f];
-    im.order.resize(F);
-    std::iota(im.order.begin(), im.order.end(), 0u);
-    // Followers are processed in index order: their roots, per-follower
-    // tables and output vertices then stream through memory (sorting by guide
-    // made every one of those a cache miss, 4x slower at 100k followers).
-    // Only distinct vertex counts are grouped, keeping each range's loop uniform.
-    std::stable_sort(im.order.begin(), im.order.end(),
-                     [&](uint32_t a, uint32_t b) { return im.classOf[a] < im.classOf[b]; });
+    buildPackets(im, ownStart, ownRows);
 }
 
 Followers::~Followers() = default;
