@@ -31,23 +31,25 @@ struct FollowerClass {
     uint32_t pad = 0;
     /// Per guide, kHot rows of P slots: qw qx qy qz (rotation of the guide
     /// segment mapped to the slot's segment), speed (m/s, the segment's
-    /// centre), rx ry rz (unit rest direction, static), then per step
-    /// Ax Ay Az (A of follower_kernels.h's (2): the rest direction turned by
-    /// q) and d_v (Algorithm 1's clamped speed).
+    /// centre), rx ry rz (unit rest direction, static).
     std::vector<float> hot;
     /// Per guide, kCold rows of P slots, slot = vertex: x y z (world), bound
     /// (collisionBound; +inf at the root and in the padding), vx vy vz, unused.
     std::vector<float> cold;
-    /// Guide pairs of this class's followers and, per pair and slot, one
-    /// record of 8 floats rebuilt every step: θ, B - A, D of (2) (followers
-    /// with the guides' rest shape) or θ and the quaternion e of (1) (own
-    /// rest shapes), zero-padded. A record per slot lets a packet of 8
-    /// followers read its lanes' pairs with 8 loads and one transpose.
+    /// Per guide and slot, a record of 8 floats rebuilt every step: A of
+    /// follower_kernels.h's (2) and 0 (followers with the guides' rest shape)
+    /// or the guide's rotation q (own rest shapes), then the vertex x y z and
+    /// its collision bound.
+    std::vector<float> guideRecords;
+    /// Guide pairs of this class's followers and, per pair and slot, a record
+    /// of 8 floats rebuilt every step: θ, then B - A and D of (2) (followers
+    /// with the guides' rest shape) or the quaternion e of (1) and 0, 0 (own
+    /// rest shapes), then Algorithm 1's d_v (guide 1's clamped speed).
     std::vector<GuidePair> pairs;
     std::vector<float> pairRecords;
     std::vector<float> radii;          ///< S + 1 tapered radii
     std::vector<float> weightedCurve;  ///< fixedOffset · d_f(j - 1) per slot, 0 at slot 0 and in the padding
-    static constexpr int kHot = 12;
+    static constexpr int kHot = 8;
     static constexpr int kCold = 8;
     static constexpr int kRecord = 8;
 
@@ -59,11 +61,11 @@ struct FollowerClass {
     }
 };
 
-/// Eight followers of one class with the same guide 1, computed together
-/// in the 8 lanes of a vector (lanes = followers): everything of guide 1 is
-/// one broadcast, per-lane values are loads of the fields below. A class's
-/// followers are sorted by (guide 1, guide 2, index) and cut into packets;
-/// the last packet of a guide repeats its last follower in the unused lanes
+/// Eight consecutive followers of one class, computed together in the 8
+/// lanes of a vector (lanes = followers). Consecutive, so the output and the
+/// per-step roots stream through memory in order; each lane reads its own
+/// guide and pair records (8 loads and a transpose per slot). The last
+/// packet of a class repeats its last follower in the unused lanes
 /// (computed, never written).
 struct alignas(32) FollowerPacket {
     static constexpr int kLanes = 8;
@@ -71,9 +73,9 @@ struct alignas(32) FollowerPacket {
     float scale[kLanes];    ///< segment length (1 with own rest shapes: their segments carry it)
     float weight[kLanes];   ///< interpolation weight d1 / (d1 + d2)
     uint32_t hash[kLanes];  ///< followerHash(seed, follower)
-    uint32_t follower[kLanes], pair[kLanes];
+    uint32_t follower[kLanes], guide1[kLanes], pair[kLanes];
     uint32_t vertexOffset[kLanes];  ///< first output vertex, relative to the follower block
-    uint32_t guide1 = 0, count = 0, cls = 0;
+    uint32_t count = 0, cls = 0;
     uint32_t own = 0;  ///< offset of the packet's own rest segments: P slots × 3 × 8 lanes
 };
 

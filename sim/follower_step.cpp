@@ -40,7 +40,8 @@ constexpr int kLanes = FollowerPacket::kLanes;
 template <bool Own>
 [[gnu::always_inline]] inline void buildPairRecords(const Impl& im, FollowerClass& c, size_t begin, size_t end) {
     const size_t P = c.pad;
-    alignas(32) float rows[7][kMaxFollowerVertices];
+    alignas(32) float rows[8][kMaxFollowerVertices];
+    const float maxVelocity = im.settings.maxVelocity;
     for (size_t p = begin; p < end; ++p) {
         const GuidePair& gp = c.pairs[p];
         // One pointer per row: the slot loop reads and writes contiguous
@@ -48,10 +49,11 @@ template <bool Own>
         // lost once this is inlined).
         const float* h1 = c.hot.data() + size_t(gp.guide1) * FollowerClass::kHot * P;
         const float* h2 = c.hot.data() + size_t(gp.guide2) * FollowerClass::kHot * P;
-        const float *aW = h1, *aX = h1 + P, *aY = h1 + 2 * P, *aZ = h1 + 3 * P;
+        const float *aW = h1, *aX = h1 + P, *aY = h1 + 2 * P, *aZ = h1 + 3 * P, *speed = h1 + 4 * P;
         const float *fX = h1 + 5 * P, *fY = h1 + 6 * P, *fZ = h1 + 7 * P;
         const float *bW = h2, *bX = h2 + P, *bY = h2 + 2 * P, *bZ = h2 + 3 * P;
-        float *o0 = rows[0], *o1 = rows[1], *o2 = rows[2], *o3 = rows[3], *o4 = rows[4], *o5 = rows[5], *o6 = rows[6];
+        float *o0 = rows[0], *o1 = rows[1], *o2 = rows[2], *o3 = rows[3], *o4 = rows[4], *o5 = rows[5], *o6 = rows[6],
+              *o7 = rows[7];
         const float kc = gp.twistC, ks = gp.twistS;
 #pragma GCC ivdep
         for (size_t j = 0; j < P; ++j) {
@@ -62,6 +64,7 @@ template <bool Own>
             Quat e;
             slerpArc(a, b, theta, e);
             o0[j] = theta;
+            o7[j] = variableOffset(speed[j], maxVelocity);
             if constexpr (Own) {
                 o1[j] = e.w;
                 o2[j] = e.x;
@@ -84,7 +87,7 @@ template <bool Own>
         float* out = c.pairRecords.data() + p * P * FollowerClass::kRecord;
         for (size_t j = 0; j < P; j += 8) {
             f8 r0 = load(rows[0] + j), r1 = load(rows[1] + j), r2 = load(rows[2] + j), r3 = load(rows[3] + j);
-            f8 r4 = load(rows[4] + j), r5 = load(rows[5] + j), r6 = load(rows[6] + j), r7{};
+            f8 r4 = load(rows[4] + j), r5 = load(rows[5] + j), r6 = load(rows[6] + j), r7 = load(rows[7] + j);
             transpose8(r0, r1, r2, r3, r4, r5, r6, r7);
             const f8 r[8] = {r0, r1, r2, r3, r4, r5, r6, r7};
             for (int k = 0; k < 8; ++k) store(out + (j + k) * FollowerClass::kRecord, r[k]);
@@ -141,11 +144,13 @@ template <FollowerMode M, bool Own>
     const FollowerClass& c = im.classes[pk.cls];
     const size_t P = c.pad;
     const uint32_t S = c.segments;
-    const float* hot = c.hot.data() + size_t(pk.guide1) * FollowerClass::kHot * P;
-    const float* g1 = c.cold.data() + size_t(pk.guide1) * FollowerClass::kCold * P;
     const float* ownRest = Own ? im.ownRestData.data() + pk.own : nullptr;
-    const float* rec[kLanes];
-    for (int k = 0; k < kLanes; ++k) rec[k] = c.pairRecords.data() + size_t(pk.pair[k]) * P * FollowerClass::kRecord;
+    const float* guideRec[kLanes];
+    const float* pairRec[kLanes];
+    for (int k = 0; k < kLanes; ++k) {
+        guideRec[k] = c.guideRecords.data() + size_t(pk.guide1[k]) * P * FollowerClass::kRecord;
+        pairRec[k] = c.pairRecords.data() + size_t(pk.pair[k]) * P * FollowerClass::kRecord;
+    }
 
     // Root frames of the lanes: E = [t', n, z'] per lane, orthonormalised and
     // turned about n by the rest twist toward guide 1 (see followers.h);
@@ -192,28 +197,34 @@ template <FollowerMode M, bool Own>
     const f8 weight = load(pk.weight);
     i8 outside = i8{} - 1;
     for (uint32_t j = 1; j <= S; ++j) {
+        // The lanes' guide records: lead (A or q), guide vertex, bound.
+        f8 g0 = load(guideRec[0] + 8 * j), g1 = load(guideRec[1] + 8 * j), g2 = load(guideRec[2] + 8 * j);
+        f8 g3 = load(guideRec[3] + 8 * j), g4 = load(guideRec[4] + 8 * j), g5 = load(guideRec[5] + 8 * j);
+        f8 g6 = load(guideRec[6] + 8 * j), g7 = load(guideRec[7] + 8 * j);
+        transpose8(g0, g1, g2, g3, g4, g5, g6, g7);
         f8 vx, vy, vz, t{};
         f8 s{}, co = splat(1.f);
         f8 r0{}, r1{}, r2{}, r3{}, r4{}, r5{}, r6{}, r7{};
         if constexpr (M != FollowerMode::Cluster) {
-            // Slerp weight t (Algorithm 1: d_r = fixedOffset d_f + rand_xy d_v),
-            // then the lanes' pair records (θ, ...) and sin, cos of φ = tθ.
+            // The lanes' pair records (θ, ..., d_v), the slerp weight t
+            // (Algorithm 1: d_r = fixedOffset d_f + rand_xy d_v), sin and cos of φ = tθ.
+            r0 = load(pairRec[0] + 8 * j), r1 = load(pairRec[1] + 8 * j), r2 = load(pairRec[2] + 8 * j);
+            r3 = load(pairRec[3] + 8 * j), r4 = load(pairRec[4] + 8 * j), r5 = load(pairRec[5] + 8 * j);
+            r6 = load(pairRec[6] + 8 * j), r7 = load(pairRec[7] + 8 * j);
+            transpose8(r0, r1, r2, r3, r4, r5, r6, r7);
             if constexpr (M == FollowerMode::Interpolate) {
                 t = weight;
             } else {
                 const f8 random = toSignedUnit(segmentHash(hash, splat(uint32_t(j - 1))));
-                t = splat(c.weightedCurve[j]) + random * splat(hot[11 * P + j]);
+                t = splat(c.weightedCurve[j]) + random * r7;
             }
-            r0 = load(rec[0] + j * 8), r1 = load(rec[1] + j * 8), r2 = load(rec[2] + j * 8), r3 = load(rec[3] + j * 8);
-            r4 = load(rec[4] + j * 8), r5 = load(rec[5] + j * 8), r6 = load(rec[6] + j * 8), r7 = load(rec[7] + j * 8);
-            transpose8(r0, r1, r2, r3, r4, r5, r6, r7);
             sinCos(reduceHalfTurns(t * r0), s, co);
         }
         weights[j] = t;
-        if constexpr (!Own) {  // (2): A + s² (B - A) + cs D, A of guide 1
-            vx = splat(hot[8 * P + j]);
-            vy = splat(hot[9 * P + j]);
-            vz = splat(hot[10 * P + j]);
+        if constexpr (!Own) {  // (2): A + s² (B - A) + cs D
+            vx = g0;
+            vy = g1;
+            vz = g2;
             if constexpr (M != FollowerMode::Cluster) {
                 const f8 ss = s * s, cs = co * s;
                 vx += ss * r1 + cs * r4;
@@ -221,8 +232,7 @@ template <FollowerMode M, bool Own>
                 vz += ss * r3 + cs * r6;
             }
         } else {  // (1): q = cos φ a + sin φ e, then q f q* of the lane's own rest segment
-            const f8 qw = co * splat(hot[j]) + s * r1, qx = co * splat(hot[P + j]) + s * r2;
-            const f8 qy = co * splat(hot[2 * P + j]) + s * r3, qz = co * splat(hot[3 * P + j]) + s * r4;
+            const f8 qw = co * g0 + s * r1, qx = co * g1 + s * r2, qy = co * g2 + s * r3, qz = co * g3 + s * r4;
             const float* f = ownRest + size_t(j) * 3 * kLanes;
             rotate(qw, qx, qy, qz, load(f), load(f + kLanes), load(f + 2 * kLanes), vx, vy, vz);
         }
@@ -234,8 +244,8 @@ template <FollowerMode M, bool Own>
         pos[3 * j + 1] = y;
         pos[3 * j + 2] = z;
         if (ctx.collider) {
-            const f8 dx = x - splat(g1[j]), dy = y - splat(g1[P + j]), dz = z - splat(g1[2 * P + j]);
-            cleared[j] = dx * dx + dy * dy + dz * dz < splat(g1[3 * P + j]);
+            const f8 dx = x - g4, dy = y - g5, dz = z - g6;
+            cleared[j] = dx * dx + dy * dy + dz * dz < g7;
             outside &= cleared[j];
         }
     }
@@ -245,7 +255,10 @@ template <FollowerMode M, bool Own>
         alignas(32) int32_t clear[kLanes];
         std::memcpy(clear, &outside, sizeof clear);
         for (uint32_t k = 0; k < pk.count; ++k)
-            if (!clear[k]) collideLane(ctx, c, g1, cleared, int(k), ownRest, pk.scale[k], pos, counters);
+            if (!clear[k]) {
+                const float* g1 = c.cold.data() + size_t(pk.guide1[k]) * FollowerClass::kCold * P;
+                collideLane(ctx, c, g1, cleared, int(k), ownRest, pk.scale[k], pos, counters);
+            }
     }
 
     // Output: per 8 floats, a transpose turns lanes back into followers.
@@ -280,6 +293,7 @@ template <FollowerMode M, bool Own>
     if (!ctx.difference) {
         // No previous positions: the slerp-weighted blend of the guides' vertex velocities.
         for (uint32_t k = 0; k < pk.count; ++k) {
+            const float* g1 = c.cold.data() + size_t(pk.guide1[k]) * FollowerClass::kCold * P;
             const float* g2 = c.cold.data() + size_t(c.pairs[pk.pair[k]].guide2) * FollowerClass::kCold * P;
             float* vel = outVel[k];
             for (uint32_t v = 0; v <= S; ++v) {
@@ -290,30 +304,10 @@ template <FollowerMode M, bool Own>
     }
 }
 
-/// Asks for the cache lines packet `pk` will read and write: its roots and
-/// output vertices lie anywhere in memory (followers are packed by guide,
-/// the output is in follower order), and a packet's arithmetic takes longer
-/// than a memory access, so one packet ahead hides the latency.
-[[gnu::always_inline]] inline void prefetchPacket(const StepContext& ctx, const FollowerPacket& pk) {
-    const size_t bytes = 3 * sizeof(float) * (ctx.im->classes[pk.cls].segments + 1);
-    for (uint32_t k = 0; k < pk.count; ++k) {
-        __builtin_prefetch(ctx.roots + pk.follower[k]);
-        const char* p = reinterpret_cast<const char*>(ctx.positions + pk.vertexOffset[k]);
-        const char* v = reinterpret_cast<const char*>(ctx.velocities + pk.vertexOffset[k]);
-        for (size_t b = 0; b < bytes + 63; b += 64) {
-            __builtin_prefetch(p + b, 1);
-            __builtin_prefetch(v + b, 1);
-        }
-    }
-}
-
 template <FollowerMode M, bool Own>
 [[gnu::always_inline]] inline void processRangeT(const StepContext& ctx, size_t begin, size_t end, Counters& counters) {
     const FollowerPacket* packets = ctx.im->packets.data();
-    for (size_t i = begin; i < end; ++i) {
-        if (i + 1 < end) prefetchPacket(ctx, packets[i + 1]);
-        processPacket<M, Own>(ctx, packets[i], counters);
-    }
+    for (size_t i = begin; i < end; ++i) processPacket<M, Own>(ctx, packets[i], counters);
 }
 
 [[gnu::target_clones("arch=x86-64-v3", "default")]] void processRange(const StepContext& ctx, size_t begin,

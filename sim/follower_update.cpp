@@ -79,12 +79,6 @@ void fillGuide(Impl& im, const FollowerStep& step, const Collider* collider, siz
             const uint32_t s = same ? j - 1 : FollowerClass::guideSegment(j - 1, S, gs);
             for (int k = 0; k < 4; ++k) row[k * P + j] = q[s][k];
             row[4 * P + j] = speed[s];
-            // A = q r q* (the rest direction turned) and Algorithm 1's d_v:
-            // shared by every follower led by this guide.
-            const Vec3f a = follower::sandwich({q[s][0], q[s][1], q[s][2], q[s][3]},
-                                               Vec3f(row[5 * P + j], row[6 * P + j], row[7 * P + j]));
-            for (int k = 0; k < 3; ++k) row[(8 + k) * P + j] = a[k];
-            row[11 * P + j] = follower::variableOffset(speed[s], im.settings.maxVelocity);
         }
         float* cold = c.cold.data() + g * FollowerClass::kCold * P;
         for (uint32_t j = 0; j < P; ++j) {
@@ -97,6 +91,24 @@ void fillGuide(Impl& im, const FollowerStep& step, const Collider* collider, siz
             cold[4 * P + j] = v ? v[gv].x() : 0.f;
             cold[5 * P + j] = v ? v[gv].y() : 0.f;
             cold[6 * P + j] = v ? v[gv].z() : 0.f;
+            // The record followers led by this guide read per slot: A = q r q*
+            // (the rest direction turned; followers with own rest shapes take
+            // q itself), then the vertex and its bound.
+            float* rec = c.guideRecords.data() + (g * P + j) * FollowerClass::kRecord;
+            const follower::Quat qj{row[j], row[P + j], row[2 * P + j], row[3 * P + j]};
+            if (im.ownRestData.empty()) {
+                const Vec3f a = follower::sandwich(qj, Vec3f(row[5 * P + j], row[6 * P + j], row[7 * P + j]));
+                rec[0] = a.x();
+                rec[1] = a.y();
+                rec[2] = a.z();
+                rec[3] = 0.f;
+            } else {
+                rec[0] = qj.w;
+                rec[1] = qj.x;
+                rec[2] = qj.y;
+                rec[3] = qj.z;
+            }
+            for (int k = 0; k < 4; ++k) rec[4 + k] = cold[k * P + j];
         }
     }
 }

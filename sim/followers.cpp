@@ -86,9 +86,9 @@ void checkShape(const RestShapes& shapes, size_t i, const char* what) {
 template <typename T>
 T perFollower(const std::vector<T>& values, size_t i) { return values.size() == 1 ? values[0] : values[i]; }
 
-/// Cuts each class's followers, sorted by (guide 1, guide 2, index), into
-/// packets of 8 with one guide 1; fills the lanes' fields and own rest
-/// segments. Unused lanes repeat the packet's last follower.
+/// Cuts each class's followers, in index order, into packets of 8; fills
+/// the lanes' fields and own rest segments. Unused lanes of a class's last
+/// packet repeat its last follower.
 void buildPackets(Followers::Impl& im, const std::vector<size_t>& ownStart, const std::vector<float>& ownRows) {
     constexpr int L = FollowerPacket::kLanes;
     const bool own = !ownRows.empty();
@@ -97,26 +97,19 @@ void buildPackets(Followers::Impl& im, const std::vector<size_t>& ownStart, cons
         std::vector<uint32_t> members;
         for (uint32_t f = 0; f < im.followers; ++f)
             if (im.classOf[f] == cls) members.push_back(f);
-        std::sort(members.begin(), members.end(), [&](uint32_t a, uint32_t b) {
-            const FollowerNeighbours &na = im.neighbours[a], &nb = im.neighbours[b];
-            if (na.guide1 != nb.guide1) return na.guide1 < nb.guide1;
-            return na.guide2 != nb.guide2 ? na.guide2 < nb.guide2 : a < b;
-        });
         const uint32_t P = im.classes[cls].pad;
-        for (size_t i = 0; i < members.size();) {
-            const uint32_t g1 = im.neighbours[members[i]].guide1;
-            size_t n = 1;
-            while (n < size_t(L) && i + n < members.size() && im.neighbours[members[i + n]].guide1 == g1) ++n;
+        for (size_t i = 0; i < members.size(); i += L) {
+            const size_t n = std::min(members.size() - i, size_t(L));
             FollowerPacket pk;
-            pk.guide1 = g1;
             pk.count = uint32_t(n);
             pk.cls = cls;
             pk.own = uint32_t(ownTotal);
             for (int k = 0; k < L; ++k) {
                 const uint32_t f = members[i + std::min(size_t(k), n - 1)];
                 pk.follower[k] = f;
-                pk.vertexOffset[k] = im.vertexOffset[f];
+                pk.guide1[k] = im.neighbours[f].guide1;
                 pk.pair[k] = im.pairOf[f];
+                pk.vertexOffset[k] = im.vertexOffset[f];
                 pk.alignC[k] = im.alignC[f];
                 pk.alignS[k] = im.alignS[f];
                 pk.scale[k] = own ? 1.f : im.segmentLength[f];
@@ -133,7 +126,6 @@ void buildPackets(Followers::Impl& im, const std::vector<size_t>& ownStart, cons
                 if (ownTotal > 0xffffffffu) throw Error("followers: too many follower rest vertices");
             }
             im.packets.push_back(pk);
-            i += n;
         }
     }
 }
@@ -370,7 +362,10 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
             }
             im.pairOf[f] = it->second;
         }
-        for (FollowerClass& c : im.classes) c.pairRecords.assign(c.pairs.size() * c.pad * FollowerClass::kRecord, 0.f);
+        for (FollowerClass& c : im.classes) {
+            c.pairRecords.assign(c.pairs.size() * c.pad * FollowerClass::kRecord, 0.f);
+            c.guideRecords.assign(G * c.pad * FollowerClass::kRecord, 0.f);
+        }
     }
 
     im.ids.resize(F);
