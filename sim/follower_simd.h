@@ -43,6 +43,26 @@ HP_SIMD bool anyLane(i8 m) {
     return (q[0] | q[1] | q[2] | q[3]) != 0;
 }
 
+/// Half of an 8 × 8 transpose: the 4 floats at p[k] (k = 0..7, the lanes)
+/// as 4 vectors, c_i lane k = p[k][i]. Two 4-float loads per 128-bit half,
+/// then a 4 × 4 transpose in each half: 12 shuffles for 4 outputs, and only
+/// those 4 live, where a full transpose keeps 8 registers busy.
+HP_SIMD void transpose8x4(const float* const* p, f8& c0, f8& c1, f8& c2, f8& c3) {
+    typedef float f4u __attribute__((vector_size(16), aligned(4), may_alias));
+    const f8 r0 = __builtin_shufflevector(*reinterpret_cast<const f4u*>(p[0]), *reinterpret_cast<const f4u*>(p[4]), 0, 1, 2, 3, 4, 5, 6, 7);
+    const f8 r1 = __builtin_shufflevector(*reinterpret_cast<const f4u*>(p[1]), *reinterpret_cast<const f4u*>(p[5]), 0, 1, 2, 3, 4, 5, 6, 7);
+    const f8 r2 = __builtin_shufflevector(*reinterpret_cast<const f4u*>(p[2]), *reinterpret_cast<const f4u*>(p[6]), 0, 1, 2, 3, 4, 5, 6, 7);
+    const f8 r3 = __builtin_shufflevector(*reinterpret_cast<const f4u*>(p[3]), *reinterpret_cast<const f4u*>(p[7]), 0, 1, 2, 3, 4, 5, 6, 7);
+    const i8 lo{0, 8, 1, 9, 4, 12, 5, 13}, hi{2, 10, 3, 11, 6, 14, 7, 15};
+    const i8 lo2{0, 1, 8, 9, 4, 5, 12, 13}, hi2{2, 3, 10, 11, 6, 7, 14, 15};
+    const f8 t0 = __builtin_shuffle(r0, r1, lo), t1 = __builtin_shuffle(r0, r1, hi);
+    const f8 t2 = __builtin_shuffle(r2, r3, lo), t3 = __builtin_shuffle(r2, r3, hi);
+    c0 = __builtin_shuffle(t0, t2, lo2);
+    c1 = __builtin_shuffle(t0, t2, hi2);
+    c2 = __builtin_shuffle(t1, t3, lo2);
+    c3 = __builtin_shuffle(t1, t3, hi2);
+}
+
 /// Lane-wise square root (a loop GCC turns into one vector instruction;
 /// vector extensions have no sqrt of their own).
 HP_SIMD f8 sqrt8(f8 x) {

@@ -196,47 +196,51 @@ template <FollowerMode M, bool Own>
     const u8 hash = *reinterpret_cast<const u8*>(pk.hash);
     const f8 weight = load(pk.weight);
     i8 outside = i8{} - 1;
+    // Two passes down the strand, each with fewer live registers than one:
+    // 1. local directions (guide 1's frame) from the records, into pos[3j..];
+    // 2. world space, the running sum from the root, the bound tests.
+    const float* lane[kLanes];
     for (uint32_t j = 1; j <= S; ++j) {
-        // The lanes' guide records: lead (A or q), guide vertex, bound.
-        f8 g0 = load(guideRec[0] + 8 * j), g1 = load(guideRec[1] + 8 * j), g2 = load(guideRec[2] + 8 * j);
-        f8 g3 = load(guideRec[3] + 8 * j), g4 = load(guideRec[4] + 8 * j), g5 = load(guideRec[5] + 8 * j);
-        f8 g6 = load(guideRec[6] + 8 * j), g7 = load(guideRec[7] + 8 * j);
-        transpose8(g0, g1, g2, g3, g4, g5, g6, g7);
-        f8 vx, vy, vz, t{};
-        f8 s{}, co = splat(1.f);
-        f8 r0{}, r1{}, r2{}, r3{}, r4{}, r5{}, r6{}, r7{};
+        f8 t{}, s{}, co = splat(1.f);
+        f8 theta{}, e1{}, e2{}, e3{}, e4{}, e5{}, e6{}, dv{};
         if constexpr (M != FollowerMode::Cluster) {
             // The lanes' pair records (θ, ..., d_v), the slerp weight t
             // (Algorithm 1: d_r = fixedOffset d_f + rand_xy d_v), sin and cos of φ = tθ.
-            r0 = load(pairRec[0] + 8 * j), r1 = load(pairRec[1] + 8 * j), r2 = load(pairRec[2] + 8 * j);
-            r3 = load(pairRec[3] + 8 * j), r4 = load(pairRec[4] + 8 * j), r5 = load(pairRec[5] + 8 * j);
-            r6 = load(pairRec[6] + 8 * j), r7 = load(pairRec[7] + 8 * j);
-            transpose8(r0, r1, r2, r3, r4, r5, r6, r7);
+            for (int k = 0; k < kLanes; ++k) lane[k] = pairRec[k] + 8 * j;
+            transpose8x4(lane, theta, e1, e2, e3);
+            for (int k = 0; k < kLanes; ++k) lane[k] += 4;
+            transpose8x4(lane, e4, e5, e6, dv);
             if constexpr (M == FollowerMode::Interpolate) {
                 t = weight;
             } else {
                 const f8 random = toSignedUnit(segmentHash(hash, splat(uint32_t(j - 1))));
-                t = splat(c.weightedCurve[j]) + random * r7;
+                t = splat(c.weightedCurve[j]) + random * dv;
             }
-            sinCos(reduceHalfTurns(t * r0), s, co);
+            sinCos(reduceHalfTurns(t * theta), s, co);
         }
         weights[j] = t;
+        f8 l0, l1, l2, l3;  // the guide record's lead: A or q
+        for (int k = 0; k < kLanes; ++k) lane[k] = guideRec[k] + 8 * j;
+        transpose8x4(lane, l0, l1, l2, l3);
+        f8 vx = l0, vy = l1, vz = l2;
         if constexpr (!Own) {  // (2): A + s² (B - A) + cs D
-            vx = g0;
-            vy = g1;
-            vz = g2;
             if constexpr (M != FollowerMode::Cluster) {
                 const f8 ss = s * s, cs = co * s;
-                vx += ss * r1 + cs * r4;
-                vy += ss * r2 + cs * r5;
-                vz += ss * r3 + cs * r6;
+                vx += ss * e1 + cs * e4;
+                vy += ss * e2 + cs * e5;
+                vz += ss * e3 + cs * e6;
             }
         } else {  // (1): q = cos φ a + sin φ e, then q f q* of the lane's own rest segment
-            const f8 qw = co * g0 + s * r1, qx = co * g1 + s * r2, qy = co * g2 + s * r3, qz = co * g3 + s * r4;
+            const f8 qw = co * l0 + s * e1, qx = co * l1 + s * e2, qy = co * l2 + s * e3, qz = co * l3 + s * e4;
             const float* f = ownRest + size_t(j) * 3 * kLanes;
             rotate(qw, qx, qy, qz, load(f), load(f + kLanes), load(f + 2 * kLanes), vx, vy, vz);
         }
-        // World space (scaled frame), then the running sum from the root.
+        pos[3 * j] = vx;
+        pos[3 * j + 1] = vy;
+        pos[3 * j + 2] = vz;
+    }
+    for (uint32_t j = 1; j <= S; ++j) {
+        const f8 vx = pos[3 * j], vy = pos[3 * j + 1], vz = pos[3 * j + 2];
         x += m00 * vx + m01 * vy + m02 * vz;
         y += m10 * vx + m11 * vy + m12 * vz;
         z += m20 * vx + m21 * vy + m22 * vz;
@@ -244,8 +248,11 @@ template <FollowerMode M, bool Own>
         pos[3 * j + 1] = y;
         pos[3 * j + 2] = z;
         if (ctx.collider) {
-            const f8 dx = x - g4, dy = y - g5, dz = z - g6;
-            cleared[j] = dx * dx + dy * dy + dz * dz < g7;
+            f8 gx, gy, gz, bound;  // the guide record's vertex and bound
+            for (int k = 0; k < kLanes; ++k) lane[k] = guideRec[k] + 8 * j + 4;
+            transpose8x4(lane, gx, gy, gz, bound);
+            const f8 dx = x - gx, dy = y - gy, dz = z - gz;
+            cleared[j] = dx * dx + dy * dy + dz * dz < bound;
             outside &= cleared[j];
         }
     }
