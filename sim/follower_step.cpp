@@ -155,17 +155,19 @@ template <FollowerMode M, bool Own>
     // Root frames of the lanes: E = [t', n, z'] per lane, orthonormalised and
     // turned about n by the rest twist toward guide 1 (see followers.h);
     // times the segment length for followers with the guides' rest shape.
-    alignas(32) float root[9][kLanes];
+    // SurfaceFrame is 9 floats (position, normal, tangent): the first 8 of
+    // each lane by a transpose, the tangent's z lane by lane.
+    static_assert(sizeof(SurfaceFrame) == 9 * sizeof(float), "SurfaceFrame layout");
+    const float* frames[kLanes];
+    alignas(32) float tangentZ[kLanes];
     for (int k = 0; k < kLanes; ++k) {
-        const SurfaceFrame& r = ctx.roots[pk.follower[k]];
-        for (int i = 0; i < 3; ++i) {
-            root[i][k] = r.position[i];
-            root[3 + i][k] = r.normal[i];
-            root[6 + i][k] = r.tangent[i];
-        }
+        frames[k] = ctx.roots[pk.follower[k]].position.data();
+        tangentZ[k] = frames[k][8];
     }
-    f8 nx = load(root[3]), ny = load(root[4]), nz = load(root[5]);
-    f8 tx = load(root[6]), ty = load(root[7]), tz = load(root[8]);
+    f8 x = load(frames[0]), y = load(frames[1]), z = load(frames[2]), nx = load(frames[3]);
+    f8 ny = load(frames[4]), nz = load(frames[5]), tx = load(frames[6]), ty = load(frames[7]);
+    transpose8(x, y, z, nx, ny, nz, tx, ty);
+    f8 tz = load(tangentZ);
     const f8 invN = splat(1.f) / sqrt8(nx * nx + ny * ny + nz * nz);
     nx *= invN;
     ny *= invN;
@@ -189,7 +191,6 @@ template <FollowerMode M, bool Own>
     alignas(32) f8 pos[3 * kMaxFollowerVertices];
     alignas(32) f8 weights[kMaxFollowerVertices];
     alignas(32) i8 cleared[kMaxFollowerVertices];
-    f8 x = load(root[0]), y = load(root[1]), z = load(root[2]);
     pos[0] = x;
     pos[1] = y;
     pos[2] = z;
@@ -279,22 +280,40 @@ template <FollowerMode M, bool Own>
         outPos[k] = ctx.positions[0].data() + 3 * size_t(pk.vertexOffset[k]);
         outVel[k] = ctx.velocities[0].data() + 3 * size_t(pk.vertexOffset[k]);
     }
+    // Transposed into one row per lane first, then written lane by lane: the
+    // output is one sequential stream (8 consecutive followers), which the
+    // hardware prefetcher follows, where writing chunk by chunk across lanes
+    // interleaves 8 streams.
+    alignas(32) float rows[kLanes][3 * kMaxFollowerVertices];
     for (size_t i = 0; i < n3; i += 8) {
         f8 o0 = pos[i], o1 = pos[i + 1], o2 = pos[i + 2], o3 = pos[i + 3];
         f8 o4 = pos[i + 4], o5 = pos[i + 5], o6 = pos[i + 6], o7 = pos[i + 7];
         transpose8(o0, o1, o2, o3, o4, o5, o6, o7);
-        const f8 o[kLanes] = {o0, o1, o2, o3, o4, o5, o6, o7};
-        if (i + 8 <= n3) {
-            for (uint32_t k = 0; k < count; ++k) {
-                if (difference) store(outVel[k] + i, (o[k] - load(outPos[k] + i)) * invDt);
-                store(outPos[k] + i, o[k]);
+        store(rows[0] + i, o0);
+        store(rows[1] + i, o1);
+        store(rows[2] + i, o2);
+        store(rows[3] + i, o3);
+        store(rows[4] + i, o4);
+        store(rows[5] + i, o5);
+        store(rows[6] + i, o6);
+        store(rows[7] + i, o7);
+    }
+    const size_t whole = n3 & ~size_t(7);
+    for (uint32_t k = 0; k < count; ++k) {
+        float* __restrict p = outPos[k];
+        float* __restrict u = outVel[k];
+        const float* __restrict row = rows[k];
+        if (difference) {
+            for (size_t i = 0; i < whole; i += 8) {
+                store(u + i, (load(row + i) - load(p + i)) * invDt);
+                store(p + i, load(row + i));
             }
-        } else {  // the strands' last, partial 8 floats
-            for (uint32_t k = 0; k < count; ++k)
-                for (size_t r = 0; r < n3 - i; ++r) {
-                    if (difference) outVel[k][i + r] = (o[k][r] - outPos[k][i + r]) * ctx.invDt;
-                    outPos[k][i + r] = o[k][r];
-                }
+            for (size_t i = whole; i < n3; ++i) {
+                u[i] = (row[i] - p[i]) * ctx.invDt;
+                p[i] = row[i];
+            }
+        } else {
+            for (size_t i = 0; i < n3; ++i) p[i] = row[i];
         }
     }
     if (!ctx.difference) {
