@@ -100,36 +100,54 @@ template <bool Own>
 /// projected out keeping its segment's length, and every later vertex moves
 /// by the same shift, so segment directions are kept elsewhere.
 /// `cleared[v]` is the vector pass's bound test of the unshifted vertex,
-/// valid until the first projection; after it shifted vertices are tested again.
-void collideLane(const StepContext& ctx, const FollowerClass& c, const float* g1, const i8* cleared, int k,
-                 const float* ownRest, float segmentLength, f8* pos, Counters& counters) {
+/// valid until the first projection (and `uncleared`, bit v, the same for
+/// vertices 1..31); after it shifted vertices are tested again.
+void collideLane(const StepContext& ctx, const FollowerClass& c, const float* g1, const i8* cleared,
+                 uint32_t uncleared, int k, const float* ownRest, float segmentLength, f8* pos, Counters& counters) {
     const size_t P = c.pad;
     float sx = 0.f, sy = 0.f, sz = 0.f;
     bool shifted = false;
-    for (uint32_t v = 1; v <= c.segments; ++v) {
+    // Vertex v at q: queried without the normal (most queried vertices are
+    // outside), again with it when inside, then projected.
+    auto query = [&](uint32_t v, float qx, float qy, float qz) {
+        ++counters.queries;
+        Vec3f p(qx, qy, qz), normal;
+        float d = ctx.collider->signedDistance(p);
+        if (!(d < c.radii[v])) return;
+        d = ctx.collider->signedDistance(p, &normal);
+        const Vec3f previous(pos[3 * v - 3][k], pos[3 * v - 2][k], pos[3 * v - 1][k]);
+        float length = segmentLength;
+        if (ownRest) {
+            const float* r = ownRest + size_t(v) * 3 * kLanes + k;
+            length = std::sqrt(r[0] * r[0] + r[kLanes] * r[kLanes] + r[2 * kLanes] * r[2 * kLanes]);
+        }
+        projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p);
+        sx += p.x() - qx;
+        sy += p.y() - qy;
+        sz += p.z() - qz;
+        shifted = true;
+        ++counters.projected;
+    };
+    uint32_t v = 1;
+    if (c.segments < 32) {
+        // Up to the first projection, only the vertices the bound failed.
+        while (uncleared && !shifted) {
+            v = uint32_t(__builtin_ctz(uncleared));
+            uncleared &= uncleared - 1;
+            query(v, pos[3 * v][k], pos[3 * v + 1][k], pos[3 * v + 2][k]);
+        }
+        if (!shifted) return;
+        pos[3 * v][k] += sx;
+        pos[3 * v + 1][k] += sy;
+        pos[3 * v + 2][k] += sz;
+        ++v;
+    }
+    for (; v <= c.segments; ++v) {
         if (!shifted && cleared[v][k]) continue;
         float &px = pos[3 * v][k], &py = pos[3 * v + 1][k], &pz = pos[3 * v + 2][k];
         const float qx = px + sx, qy = py + sy, qz = pz + sz;
         const float gx = qx - g1[v], gy = qy - g1[P + v], gz = qz - g1[2 * P + v];
-        if (!shifted || !(gx * gx + gy * gy + gz * gz < g1[3 * P + v])) {
-            ++counters.queries;
-            Vec3f p(qx, qy, qz), normal;
-            const float d = ctx.collider->signedDistance(p, &normal);
-            if (d < c.radii[v]) {
-                const Vec3f previous(pos[3 * v - 3][k], pos[3 * v - 2][k], pos[3 * v - 1][k]);
-                float length = segmentLength;
-                if (ownRest) {
-                    const float* r = ownRest + size_t(v) * 3 * kLanes + k;
-                    length = std::sqrt(r[0] * r[0] + r[kLanes] * r[kLanes] + r[2 * kLanes] * r[2 * kLanes]);
-                }
-                projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p);
-                sx += p.x() - qx;
-                sy += p.y() - qy;
-                sz += p.z() - qz;
-                shifted = true;
-                ++counters.projected;
-            }
-        }
+        if (!shifted || !(gx * gx + gy * gy + gz * gz < g1[3 * P + v])) query(v, qx, qy, qz);
         if (shifted) {
             px += sx;
             py += sy;
@@ -197,6 +215,7 @@ template <FollowerMode M, bool Own>
     const u8 hash = *reinterpret_cast<const u8*>(pk.hash);
     const f8 weight = load(pk.weight);
     i8 outside = i8{} - 1;
+    u8 uncleared{};  // bit v: vertex v (< 32) not cleared by the bound
     // Two passes down the strand, each with fewer live registers than one:
     // 1. local directions (guide 1's frame) from the records, into pos[3j..];
     // 2. world space, the running sum from the root, the bound tests.
@@ -255,6 +274,7 @@ template <FollowerMode M, bool Own>
             const f8 dx = x - gx, dy = y - gy, dz = z - gz;
             cleared[j] = dx * dx + dy * dy + dz * dz < bound;
             outside &= cleared[j];
+            if (j < 32) uncleared |= u8(~cleared[j]) & splat(1u << j);
         }
     }
     for (size_t v = S + 1; v < P; ++v) pos[3 * v] = pos[3 * v + 1] = pos[3 * v + 2] = f8{};  // never written out
@@ -265,7 +285,7 @@ template <FollowerMode M, bool Own>
         for (uint32_t k = 0; k < pk.count; ++k)
             if (!clear[k]) {
                 const float* g1 = c.cold.data() + size_t(pk.guide1[k]) * FollowerClass::kCold * P;
-                collideLane(ctx, c, g1, cleared, int(k), ownRest, pk.scale[k], pos, counters);
+                collideLane(ctx, c, g1, cleared, uncleared[k], int(k), ownRest, pk.scale[k], pos, counters);
             }
     }
 
