@@ -55,7 +55,7 @@ HP_FOLLOWER_KERNEL float variableOffset(float speed, float maxVelocity) {
 }
 
 /// Resulting slerp weight of Algorithm 1: d_r = fixed * d_f + rand * d_v.
-/// May leave [0, 1] (rand < 0 near root and tip); slerpWeights extrapolates
+/// May leave [0, 1] (rand < 0 near root and tip); the slerp (1) extrapolates
 /// along the same great circle rather than clamping, so the variation stays
 /// symmetric about the fixed-offset curve.
 HP_FOLLOWER_KERNEL float variedWeight(float fixedOffset, float df, float random, float dv) {
@@ -123,6 +123,12 @@ struct Quat {
 // guide pair and segment; a follower then needs one sine and one cosine of
 // φ = tθ. The templates below take float or an 8-lane vector
 // (sim/follower_simd.h) alike; the arithmetic is the same.
+// Error bound (tests/test_follower_kernels.cpp, 20k random pairs from equal
+// to opposite rotations, t in [-0.5, 1.5], against double precision):
+// |q - slerp| < 1e-6 (measured 3.4e-7) and the rotated direction of (2)
+// within 2e-6 (measured 7.6e-7); Eberly's series used before was 2.4e-7
+// only for cos θ >= 0.7 and 3e-5 toward opposite rotations. (sin, cos) stay
+// on the unit circle to 3e-7, so directions need no renormalisation.
 
 /// Polynomials for |x| <= π/2 (Chebyshev fits of (sin x / x - 1) / x² and
 /// (cos x - 1) / x², degree 9 and 10): absolute error < 3e-8 before float

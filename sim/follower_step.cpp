@@ -4,17 +4,22 @@
 // sim/follower_kernels.h has the equations, sim/follower_update.cpp the
 // step around this.
 //
-// Performance (100k followers × 24 vertices: ~2.3M segments per step):
+// Performance (100k followers × 24 vertices: 2.3M segments per step; the
+// measurements behind these choices are in the README's follower section):
 // - What depends only on a follower's guides is computed once per guide or
-//   guide pair and segment: A and d_v per guide (fillGuide), the slerp arc θ
-//   and B - A, D of (2) per pair (a few thousand pairs against 100k
+//   guide pair and segment: A of (2) and the guide vertex with its collision
+//   bound per guide (guide records, fillGuide), the slerp arc θ, B - A and D
+//   of (2) and d_v per pair (pair records; ~4.5k pairs against 100k
 //   followers). Per segment a follower then evaluates its weight t (hash,
 //   Algorithm 1), sin and cos of tθ (polynomials), (2) and its root frame.
-// - Lanes are followers: a packet of 8 followers with the same guide 1 runs
-//   down the strand together, so guide 1's rows are broadcasts, positions
-//   are a running sum per lane (no shuffles), and the per-follower setup
-//   (frame) is vector work too. The lanes' pair records (one per slot) are
-//   8 loads and a transpose; the output is a transpose back per 8 floats.
+// - Lanes are followers: a packet of 8 consecutive followers runs down the
+//   strand together, so positions are a running sum per lane, and the frame
+//   setup is vector work too. Each lane reads its own records, 4 floats at
+//   a time, turned into lanes by a transpose. Consecutive, because the
+//   output (positions read for the velocities, positions and velocities
+//   written: ~86 MB per step at 100k) must stream through memory in order;
+//   packing followers by guide instead made every access a cache miss
+//   (3x the memory time).
 // - Collision: one vector test per vertex against guide 1's bound
 //   (collisionBound); only followers with a vertex the bound cannot clear
 //   take the sequential follow-the-leader loop, from that vertex on.
