@@ -10,14 +10,17 @@
 //   it takes the segment's rest direction to its current direction, with the
 //   twist fixed by parallel transport along the strand (segmentRotation).
 //
-// Everything is inline and scalar: the follower update calls these inside
-// loops over a strand's segments that the compiler vectorizes.
+// Everything is inline. The follower update runs these over 8 segments at a
+// time: templates take float or an 8-lane vector (sim/follower_simd.h) with
+// the same arithmetic; the float-only ones run inside loops over segments
+// that the compiler vectorizes.
 #pragma once
 
 #include "sim/head.h"
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -52,7 +55,7 @@ HP_FOLLOWER_KERNEL float variableOffset(float speed, float maxVelocity) {
 }
 
 /// Resulting slerp weight of Algorithm 1: d_r = fixed * d_f + rand * d_v.
-/// May leave [0, 1] (rand < 0 near root and tip); slerpWeights extrapolates
+/// May leave [0, 1] (rand < 0 near root and tip); the slerp (1) extrapolates
 /// along the same great circle rather than clamping, so the variation stays
 /// symmetric about the fixed-offset curve.
 HP_FOLLOWER_KERNEL float variedWeight(float fixedOffset, float df, float random, float dv) {
@@ -72,7 +75,9 @@ HP_FOLLOWER_KERNEL float interpolationWeight(float d1, float d2) {
 // hashing instead of storing 23 floats per follower or carrying RNG state.
 
 /// MurmurHash3's 32-bit finaliser: a bijection with full avalanche.
-HP_FOLLOWER_KERNEL uint32_t mix32(uint32_t h) {
+/// U: uint32_t or a vector of them.
+template <typename U>
+HP_FOLLOWER_KERNEL U mix32(U h) {
     h ^= h >> 16;
     h *= 0x85ebca6bu;
     h ^= h >> 13;
@@ -86,54 +91,134 @@ HP_FOLLOWER_KERNEL uint32_t followerHash(uint32_t seed, uint32_t follower) {
     return mix32(seed * 0x9e3779b9u ^ mix32(follower + 0x7f4a7c15u));
 }
 
-/// rand_xy for segment y of the follower with hash `base`: in [-1, 1).
+/// The hash of segment y of the follower with hash `base`.
+template <typename U>
+HP_FOLLOWER_KERNEL U segmentHash(U base, U y) {
+    return mix32(base + y * 0x27d4eb2fu);
+}
+
+/// rand_xy for segment y of the follower with hash `base`: in [-1, 1)
+/// (the hash read as a signed integer, times 2^-31).
 HP_FOLLOWER_KERNEL float segmentRandom(uint32_t base, uint32_t y) {
-    const uint32_t h = mix32(base + y * 0x27d4eb2fu);
-    return float(int32_t(h)) * (1.f / 2147483648.f);
+    return float(int32_t(segmentHash(base, y))) * (1.f / 2147483648.f);
 }
 
 // ---------------------------------------------------------------------------
-// Slerp, branch-free (Eberly 2011, "A fast and accurate algorithm for
-// computing SLERP"): with x = cos θ >= 0,
-//   slerp(q0, q1, t) = c0 q0 + c1 q1,   c0 = s(1 - t), c1 = s(t),
-//   s(t) = sin(tθ) / sin θ = t Π_{i=1..8} (1 + (u_i t² - v_i)(x - 1)),
-//   u_i = 1 / (i (2i + 1)), v_i = i / (2i + 1), the last pair scaled by
-//   μ = 1.85298109 to absorb the truncated tail.
-// The products are the nested form of the power series of s in (x - 1). No
-// acos/sin: a few dozen multiply-adds that vectorize. Measured error of s
-// against double precision for t in [-1, 2]: 2.4e-7 for x >= 0.7 (guides
-// within 90° of each other), 1.2e-6 for x >= 0.5, 3e-5 at x = 0 (opposite
-// rotations); followers renormalise each direction, so lengths stay exact.
+/// A quaternion (w, x, y, z) in float, with the few operations the guide
+/// tables need written out (Eigen's double quaternions cost 3x as much here).
+struct Quat {
+    float w = 1.f, x = 0.f, y = 0.f, z = 0.f;
+};
 
-HP_FOLLOWER_KERNEL float slerpSeries(float t, float xm1) {
-    constexpr float mu = 1.85298109240830f;
-    constexpr float u[8] = {1.f / (1 * 3), 1.f / (2 * 5), 1.f / (3 * 7),  1.f / (4 * 9),
-                            1.f / (5 * 11), 1.f / (6 * 13), 1.f / (7 * 15), mu / (8 * 17)};
-    constexpr float v[8] = {1.f / 3, 2.f / 5, 3.f / 7, 4.f / 9, 5.f / 11, 6.f / 13, 7.f / 15, mu * 8 / 17};
-    const float t2 = t * t;
-    float b = 1.f;
-#pragma GCC unroll 8
-    for (int i = 7; i >= 0; --i) b = 1.f + (u[i] * t2 - v[i]) * xm1 * b;
-    return t * b;
+// ---------------------------------------------------------------------------
+// Slerp by its arc (per guide pair and segment, once per step) and a
+// polynomial sine and cosine (per follower and segment).
+//
+// With a, b unit quaternions, a · b = cos θ >= 0 (b negated otherwise: the
+// same rotation, the shorter arc), and e the unit quaternion orthogonal to a
+// in their plane, e = (b - (a · b) a) / |b - (a · b) a|:
+//   slerp(a, b, t) = cos(tθ) a + sin(tθ) e,                           (1)
+// for any t (outside [0, 1] it extrapolates along the same great circle).
+// θ and e depend on the two guides only, so a step computes them once per
+// guide pair and segment; a follower then needs one sine and one cosine of
+// φ = tθ. The templates below take float or an 8-lane vector
+// (sim/follower_simd.h) alike; the arithmetic is the same.
+// Error bound (tests/test_follower_kernels.cpp, 20k random pairs from equal
+// to opposite rotations, t in [-0.5, 1.5], against double precision):
+// |q - slerp| < 1e-6 (measured 3.4e-7) and the rotated direction of (2)
+// within 2e-6 (measured 7.6e-7); Eberly's series used before was 2.4e-7
+// only for cos θ >= 0.7 and 3e-5 toward opposite rotations. (sin, cos) stay
+// on the unit circle to 3e-7, so directions need no renormalisation.
+
+/// Polynomials for |x| <= π/2 (Chebyshev fits of (sin x / x - 1) / x² and
+/// (cos x - 1) / x², degree 9 and 10): absolute error < 3e-8 before float
+/// rounding; sin 0 = 0 and cos 0 = 1 exactly, so t = 0 gives guide 1's
+/// rotation bit for bit.
+template <typename T>
+HP_FOLLOWER_KERNEL void sinCos(T x, T& s, T& c) {
+    const T z = x * x;
+    const T ps = ((2.634756392e-6f * z - 1.982273949e-4f) * z + 8.333242135e-3f) * z - 1.666666596e-1f;
+    const T pc = (((-2.629751742e-7f * z + 2.477457975e-5f) * z - 1.388865165e-3f) * z + 4.166665936e-2f) * z -
+                 4.999999996e-1f;
+    s = x + (x * z) * ps;
+    c = 1.f + z * pc;
 }
 
-/// Coefficients (c0, c1) of slerp(q0, q1, t) = c0 q0 + c1 q1, given
-/// dot = q0 · q1. The shorter arc is taken: for dot < 0, c1 comes back negated
-/// (as if q1 were -q1, the same rotation).
-HP_FOLLOWER_KERNEL void slerpWeights(float dot, float t, float& c0, float& c1) {
-    const float sign = dot < 0.f ? -1.f : 1.f;
-    const float xm1 = dot * sign - 1.f;
-    c0 = slerpSeries(1.f - t, xm1);
-    c1 = slerpSeries(t, xm1) * sign;
+/// x - kπ for the nearest integer k, in [-π/2, π/2]; π in three parts
+/// (Cody-Waite) so kπ is exact for |k| < 2^15. For the rotations of (1) the
+/// sign change of (sin, cos) is immaterial: q and -q are the same rotation
+/// and everything below is quadratic in (sin, cos). |x| < 2^22 π.
+template <typename T>
+HP_FOLLOWER_KERNEL T reduceHalfTurns(T x) {
+    constexpr float kRound = 12582912.f;  // 1.5 · 2^23: adding it rounds to an integer
+    const T k = (x * 0.318309886f + kRound) - kRound;
+    return ((x - k * 3.140625f) - k * 9.67025756835937500e-4f) - k * 6.27711415e-7f;
+}
+
+/// atan2(y, x) for x, y >= 0, in [0, π/2]: reduced to |u| <= tan(π/8) by
+/// atan(n/m) = π/4 + atan((n - m)/(n + m)) and the complement π/2 - atan(m/n),
+/// then u + u³ P(u²) (Chebyshev fit, error < 4e-8). One division, no
+/// branches: per guide pair and segment in a loop the compiler vectorizes.
+HP_FOLLOWER_KERNEL float atan2Positive(float y, float x) {
+    const bool yBig = y > x;
+    const float n = yBig ? x : y, m = yBig ? y : x;  // n <= m
+    const bool half = n > 0.414213562f * m;
+    const float den = half ? n + m : m;
+    const float u = (half ? n - m : n) / (den > 0.f ? den : 1.f);  // x = y = 0: 0
+    const float z = u * u;
+    const float p = ((8.520492036e-2f * z - 1.402414284e-1f) * z + 1.999123774e-1f) * z - 3.333328656e-1f;
+    const float a = (u + (u * z) * p) + (half ? 0.785398163f : 0.f);
+    return yBig ? 1.570796327f - a : a;
+}
+
+/// The arc of slerp (1) from a to b: θ and e. With r = b - (a · b) a
+/// (b negated when a · b < 0), sin θ = |r|, cos θ = a · b, e = r / |r|,
+/// θ = atan2(|r|, a · b) (accurate for small θ, unlike acos). For |r| -> 0
+/// (equal rotations) e = 0, so every t gives a.
+HP_FOLLOWER_KERNEL void slerpArc(const Quat& a, Quat b, float& theta, Quat& e) {
+    float d = a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z;
+    const float sign = d < 0.f ? -1.f : 1.f;
+    d *= sign;
+    const float rw = b.w * sign - d * a.w, rx = b.x * sign - d * a.x;
+    const float ry = b.y * sign - d * a.y, rz = b.z * sign - d * a.z;
+    const float sinTheta = std::sqrt(rw * rw + rx * rx + ry * ry + rz * rz);
+    // Divide unconditionally, then select: a division under a condition
+    // could trap, and the compiler would not vectorize the loop around it.
+    const float reciprocal = 1.f / std::max(sinTheta, 1e-20f);
+    const float inv = sinTheta > 1e-20f ? reciprocal : 0.f;
+    e = {rw * inv, rx * inv, ry * inv, rz * inv};
+    theta = atan2Positive(sinTheta, d);
+}
+
+/// q v q* for any quaternion q = (w, u) (unit or not):
+///   (w² - u·u) v + 2 (u·v) u + 2 w (u × v)   (scaled by |q|² for non-unit q).
+HP_FOLLOWER_KERNEL Eigen::Vector3f sandwich(const Quat& q, const Eigen::Vector3f& v) {
+    const Eigen::Vector3f u(q.x, q.y, q.z);
+    return (q.w * q.w - u.dot(u)) * v + (2.f * u.dot(v)) * u + (2.f * q.w) * u.cross(v);
+}
+
+/// Rest direction f turned by slerp (1), as a function of φ = tθ: with
+/// q = c a + s e (c = cos φ, s = sin φ), q f q* is quadratic in (c, s):
+///   q f q* = c² A + s² B + cs D,  A = a f a*,  B = e f e*,
+///   D = a f e* + e f a* = (a + e) f (a + e)* - A - B.
+/// With c² = 1 - s²:   q f q* = A + s² (B - A) + cs D.                (2)
+/// Outputs A, B - A and D; a follower then needs 8 multiply-adds per
+/// segment instead of a quaternion blend and rotation.
+HP_FOLLOWER_KERNEL void slerpedDirection(const Quat& a, const Quat& e, const Eigen::Vector3f& f, Eigen::Vector3f& A,
+                                         Eigen::Vector3f& BminusA, Eigen::Vector3f& D) {
+    A = sandwich(a, f);
+    const Eigen::Vector3f B = sandwich(e, f);
+    D = sandwich({a.w + e.w, a.x + e.x, a.y + e.y, a.z + e.z}, f) - A - B;
+    BminusA = B - A;
 }
 
 /// Rotates v by the unit quaternion (w, x, y, z):
 ///   v' = v + w τ + u × τ,   τ = 2 u × v,   u = (x, y, z).
-HP_FOLLOWER_KERNEL void rotate(float w, float x, float y, float z, float vx, float vy, float vz, float& ox, float& oy,
-                   float& oz) {
-    const float tx = 2.f * (y * vz - z * vy);
-    const float ty = 2.f * (z * vx - x * vz);
-    const float tz = 2.f * (x * vy - y * vx);
+template <typename T>
+HP_FOLLOWER_KERNEL void rotate(T w, T x, T y, T z, T vx, T vy, T vz, T& ox, T& oy, T& oz) {
+    const T tx = 2.f * (y * vz - z * vy);
+    const T ty = 2.f * (z * vx - x * vz);
+    const T tz = 2.f * (x * vy - y * vx);
     ox = vx + w * tx + (y * tz - z * ty);
     oy = vy + w * ty + (z * tx - x * tz);
     oz = vz + w * tz + (x * ty - y * tx);
@@ -141,12 +226,6 @@ HP_FOLLOWER_KERNEL void rotate(float w, float x, float y, float z, float vx, flo
 
 // ---------------------------------------------------------------------------
 // Segment rotations of a guide (per guide and step, a few hundred flops).
-
-/// A quaternion (w, x, y, z) in float, with the few operations the guide
-/// tables need written out (Eigen's double quaternions cost 3x as much here).
-struct Quat {
-    float w = 1.f, x = 0.f, y = 0.f, z = 0.f;
-};
 
 /// Hamilton product a b (apply b, then a).
 HP_FOLLOWER_KERNEL Quat operator*(const Quat& a, const Quat& b) {

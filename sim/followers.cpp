@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <unordered_map>
 
 namespace hp {
 
@@ -85,6 +86,50 @@ void checkShape(const RestShapes& shapes, size_t i, const char* what) {
 template <typename T>
 T perFollower(const std::vector<T>& values, size_t i) { return values.size() == 1 ? values[0] : values[i]; }
 
+/// Cuts each class's followers, in index order, into packets of 8; fills
+/// the lanes' fields and own rest segments. Unused lanes of a class's last
+/// packet repeat its last follower.
+void buildPackets(Followers::Impl& im, const std::vector<size_t>& ownStart, const std::vector<float>& ownRows) {
+    constexpr int L = FollowerPacket::kLanes;
+    const bool own = !ownRows.empty();
+    size_t ownTotal = 0;
+    for (uint32_t cls = 0; cls < im.classes.size(); ++cls) {
+        std::vector<uint32_t> members;
+        for (uint32_t f = 0; f < im.followers; ++f)
+            if (im.classOf[f] == cls) members.push_back(f);
+        const uint32_t P = im.classes[cls].pad;
+        for (size_t i = 0; i < members.size(); i += L) {
+            const size_t n = std::min(members.size() - i, size_t(L));
+            FollowerPacket pk;
+            pk.count = uint32_t(n);
+            pk.cls = cls;
+            pk.own = uint32_t(ownTotal);
+            for (int k = 0; k < L; ++k) {
+                const uint32_t f = members[i + std::min(size_t(k), n - 1)];
+                pk.follower[k] = f;
+                pk.guide1[k] = im.neighbours[f].guide1;
+                pk.pair[k] = im.pairOf[f];
+                pk.vertexOffset[k] = im.vertexOffset[f];
+                pk.alignC[k] = im.alignC[f];
+                pk.alignS[k] = im.alignS[f];
+                pk.scale[k] = own ? 1.f : im.segmentLength[f];
+                pk.weight[k] = im.weight[f];
+                pk.hash[k] = follower::followerHash(im.settings.seed, f);
+            }
+            if (own) {
+                im.ownRestData.resize(ownTotal + size_t(P) * 3 * L);
+                for (int k = 0; k < L; ++k)
+                    for (uint32_t j = 0; j < P; ++j)
+                        for (int c = 0; c < 3; ++c)
+                            im.ownRestData[ownTotal + (size_t(j) * 3 + c) * L + k] = ownRows[ownStart[pk.follower[k]] + c * P + j];
+                ownTotal += size_t(P) * 3 * L;
+                if (ownTotal > 0xffffffffu) throw Error("followers: too many follower rest vertices");
+            }
+            im.packets.push_back(pk);
+        }
+    }
+}
+
 }  // namespace
 
 Followers::Followers(const FollowerGroom& groom, const FollowerSettings& settings) : impl_(std::make_unique<Impl>()) {
@@ -151,7 +196,7 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
             if (im.classes.size() == 255) throw Error("followers: more than 255 distinct follower vertex counts");
             FollowerClass c;
             c.segments = s;
-            c.pad = padTo8(s);
+            c.pad = padTo8(s + 1);  // slot 0 is the root (FollowerClass)
             im.classes.push_back(std::move(c));
             it = im.classes.end() - 1;
         }
@@ -160,22 +205,24 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
     for (FollowerClass& c : im.classes) {
         const uint32_t P = c.pad;
         c.hot.assign(G * FollowerClass::kHot * P, 0.f);
-        c.cold.assign(G * (c.segments + 1) * FollowerClass::kCold, 0.f);
+        c.cold.assign(G * FollowerClass::kCold * P, 0.f);
         for (size_t g = 0; g < G; ++g) {
+            // Identity rotations and zero rest directions at the root slot and
+            // in the padding: those slots add nothing to the positions.
             float* row = c.hot.data() + g * FollowerClass::kHot * P;
             const uint32_t gs = im.guideSegmentOffsets[g + 1] - im.guideSegmentOffsets[g];
-            for (uint32_t y = 0; y < P; ++y) {
-                row[0 * P + y] = 1.f;  // identity rotation in the padding
-                const bool real = y < c.segments;
-                const Vec3f r = real ? im.guideRestDirs[im.guideSegmentOffsets[g] + FollowerClass::guideSegment(y, c.segments, gs)]
-                                     : Vec3f::UnitY();
-                row[5 * P + y] = r.x();
-                row[6 * P + y] = r.y();
-                row[7 * P + y] = r.z();
+            for (uint32_t j = 0; j < P; ++j) {
+                row[0 * P + j] = 1.f;
+                if (j < 1 || j > c.segments) continue;
+                const Vec3f r = im.guideRestDirs[im.guideSegmentOffsets[g] + FollowerClass::guideSegment(j - 1, c.segments, gs)];
+                row[5 * P + j] = r.x();
+                row[6 * P + j] = r.y();
+                row[7 * P + j] = r.z();
             }
         }
-        c.df.resize(P);
-        for (uint32_t y = 0; y < P; ++y) c.df[y] = follower::fixedOffsetCurve(float(y), float(c.segments));
+        c.weightedCurve.assign(P, 0.f);
+        for (uint32_t j = 1; j <= c.segments; ++j)
+            c.weightedCurve[j] = settings.fixedOffset * follower::fixedOffsetCurve(float(j - 1), float(c.segments));
         c.radii.resize(c.segments + 1);
         for (uint32_t v = 0; v <= c.segments; ++v)
             c.radii[v] = taperedRadius(settings.rootRadius, settings.tipRadius, float(v) / float(c.segments));
@@ -192,21 +239,17 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
     im.weight.resize(F);
     im.alignC.resize(F);
     im.alignS.resize(F);
-    im.twistC.resize(F);
-    im.twistS.resize(F);
     im.segmentLength.assign(F, 0.f);
-    im.ownRest.assign(F, Impl::kNone);
     im.vertexOffset.resize(F + 1);
     im.vertexOffset[0] = 0;
     for (size_t f = 0; f < F; ++f) im.vertexOffset[f + 1] = im.vertexOffset[f] + followerSegments(f) + 1;
+    // Own rest segments per follower (3 rows of P slots), moved into the
+    // packets' lane layout once those are formed.
+    std::vector<size_t> ownStart(own ? F + 1 : 0);
+    std::vector<float> ownRows;
     if (own) {
-        size_t total = 0;
-        for (size_t f = 0; f < F; ++f) {
-            im.ownRest[f] = uint32_t(total);
-            total += 4 * size_t(im.classes[im.classOf[f]].pad);
-        }
-        if (total > 0xffffffffu) throw Error("followers: too many follower rest vertices");
-        im.ownRestData.assign(total, 0.f);
+        for (size_t f = 0; f < F; ++f) ownStart[f + 1] = ownStart[f] + 3 * size_t(im.classes[im.classOf[f]].pad);
+        ownRows.assign(ownStart[F], 0.f);
     }
 
     // Mean squared difference of unit rest directions, `b` carried into `a`'s
@@ -284,27 +327,18 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
             const double phiF = twistAngle(guideFrames[g1], Rf);
             im.alignC[f] = float(std::cos(phiF));
             im.alignS[f] = float(std::sin(phiF));
-            const double phiK = twistAngle(guideFrames[g2], guideFrames[g1]);
-            im.twistC[f] = float(std::cos(phiK));
-            im.twistS[f] = float(std::sin(phiK));
 
             const FollowerClass& c = im.classes[im.classOf[f]];
             if (own) {
-                // Rest directions in the effective frame: f' = R_y(φ)ᵀ f.
-                float* out = im.ownRestData.data() + im.ownRest[f];
+                // Rest segments (direction × length) in the effective frame:
+                // f' = R_y(φ)ᵀ f, slot y + 1 for segment y.
+                float* out = ownRows.data() + ownStart[f];
                 const uint32_t a = groom.followerShapes.offsets[f];
-                for (uint32_t y = 0; y < c.pad; ++y) {
-                    Vec3d d = Vec3d::UnitY();
-                    double len = 0.0;
-                    if (y < segs) {
-                        d = (groom.followerShapes.points[a + y + 1] - groom.followerShapes.points[a + y]).cast<double>();
-                        len = d.norm();
-                        d = rotateY(-phiF, d / len);
-                    }
-                    out[0 * c.pad + y] = float(d.x());
-                    out[1 * c.pad + y] = float(d.y());
-                    out[2 * c.pad + y] = float(d.z());
-                    out[3 * c.pad + y] = float(len);
+                for (uint32_t y = 0; y < segs; ++y) {
+                    const Vec3d d = (groom.followerShapes.points[a + y + 1] - groom.followerShapes.points[a + y]).cast<double>();
+                    const double len = d.norm();
+                    const Vec3d r = len * rotateY(-phiF, d / len);
+                    for (int i = 0; i < 3; ++i) out[i * c.pad + y + 1] = float(r[i]);
                 }
             } else {
                 im.segmentLength[f] = perFollower(groom.followerLengths, f) / float(segs);
@@ -312,16 +346,31 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
         }
     });
 
+    // --- Guide pairs: the pair tables are per (guide 1, guide 2) and class,
+    // numbered in follower order (deterministic). Cluster mode reads guide 1 only.
+    im.pairOf.resize(F);
+    {
+        std::vector<std::unordered_map<uint64_t, uint32_t>> index(im.classes.size());
+        for (size_t f = 0; f < F; ++f) {
+            FollowerClass& c = im.classes[im.classOf[f]];
+            const uint32_t g1 = im.neighbours[f].guide1;
+            const uint32_t g2 = settings.mode == FollowerMode::Cluster ? g1 : im.neighbours[f].guide2;
+            const auto [it, added] = index[im.classOf[f]].emplace(uint64_t(g1) << 32 | g2, uint32_t(c.pairs.size()));
+            if (added) {
+                const double phiK = twistAngle(guideFrames[g2], guideFrames[g1]);
+                c.pairs.push_back({g1, g2, float(std::cos(phiK)), float(std::sin(phiK))});
+            }
+            im.pairOf[f] = it->second;
+        }
+        for (FollowerClass& c : im.classes) {
+            c.pairRecords.assign(c.pairs.size() * c.pad * FollowerClass::kRecord, 0.f);
+            c.guideRecords.assign(G * c.pad * FollowerClass::kRecord, 0.f);
+        }
+    }
+
     im.ids.resize(F);
     for (size_t f = 0; f < F; ++f) im.ids[f] = groom.followerIds.empty() ? uint32_t(G + f) : groom.followerIds[f];
-    im.order.resize(F);
-    std::iota(im.order.begin(), im.order.end(), 0u);
-    // Followers are processed in index order: their roots, per-follower
-    // tables and output vertices then stream through memory (sorting by guide
-    // made every one of those a cache miss, 4x slower at 100k followers).
-    // Only distinct vertex counts are grouped, keeping each range's loop uniform.
-    std::stable_sort(im.order.begin(), im.order.end(),
-                     [&](uint32_t a, uint32_t b) { return im.classOf[a] < im.classOf[b]; });
+    buildPackets(im, ownStart, ownRows);
 }
 
 Followers::~Followers() = default;

@@ -163,7 +163,9 @@ class Followers {
     /// sizes disagree with the groom or a guide vertex is not finite.
     ///
     /// Runs on TBB's threads (settings.parallel); results are the same bits
-    /// for any thread count. One update at a time per Followers object. To
+    /// for any thread count on one machine (an AVX2 + FMA machine and an
+    /// older x86-64 one round differently, see sim/follower_step.cpp). One
+    /// update at a time per Followers object. To
     /// keep the per-step cost to the followers themselves, a guide solver
     /// writing into `out` in place should overwrite the guide block rather
     /// than clear() the frame (which forces the layout to be rewritten and

@@ -1,6 +1,6 @@
-// Follower strands (sim/followers.h): kernels, neighbour selection, the three
-// modes against shapes computed independently, thread independence, lengths,
-// velocities and head collision.
+// Follower strands (sim/followers.h): neighbour selection, the three modes
+// against shapes computed independently, thread and lane independence,
+// lengths, velocities and head collision (kernels: test_follower_kernels.cpp).
 #include "core/errors.h"
 #include "pipeline/follower_settings.h"
 #include "sim/follower_kernels.h"
@@ -96,80 +96,6 @@ std::vector<Vec3f> bentShape(const SurfaceFrame& g, int vertices) {
 }
 
 }  // namespace
-
-// ---------------------------------------------------------------------------
-// Kernels
-
-TEST(FollowerKernels, FixedOffsetIsZeroAtRootAndTipAndOneInTheMiddle) {
-    // The seed: 23 segments, qs = 23 / 2 = 11 in integer arithmetic = (23 - 1) / 2.
-    EXPECT_EQ(follower::fixedOffsetCurve(0, 23), 0.f);
-    EXPECT_EQ(follower::fixedOffsetCurve(22, 23), 0.f);  // y = 2 qs, the tip segment
-    EXPECT_EQ(follower::fixedOffsetCurve(11, 23), 1.f);
-    for (int y = 0; y < 23; ++y) {
-        EXPECT_FLOAT_EQ(follower::fixedOffsetCurve(float(y), 23), follower::fixedOffsetCurve(float(22 - y), 23));
-        if (y < 11) {
-            EXPECT_LT(follower::fixedOffsetCurve(float(y), 23), follower::fixedOffsetCurve(float(y + 1), 23));
-        }
-    }
-    // Even counts stay symmetric: 0 at both ends, the two middle segments equal and maximal.
-    EXPECT_EQ(follower::fixedOffsetCurve(0, 24), 0.f);
-    EXPECT_EQ(follower::fixedOffsetCurve(23, 24), 0.f);
-    EXPECT_FLOAT_EQ(follower::fixedOffsetCurve(11, 24), follower::fixedOffsetCurve(12, 24));
-    EXPECT_GT(follower::fixedOffsetCurve(11, 24), follower::fixedOffsetCurve(10, 24));
-    EXPECT_EQ(follower::fixedOffsetCurve(0, 1), 0.f);
-}
-
-TEST(FollowerKernels, SlerpSeriesMatchesExactSlerp) {
-    std::mt19937 rng(7);
-    std::normal_distribution<double> n;
-    std::uniform_real_distribution<double> ut(-0.5, 1.5);
-    double worst = 0, worstNear = 0;
-    for (int i = 0; i < 20000; ++i) {
-        Eigen::Quaterniond a(n(rng), n(rng), n(rng), n(rng)), b(n(rng), n(rng), n(rng), n(rng));
-        a.normalize();
-        b.normalize();
-        if (i % 2) b = Eigen::Quaterniond(a.coeffs() + 0.3 * b.coeffs()).normalized();  // nearby pairs
-        const double t = ut(rng);
-        // Exact slerp along the shorter arc, extrapolating outside [0, 1].
-        double d = a.dot(b);
-        Eigen::Vector4d bc = b.coeffs();
-        if (d < 0) { d = -d; bc = -bc; }
-        const double th = std::acos(std::min(1.0, d));
-        const Eigen::Vector4d exact = th < 1e-9 ? Eigen::Vector4d(a.coeffs())
-                                                : Eigen::Vector4d((std::sin((1 - t) * th) * a.coeffs() + std::sin(t * th) * bc) / std::sin(th));
-        float c0, c1;
-        follower::slerpWeights(float(a.dot(b)), float(t), c0, c1);
-        const Eigen::Vector4d got = double(c0) * a.coeffs().cast<float>().cast<double>() + double(c1) * b.coeffs().cast<float>().cast<double>();
-        const double err = (got - exact).norm();
-        worst = std::max(worst, err);
-        if (d >= 0.7) worstNear = std::max(worstNear, err);
-    }
-    EXPECT_LT(worst, 1e-4);
-    EXPECT_LT(worstNear, 2e-6);
-}
-
-TEST(FollowerKernels, SegmentRandomIsFixedUniformAndDecorrelated) {
-    const uint32_t a = follower::followerHash(1, 10), b = follower::followerHash(2, 10), c = follower::followerHash(1, 11);
-    double sum = 0, sum2 = 0;
-    int differ = 0;
-    float lo = 1, hi = -1;
-    for (uint32_t y = 0; y < 20000; ++y) {
-        const float r = follower::segmentRandom(a, y);
-        EXPECT_EQ(r, follower::segmentRandom(follower::followerHash(1, 10), y));
-        lo = std::min(lo, r);
-        hi = std::max(hi, r);
-        sum += r;
-        sum2 += r * r;
-        differ += r != follower::segmentRandom(b, y) && r != follower::segmentRandom(c, y);
-    }
-    EXPECT_GE(lo, -1.f);
-    EXPECT_LT(hi, 1.f);
-    EXPECT_LT(lo, -0.99f);
-    EXPECT_GT(hi, 0.99f);
-    EXPECT_NEAR(sum / 20000, 0.0, 0.02);
-    EXPECT_NEAR(sum2 / 20000, 1.0 / 3.0, 0.02);  // uniform on [-1, 1]
-    EXPECT_GT(differ, 19990);
-}
 
 // ---------------------------------------------------------------------------
 // Neighbours
@@ -512,6 +438,40 @@ TEST(Followers, SameBitsOnOneAndTwoThreadsAndSerial) {
         EXPECT_EQ(std::memcmp(one.first.positions.data(), serial.first.positions.data(), bytes), 0);
         EXPECT_EQ(one.second, two.second);
         EXPECT_NO_THROW(two.first.validate());
+    }
+}
+
+TEST(Followers, AFollowerDoesNotDependOnItsPacketMates) {
+    // Followers run 8 to a vector (lanes); dropping the first follower moves
+    // every other one to another lane and packet. In interpolate and cluster
+    // modes (rand_xy hashes the follower index) the strands stay the same bits.
+    SphereGroomSettings s;
+    s.guides = 94;
+    s.followers = 1003;  // not a multiple of 8: a partial last packet either way
+    const FollowerGroom all = makeSphereGroom(s);
+    FollowerGroom rest = all;
+    rest.followerRoots.erase(rest.followerRoots.begin());
+    const SyntheticGuides motion(all, {});
+    StrandFrame guides;
+    std::vector<SurfaceFrame> guideRoots, rootsAll, rootsRest;
+    motion.sample(0.7, guides, guideRoots);
+    rotateRoots(all.followerRoots, motion.headRotation(0.7), rootsAll);
+    rootsRest.assign(rootsAll.begin() + 1, rootsAll.end());
+    const SphereCollider head(Vec3f::Zero(), 0.1f);
+    for (FollowerMode mode : {FollowerMode::Interpolate, FollowerMode::Cluster}) {
+        FollowerSettings settings;
+        settings.mode = mode;
+        Followers a(all, settings), b(rest, settings);
+        StrandFrame outA, outB;
+        const FollowerStats sa = a.update({guides, guideRoots, rootsAll, &head}, outA);
+        b.update({guides, guideRoots, rootsRest, &head}, outB);
+        EXPECT_GT(sa.projected, 0u) << "the collision path is exercised";
+        const size_t G = guides.strandCount();
+        for (size_t f = 1; f < all.followerRoots.size(); ++f) {
+            const auto pa = strandOf(outA, G + f), pb = strandOf(outB, G + f - 1);
+            ASSERT_EQ(pa.size(), pb.size());
+            ASSERT_EQ(std::memcmp(pa.data(), pb.data(), pa.size() * sizeof(Vec3f)), 0) << "follower " << f;
+        }
     }
 }
 
