@@ -18,6 +18,7 @@ namespace hp {
 const std::vector<CommandSpec>& commands() {
     static const std::vector<CommandSpec> list = {
         runCommandSpec(),
+        simCommandSpec(),
         renderCommandSpec(),
         compareCommandSpec(),
         viewCommandSpec(),
@@ -73,8 +74,9 @@ CommandContext::~CommandContext() = default;
 
 int runShotCommand(const CommandContext& ctx, const std::set<std::string>& only) {
     const auto start = std::chrono::steady_clock::now();
-    const ShotSettings shot = resolveShot(ctx.scene, ctx.options);
+    ShotSettings shot = resolveShot(ctx.scene, ctx.options);
     std::vector<StagePtr> stages = makeStages(ctx.scene, shot, only);
+    for (const StagePtr& s : stages) shot.writesCache |= s->name() == "sim";
     std::string names;
     for (const StagePtr& s : stages) names += (names.empty() ? "" : ", ") + s->name();
     logInfo("hairpipe: ", ctx.scene.name(), ": frames ", formatFrameRange(shot.frames), " -> ",

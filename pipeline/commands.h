@@ -11,6 +11,7 @@ namespace hp {
 
 CommandSpec runCommandSpec();
 CommandSpec renderCommandSpec();
+CommandSpec simCommandSpec();
 CommandSpec vdbCommandSpec();
 CommandSpec validateCommandSpec();
 CommandSpec infoCommandSpec();

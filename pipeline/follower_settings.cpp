@@ -14,6 +14,9 @@ FollowerSettings followerSettings(const Scene& s) {
     f.maxVelocity = float(s.number("hair.followers.max_velocity"));
     f.collide = s.flag("hair.followers.collide");
     f.seed = uint32_t(s.integer("seed"));
+    // Followers taper like the guides (hair.radius.*; the curly model has its own).
+    f.rootRadius = float(s.number("hair.radius.root"));
+    f.tipRadius = float(s.number("hair.radius.tip"));
     return f;
 }
 

@@ -9,13 +9,15 @@ void addSceneKeys(SchemaBuilder& b) {
     addHeadKeys(b);
     addHairKeys(b);
     addFollowerKeys(b);
+    addSimKeys(b);
     addCurlyKeys(b);
+    addCacheKeys(b);
     addRenderKeys(b);
     addPreviewKeys(b);
     addReferenceKeys(b);
     addVdbKeys(b);
     addCompareKeys(b);
-    addSimKeys(b);
+    addStageFrameKeys(b);
 }
 
 void addShotKeys(SchemaBuilder& b) {

@@ -40,7 +40,9 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
         // costs no simulation or head evaluation when the source allows it.
         std::vector<FrameStage*> todo;
         for (StagePtr& stage : stages) {
-            if (!shot.force && allExist(stage->outputs(frame))) {
+            const std::vector<std::filesystem::path> outputs = stage->outputs(frame);
+            if (outputs.empty()) continue;  // the stage skips this frame (its <stage>.frames)
+            if (!shot.force && allExist(outputs)) {
                 ++report.outputsSkipped;
                 logVerbose("frame ", frame, " ", stage->name(), ": outputs exist, skipped");
             } else {

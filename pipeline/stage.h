@@ -18,6 +18,7 @@
 namespace hp {
 
 class Scene;
+struct SimFrameStats;
 
 /// What the stages of one frame read. Pointers are null for parts the shot
 /// does not have (e.g. no head, no hair).
@@ -26,6 +27,9 @@ struct FrameData {
     double time = 0.0;  ///< seconds: frame / fps
     const HeadPose* head = nullptr;
     const StrandFrame* strands = nullptr;
+    /// Set when the strands were simulated for this frame (not read from the
+    /// strand cache): what the simulation measured.
+    const SimFrameStats* simulation = nullptr;
 };
 
 /// Settings fixed for a whole run: resolved from the scene and the command line.
@@ -35,6 +39,9 @@ struct ShotSettings {
     double fps = 24.0;
     long seed = 1;
     bool force = false;               ///< rewrite existing outputs
+    /// The run writes the strand cache (the "sim" stage runs), so the
+    /// simulation also writes its checkpoints for resuming.
+    bool writesCache = false;
 };
 
 class FrameSource {

@@ -1,6 +1,9 @@
 #include "pipeline/stages.h"
 
+#include <algorithm>
+
 #include "pipeline/head_setup.h"
+#include "pipeline/hair_source.h"
 #include "pipeline/head_source.h"
 
 namespace hp {
@@ -23,9 +26,38 @@ class TimeOnlySource final : public FrameSource {
     double fps_;
 };
 
+/// Runs a stage only on the frames of its `<stage>.frames` key (say, a
+/// reference every 12th frame): other frames have no outputs for it.
+class FrameSubset final : public FrameStage {
+  public:
+    FrameSubset(StagePtr stage, std::vector<int> frames) : stage_(std::move(stage)), frames_(std::move(frames)) {}
+    std::string name() const override { return stage_->name(); }
+    std::vector<std::filesystem::path> outputs(int frame) const override {
+        return selected(frame) ? stage_->outputs(frame) : std::vector<std::filesystem::path>{};
+    }
+    bool needsFrameData() const override { return stage_->needsFrameData(); }
+    void run(const FrameData& data) override {
+        if (selected(data.frame)) stage_->run(data);
+    }
+    void finish(const ShotSettings& shot) override { stage_->finish(shot); }
+
+  private:
+    bool selected(int frame) const { return std::binary_search(frames_.begin(), frames_.end(), frame); }
+    StagePtr stage_;
+    std::vector<int> frames_;
+};
+
+StagePtr withFrameSubset(StagePtr stage, const Scene& scene) {
+    if (!stage) return stage;
+    const std::string key = stage->name() + ".frames";
+    if (!scene.has(key)) return stage;
+    return std::make_unique<FrameSubset>(std::move(stage), scene.frames(key));
+}
+
 }  // namespace
 
 std::unique_ptr<FrameSource> makeFrameSource(const Scene& scene, const ShotSettings& shot) {
+    if (sceneHasHair(scene)) return makeHairFrameSource(scene, shot);
     if (sceneHasHead(scene)) return makeHeadFrameSource(loadHead(scene).motion, shot.fps);
     return std::make_unique<TimeOnlySource>(shot.fps);
 }
@@ -33,8 +65,10 @@ std::unique_ptr<FrameSource> makeFrameSource(const Scene& scene, const ShotSetti
 std::vector<StagePtr> makeStages(const Scene& scene, const ShotSettings& shot, const std::set<std::string>& only) {
     std::vector<StagePtr> stages;
     auto add = [&](StagePtr stage) {
-        if (stage && (only.empty() || only.count(stage->name()))) stages.push_back(std::move(stage));
+        if (stage && (only.empty() || only.count(stage->name())))
+            stages.push_back(withFrameSubset(std::move(stage), scene));
     };
+    add(makeSimStage(scene, shot));  // first: the strand cache of the frame
     add(makePreviewStage(scene, shot));
     add(makeReferenceStage(scene, shot));
     add(makeVdbStage(scene, shot));

@@ -8,6 +8,8 @@
 namespace hp {
 
 /// compare.*: preview vs reference metrics, difference images and report (stage_compare.cpp).
+/// "sim": the strand cache, statistics and USD export of each frame (stage_sim.cpp).
+StagePtr makeSimStage(const Scene& scene, const ShotSettings& shot);
 StagePtr makeCompareStage(const Scene& scene, const ShotSettings& shot);
 /// The GL preview (stage_preview.cpp); null unless preview.enabled.
 StagePtr makePreviewStage(const Scene& scene, const ShotSettings& shot);

@@ -2,6 +2,7 @@
 // substeps, teleports), parallelism over Bullet worlds, statistics, output.
 // The Bullet side is sim/curly_world.cpp.
 #include "sim/curly_wet.h"
+#include "sim/state_blob.h"
 
 #include "core/errors.h"
 #include "sim/curly_state.h"
@@ -443,6 +444,40 @@ void CurlyWetSolver::write(StrandFrame& frame, double time) const {
 }
 
 double CurlyWetSolver::time() const { return impl_->time; }
+double CurlyWetSolver::nextTime() const { return impl_->time + impl_->set.settings.timeStep; }
+
+std::vector<char> CurlyWetSolver::saveState() const {
+    const Impl& m = *impl_;
+    const CurlySet& set = m.set;
+    BlobWriter w;
+    w.put(m.time);
+    w.put(m.prevTime);
+    w.put(m.headTransform.matrix());
+    for (const auto* a : {&set.x, &set.v, &set.xPrev, &set.vPrev, &set.rootPos0, &set.rootPos1}) w.array(*a);
+    w.array(set.rootRot0);
+    w.array(set.rootRot1);
+    w.array(set.sigma);
+    return std::move(w.data);
+}
+
+void CurlyWetSolver::restoreState(const std::vector<char>& state) {
+    Impl& m = *impl_;
+    CurlySet& set = m.set;
+    if (!m.initialized) throw Error("curly/wet solver: restoreState() before initialize()");
+    BlobReader r(state, "curly/wet solver");
+    m.time = r.get<double>();
+    m.prevTime = r.get<double>();
+    m.headTransform.matrix() = r.get<Eigen::Matrix4f>();
+    const size_t particles = set.count * size_t(set.n);
+    for (auto* a : {&set.x, &set.v, &set.xPrev, &set.vPrev}) r.array(*a, particles);
+    r.array(set.rootPos0, set.count);
+    r.array(set.rootPos1, set.count);
+    r.array(set.rootRot0, set.count);
+    r.array(set.rootRot1, set.count);
+    r.array(set.sigma, particles);
+    r.finish();
+    m.updateWet();
+}
 size_t CurlyWetSolver::guideCount() const { return impl_->set.count; }
 int CurlyWetSolver::particlesPerGuide() const { return impl_->set.n; }
 const CurlyWetSettings& CurlyWetSolver::settings() const { return impl_->set.settings; }

@@ -160,8 +160,18 @@ class CurlyWetSolver {
     void write(StrandFrame& frame, double time) const;
 
     double time() const;
+    /// End time of the next step.
+    double nextTime() const;
     size_t guideCount() const;
     int particlesPerGuide() const;
+
+    /// The dynamic state (positions, velocities, saturation, root targets,
+    /// time) as bytes, for checkpoints; restoreState() puts it back into a
+    /// solver initialised identically, which then continues bit for bit like
+    /// the one that saved it (a particle's whole Bullet state is its position
+    /// and velocity, reloaded every step).
+    std::vector<char> saveState() const;
+    void restoreState(const std::vector<char>& state);
     const CurlyWetSettings& settings() const;
     /// Statistics of the last step (all zero before the first).
     const CurlyWetStats& lastStats() const;

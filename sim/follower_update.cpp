@@ -221,3 +221,22 @@ FollowerStats Followers::update(const FollowerStep& step, StrandFrame& out) {
 }
 
 }  // namespace hp
+
+namespace hp {
+
+void Followers::adoptPrevious(const StrandFrame& out) {
+    Impl& im = *impl_;
+    const size_t G = im.guides, F = im.followers;
+    if (out.guideCount != G || out.strandCount() != G + F)
+        throw Error(cat("followers: the frame to adopt has ", out.guideCount, " guides and ", out.strandCount(),
+                        " strands; the groom has ", G, " guides and ", G + F, " strands"));
+    const uint32_t guideVertices = out.offsets[G];
+    const size_t total = size_t(guideVertices) + im.vertexOffset[F];
+    if (out.positions.size() != total || out.velocities.size() != total ||
+        !sameRange(out.offsets, G, im.vertexOffset, 0, F + 1, guideVertices) || !sameRange(out.ids, G, im.ids, 0, F))
+        throw Error("followers: the frame to adopt does not have this groom's follower layout");
+    im.lastPositions = out.positions.data();
+    im.lastVertexCount = total;
+}
+
+}  // namespace hp

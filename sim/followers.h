@@ -172,6 +172,13 @@ class Followers {
     /// loses the previous positions the velocities need).
     FollowerStats update(const FollowerStep& step, StrandFrame& out);
 
+    /// Declares that `out` holds this object's previous output (e.g. read
+    /// back from the strand cache when a simulation resumes), so the next
+    /// update() takes finite-difference velocities from it, exactly as if
+    /// update() had written it. Throws hp::Error when its layout does not
+    /// match the groom.
+    void adoptPrevious(const StrandFrame& out);
+
     size_t guideCount() const;
     size_t followerCount() const;
     const FollowerSettings& settings() const;

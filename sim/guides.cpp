@@ -2,6 +2,7 @@
 // contacts), parallelism over Bullet worlds, statistics. The Bullet side of
 // each formulation is in sim/rope_group.cpp and sim/rigid_group.cpp.
 #include "sim/guides.h"
+#include "sim/state_blob.h"
 
 #include "core/errors.h"
 #include "sim/guide_group.h"
@@ -418,6 +419,57 @@ void GuideSolver::write(StrandFrame& frame, double time) const {
         frame.addStrand(uint32_t(g), x.data(), r.data(), x.size(), v.data());
     }
     frame.guideCount = uint32_t(set.count);
+}
+
+std::vector<char> GuideSolver::saveState() const {
+    const Impl& m = *impl_;
+    const GuideSet& set = m.set;
+    if (set.settings.formulation != GuideFormulation::Rope)
+        throw Error("guide solver: checkpoints need the rope formulation (the rigid one keeps state inside Bullet)");
+    BlobWriter w;
+    w.put(m.time);
+    w.put(m.prevTime);
+    w.put(m.startTime);
+    w.put(m.steps);
+    w.put(m.headTransform.matrix());
+    w.put(set.headTransform.matrix());
+    w.array(set.x);
+    w.array(set.v);
+    w.array(set.xPrev);
+    w.array(set.vPrev);
+    w.array(set.rootPos0);
+    w.array(set.rootPos1);
+    w.array(set.rootRot0);
+    w.array(set.rootRot1);
+    return std::move(w.data);
+}
+
+void GuideSolver::restoreState(const std::vector<char>& state) {
+    Impl& m = *impl_;
+    GuideSet& set = m.set;
+    if (!m.initialized) throw Error("guide solver: restoreState() before initialize()");
+    if (set.settings.formulation != GuideFormulation::Rope)
+        throw Error("guide solver: checkpoints need the rope formulation");
+    BlobReader r(state, "guide solver");
+    m.time = r.get<double>();
+    m.prevTime = r.get<double>();
+    m.startTime = r.get<double>();
+    m.steps = r.get<long>();
+    m.headTransform.matrix() = r.get<Eigen::Matrix4f>();
+    set.headTransform.matrix() = r.get<Eigen::Matrix4f>();
+    const size_t vertices = set.count * size_t(set.vertices);
+    r.array(set.x, vertices);
+    r.array(set.v, vertices);
+    r.array(set.xPrev, vertices);
+    r.array(set.vPrev, vertices);
+    r.array(set.rootPos0, set.count);
+    r.array(set.rootPos1, set.count);
+    r.array(set.rootRot0, set.count);
+    r.array(set.rootRot1, set.count);
+    r.finish();
+    // The Bullet nodes of every world reload x and v before the next step:
+    // a rope node's whole state is its position and velocity.
+    ++set.version;
 }
 
 double GuideSolver::time() const { return impl_->time; }

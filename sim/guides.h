@@ -149,6 +149,17 @@ class GuideSolver {
     /// Statistics of the current state without stepping (used after initialize).
     GuideStats measure(const Collider* collider) const;
 
+    /// The dynamic state (positions, velocities, root targets, time) as
+    /// bytes, for checkpoints. Rope only: the rigid formulation keeps state
+    /// inside Bullet (orientations, warm-start impulses) that cannot be
+    /// restored bit for bit, so it throws hp::Error.
+    std::vector<char> saveState() const;
+    /// Restores saveState()'s bytes into a solver initialised identically
+    /// (same settings, same roots at the same start time); the solver then
+    /// continues exactly as the one that saved them. Throws hp::Error on a
+    /// size mismatch.
+    void restoreState(const std::vector<char>& state);
+
     /// Largest bend angle between consecutive segments (and the root normal)
     /// relative to the rest shape, and (rigid) the largest twist, in degrees.
     /// For tests and diagnostics.

@@ -1,0 +1,324 @@
+#include "pipeline/shot_simulation.h"
+
+#include "core/log.h"
+#include "pipeline/curly_settings.h"
+#include "pipeline/follower_settings.h"
+#include "pipeline/sim_settings.h"
+#include "sim/curly_wet.h"
+#include "sim/followers.h"
+
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace hp {
+
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void evaluateRoots(const TriangleMesh& mesh, const std::vector<SurfacePoint>& roots, std::vector<SurfaceFrame>& out) {
+    out.resize(roots.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, roots.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) out[i] = evaluate(mesh, roots[i]);
+    });
+}
+
+}  // namespace
+
+/// The two strand models behind one interface: the rigid chain
+/// (sim/guides.h: rope or rigid formulation) and curly-wet (sim/curly_wet.h).
+class GuideModel {
+  public:
+    virtual ~GuideModel() = default;
+    virtual void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head) = 0;
+    /// Time of the next step's end.
+    virtual double nextTime() const = 0;
+    virtual double time() const = 0;
+    virtual GuideStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) = 0;
+    virtual void write(StrandFrame& frame, double time) const = 0;
+    virtual size_t guideCount() const = 0;
+    /// -1 unless the model has a saturation.
+    virtual double saturation() const { return -1; }
+    virtual std::vector<char> saveState() const = 0;
+    virtual void restoreState(const std::vector<char>& state) = 0;
+    virtual const char* name() const = 0;
+};
+
+namespace {
+
+class RigidChainModel final : public GuideModel {
+  public:
+    explicit RigidChainModel(const GuideSettings& s) : solver_(s) {}
+    void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
+        solver_.initialize(roots, head);
+    }
+    double nextTime() const override { return solver_.nextTime(); }
+    double time() const override { return solver_.time(); }
+    GuideStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
+        return solver_.step(roots, head);
+    }
+    void write(StrandFrame& frame, double time) const override { solver_.write(frame, time); }
+    size_t guideCount() const override { return solver_.guideCount(); }
+    std::vector<char> saveState() const override { return solver_.saveState(); }
+    void restoreState(const std::vector<char>& state) override { solver_.restoreState(state); }
+    const char* name() const override { return formulationName(solver_.settings().formulation); }
+
+  private:
+    GuideSolver solver_;
+};
+
+class CurlyWetModel final : public GuideModel {
+  public:
+    CurlyWetModel(const Scene& scene, const CurlyWetSettings& s) : scene_(scene), solver_(s) {}
+    void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
+        solver_.setSaturation(sceneSaturation(scene_, head.time));
+        solver_.initialize(roots, head);
+    }
+    double nextTime() const override { return solver_.nextTime(); }
+    double time() const override { return solver_.time(); }
+    GuideStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
+        solver_.setSaturation(sceneSaturation(scene_, head.time));
+        const CurlyWetStats& c = solver_.step(roots, head);
+        GuideStats g;
+        g.maxLengthError = c.maxLengthError;
+        g.meanLengthError = c.meanLengthError;
+        g.penetrationCount = c.penetrationCount;
+        g.maxPenetration = c.maxPenetration;
+        g.kineticEnergy = c.kineticEnergy;
+        g.nanCount = c.nanCount;
+        g.msPerStep = c.msPerStep;
+        g.reset = c.reset;
+        return g;
+    }
+    void write(StrandFrame& frame, double time) const override { solver_.write(frame, time); }
+    size_t guideCount() const override { return solver_.guideCount(); }
+    double saturation() const override { return solver_.lastStats().meanSaturation; }
+    std::vector<char> saveState() const override { return solver_.saveState(); }
+    void restoreState(const std::vector<char>& state) override { solver_.restoreState(state); }
+    const char* name() const override { return "curly-wet"; }
+
+  private:
+    const Scene& scene_;
+    CurlyWetSolver solver_;
+};
+
+/// Rest shapes of the guides in their own root frames (x = tangent,
+/// y = normal, z = tangent × normal), from the guides as written at t0.
+RestShapes restShapes(const StrandFrame& guides, const std::vector<SurfaceFrame>& roots) {
+    RestShapes shapes;
+    std::vector<Vec3f> local;
+    for (size_t g = 0; g < roots.size(); ++g) {
+        const SurfaceFrame& r = roots[g];
+        Eigen::Matrix3f toWorld;
+        toWorld << r.tangent, r.normal, r.bitangent();
+        const uint32_t first = guides.first(g), n = guides.vertexCount(g);
+        local.resize(n);
+        for (uint32_t v = 0; v < n; ++v) local[v] = toWorld.transpose() * (guides.positions[first + v] - r.position);
+        shapes.add(local.data(), n);
+    }
+    return shapes;
+}
+
+}  // namespace
+
+std::string SimFrameStats::json() const {
+    std::ostringstream o;
+    o.precision(9);
+    o << "{\"frame\": " << frame << ", \"time\": " << time << ", \"steps\": " << guides.steps
+      << ", \"max_length_error\": " << guides.maxLengthError << ", \"mean_length_error\": " << guides.meanLengthError
+      << ", \"penetration_count\": " << guides.penetrationCount << ", \"max_penetration\": " << guides.maxPenetration
+      << ", \"kinetic_energy\": " << guides.kineticEnergy << ", \"nan_count\": " << guides.nanCount
+      << ", \"strand_contacts\": " << guides.strandContacts << ", \"reset\": " << (guides.reset ? "true" : "false")
+      << ", \"ms_per_step\": " << guides.msPerStep << ", \"head_ms\": " << headMs
+      << ", \"follower_ms\": " << followerMs << ", \"follower_projected\": " << followerProjected
+      << ", \"frame_ms\": " << totalMs << ", \"strands\": " << strands << ", \"vertices\": " << vertices;
+    if (saturation >= 0) o << ", \"saturation\": " << saturation;
+    o << "}";
+    return o.str();
+}
+
+ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame)
+    : scene_(scene), fps_(fps), frame_(startFrame) {
+    if (!sceneHasHead(scene)) scene.fail("head.file", "the shot has hair but no head: set head.file");
+    head_ = loadHead(scene);
+    roots_ = placeGroomRoots(scene, head_);
+    if (roots_.guides.empty()) scene.fail("hair.guides.count", "the groom needs at least one guide");
+    if (usesCurlyWetModel(scene)) model_ = std::make_unique<CurlyWetModel>(scene, curlyWetSettings(scene));
+    else model_ = std::make_unique<RigidChainModel>(guideSettings(scene));
+
+    const double t0 = startFrame / fps;
+    pose_ = head_.motion->sample(t0);
+    evaluateRoots(pose_.mesh, roots_.guides, guideFrames_);
+    model_->initialize(guideFrames_, pose_);
+
+    // Followers learn the guides' rest shapes from the guides at t0.
+    StrandFrame rest;
+    model_->write(rest, t0);
+    FollowerGroom groom;
+    groom.guideRoots = guideFrames_;
+    groom.guideShapes = restShapes(rest, guideFrames_);
+    evaluateRoots(pose_.mesh, roots_.followers, followerFrames_);
+    groom.followerRoots = followerFrames_;
+    groom.followerVertices = {rest.vertexCount(0)};
+    float length = 0.f;
+    for (uint32_t v = 1; v < rest.vertexCount(0); ++v) length += (rest.positions[v] - rest.positions[v - 1]).norm();
+    groom.followerLengths = {length};
+    FollowerSettings followerOptions = followerSettings(scene);
+    if (usesCurlyWetModel(scene)) {
+        const CurlyWetSettings curly = curlyWetSettings(scene);
+        followerOptions.rootRadius = curly.rootRadius;
+        followerOptions.tipRadius = curly.tipRadius;
+    }
+    followers_ = std::make_unique<Followers>(groom, followerOptions);
+    logInfo("simulation: ", model_->guideCount(), " guides (", model_->name(), "), ", followers_->followerCount(),
+            " followers, from frame ", startFrame);
+    produceFrame(t0);
+}
+
+ShotSimulation::~ShotSimulation() = default;
+
+size_t ShotSimulation::guideCount() const { return model_->guideCount(); }
+size_t ShotSimulation::followerCount() const { return followers_->followerCount(); }
+
+const StrandFrame& ShotSimulation::advanceTo(int frame) {
+    if (frame < frame_) throw std::logic_error(cat("simulation cannot go back from frame ", frame_, " to ", frame));
+    if (frame == frame_) return strands_;
+    const double target = frame / fps_;
+    // Step while the next step ends no later than the frame (plus rounding);
+    // one more step when the frame falls between steps, so it can be
+    // interpolated from the two steps around it.
+    while (model_->time() < target - 1e-9) {
+        const double t = model_->nextTime();
+        const auto headStart = std::chrono::steady_clock::now();
+        const HeadPose pose = head_.motion->sample(t);
+        evaluateRoots(pose.mesh, roots_.guides, guideFrames_);
+        pendingHeadMs_ += msSince(headStart);
+        const GuideStats s = model_->step(guideFrames_, pose);
+        if (pendingSteps_++ == 0) pending_ = s;
+        else pending_.accumulate(s);
+        if (s.nanCount > 0)
+            throw FrameError(cat("simulation diverged before frame ", frame, " (t = ", t, " s): ", s.nanCount,
+                                 " non-finite guide values; try a smaller simulation.time_step or more substeps"));
+    }
+    frame_ = frame;
+    produceFrame(target);
+    return strands_;
+}
+
+void ShotSimulation::produceFrame(double time) {
+    const auto start = std::chrono::steady_clock::now();
+    const auto headStart = std::chrono::steady_clock::now();
+    pose_ = head_.motion->sample(time);
+    evaluateRoots(pose_.mesh, roots_.guides, guideFrames_);
+    evaluateRoots(pose_.mesh, roots_.followers, followerFrames_);
+    const double headMs = pendingHeadMs_ + msSince(headStart);
+
+    // The guides are written into the frame in place; the followers are
+    // appended after them (their velocities are differences from the
+    // previous frame, which the buffer still holds).
+    const double dt = stats_.strands > 0 ? time - stats_.time : 0.0;
+    StrandFrame guides;
+    model_->write(guides, time);
+    const auto followerStart = std::chrono::steady_clock::now();
+    const FollowerStats fs = followers_->update({guides, guideFrames_, followerFrames_, pose_.collider.get(), dt}, strands_);
+    strands_.frame = frame_;
+    strands_.time = time;
+
+    stats_ = SimFrameStats{};
+    stats_.frame = frame_;
+    stats_.time = time;
+    stats_.guides = pendingSteps_ ? pending_ : GuideStats{};
+    stats_.guides.steps = pendingSteps_;
+    stats_.followerProjected = fs.projected;
+    stats_.followerMs = msSince(followerStart);
+    stats_.headMs = headMs;
+    stats_.strands = strands_.strandCount();
+    stats_.vertices = strands_.vertexCount();
+    stats_.saturation = model_->saturation();
+    stats_.totalMs = msSince(start) + pending_.msPerStep * double(pendingSteps_);
+    pending_ = GuideStats{};
+    pendingSteps_ = 0;
+    pendingHeadMs_ = 0;
+}
+
+// ---- checkpoints -------------------------------------------------------------
+//
+// char[8] "HPCHECKP", u32 version, i32 frame, u32 model name length, model
+// name, u64 state size, state bytes (the solver's own serialisation).
+
+namespace {
+constexpr char kCheckpointMagic[8] = {'H', 'P', 'C', 'H', 'E', 'C', 'K', 'P'};
+constexpr uint32_t kCheckpointVersion = 1;
+}  // namespace
+
+void ShotSimulation::saveCheckpoint(const fs::path& file) const {
+    const std::vector<char> state = model_->saveState();
+    std::ofstream out(file, std::ios::binary | std::ios::trunc);
+    if (!out) throw IoError(file.string(), std::strerror(errno));
+    const std::string model = model_->name();
+    const uint32_t nameLength = uint32_t(model.size());
+    const uint64_t size = state.size();
+    const int32_t frame = frame_;
+    out.write(kCheckpointMagic, sizeof kCheckpointMagic);
+    out.write(reinterpret_cast<const char*>(&kCheckpointVersion), sizeof kCheckpointVersion);
+    out.write(reinterpret_cast<const char*>(&frame), sizeof frame);
+    out.write(reinterpret_cast<const char*>(&nameLength), sizeof nameLength);
+    out.write(model.data(), std::streamsize(model.size()));
+    out.write(reinterpret_cast<const char*>(&size), sizeof size);
+    out.write(state.data(), std::streamsize(state.size()));
+    out.close();
+    if (!out) throw IoError(file.string(), "write failed (disk full?)");
+}
+
+void ShotSimulation::restoreCheckpoint(const fs::path& file, const StrandFrame& strands) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw AssetError(file.string(), "cannot open checkpoint");
+    char magic[8];
+    uint32_t version = 0, nameLength = 0;
+    int32_t frame = 0;
+    uint64_t size = 0;
+    in.read(magic, sizeof magic);
+    in.read(reinterpret_cast<char*>(&version), sizeof version);
+    in.read(reinterpret_cast<char*>(&frame), sizeof frame);
+    in.read(reinterpret_cast<char*>(&nameLength), sizeof nameLength);
+    if (!in || std::memcmp(magic, kCheckpointMagic, sizeof magic) != 0 || version != kCheckpointVersion ||
+        nameLength > 64)
+        throw AssetError(file.string(), "not a hairpipe checkpoint of this version");
+    std::string model(nameLength, '\0');
+    in.read(model.data(), nameLength);
+    in.read(reinterpret_cast<char*>(&size), sizeof size);
+    if (!in || model != model_->name()) throw AssetError(file.string(), "checkpoint of another strand model: " + model);
+    std::error_code ec;
+    if (size > fs::file_size(file, ec)) throw AssetError(file.string(), "truncated checkpoint");
+    std::vector<char> state(size);
+    in.read(state.data(), std::streamsize(size));
+    if (!in) throw AssetError(file.string(), "truncated checkpoint");
+    if (strands.frame != frame || strands.strandCount() != guideCount() + followerCount())
+        throw AssetError(file.string(), cat("checkpoint of frame ", frame, " does not match the cached strands of frame ",
+                                            strands.frame));
+    model_->restoreState(state);
+    frame_ = frame;
+    strands_ = strands;
+    // The restored buffer is what the followers wrote last (velocities by difference).
+    followers_->adoptPrevious(strands_);
+    pose_ = head_.motion->sample(frame / fps_);
+    stats_ = SimFrameStats{};
+    stats_.frame = frame;
+    stats_.time = strands.time;
+    stats_.strands = strands_.strandCount();
+    stats_.vertices = strands_.vertexCount();
+    pending_ = GuideStats{};
+    pendingSteps_ = 0;
+    pendingHeadMs_ = 0;
+}
+
+}  // namespace hp

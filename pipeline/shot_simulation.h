@@ -1,0 +1,87 @@
+// The sequential part of a shot: the head animation moves the scalp, the
+// guide model (rigid chain or curly-wet) is stepped at its fixed time step,
+// and the followers are rebuilt from the guides at every output frame.
+//
+// Time: the shot starts at the scene's first frame (frames.front() / fps),
+// whatever subset of frames a run asks for. Guides step at the model's fixed
+// step (simulation.time_step, 0.02 s by default, as in seed 000); a frame
+// between two steps is written from the two surrounding steps (the solvers
+// interpolate and restore segment lengths), so the step size never depends
+// on the frame rate.
+#pragma once
+
+#include "pipeline/head_setup.h"
+#include "pipeline/scene.h"
+#include "sim/guides.h"
+#include "sim/strand.h"
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+namespace hp {
+
+/// What the simulation measured for one output frame.
+struct SimFrameStats {
+    int frame = 0;
+    double time = 0.0;
+    GuideStats guides;             ///< folded over the guide steps since the previous frame
+    size_t followerProjected = 0;  ///< follower vertices pushed out of the head
+    double headMs = 0;             ///< sampling the head animation (all steps)
+    double followerMs = 0;         ///< rebuilding the followers
+    double totalMs = 0;            ///< the whole frame
+    size_t strands = 0, vertices = 0;
+    double saturation = -1;        ///< curly-wet: mean saturation; -1 otherwise
+    /// One JSON object (a line of the run's statistics).
+    std::string json() const;
+};
+
+class GuideModel;  // the guide solver behind one interface (shot_simulation.cpp)
+
+class ShotSimulation {
+  public:
+    /// Loads the head, places the roots, builds the guide model and the
+    /// followers, and initialises everything at `startFrame`. Throws
+    /// SceneError/AssetError for bad scene settings or assets.
+    ShotSimulation(const Scene& scene, double fps, int startFrame);
+    ~ShotSimulation();
+
+    /// Advances to `frame` (>= frame()) and returns all strands there (guides
+    /// first). Throws FrameError if the simulation produced non-finite values.
+    const StrandFrame& advanceTo(int frame);
+
+    int frame() const { return frame_; }
+    const HeadPose& pose() const { return pose_; }
+    const SimFrameStats& stats() const { return stats_; }
+    const HeadSetup& head() const { return head_; }
+    size_t guideCount() const;
+    size_t followerCount() const;
+
+    /// Writes the complete simulation state at frame() (the solver state; the
+    /// frame's strands themselves are the strand cache's job).
+    void saveCheckpoint(const std::filesystem::path& file) const;
+    /// Restores the state saved by saveCheckpoint at the frame whose strands
+    /// are `strands` (read back from the strand cache). Afterwards the
+    /// simulation continues exactly as the run that saved it.
+    void restoreCheckpoint(const std::filesystem::path& file, const StrandFrame& strands);
+
+  private:
+    void produceFrame(double time);
+
+    const Scene& scene_;
+    double fps_;
+    int frame_;
+    HeadSetup head_;
+    GroomRoots roots_;
+    std::unique_ptr<GuideModel> model_;
+    std::unique_ptr<class Followers> followers_;
+    std::vector<SurfaceFrame> guideFrames_, followerFrames_;
+    HeadPose pose_;
+    StrandFrame strands_;
+    SimFrameStats stats_;
+    GuideStats pending_;  ///< steps since the last output frame
+    double pendingHeadMs_ = 0;
+    size_t pendingSteps_ = 0;
+};
+
+}  // namespace hp
