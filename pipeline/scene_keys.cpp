@@ -10,6 +10,7 @@ void addSceneKeys(SchemaBuilder& b) {
     addHairKeys(b);
     addFollowerKeys(b);
     addSimKeys(b);
+    addGroomKeys(b);
     addCurlyKeys(b);
     addCacheKeys(b);
     addRenderKeys(b);

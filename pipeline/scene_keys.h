@@ -17,6 +17,7 @@ void addPreviewKeys(SchemaBuilder& b); // preview: the GL preview pass (scene_ke
 void addHeadKeys(SchemaBuilder& b);    // head: import, clip, scalp, collider (scene_keys_head.cpp)
 void addHairKeys(SchemaBuilder& b);    // hair: root counts and placement (scene_keys_hair.cpp)
 void addReferenceKeys(SchemaBuilder& b);  // reference: Embree reference renderer (scene_keys_reference.cpp)
+void addGroomKeys(SchemaBuilder& b);   // hair.groom: rest shape (scene_keys_sim.cpp)
 void addCacheKeys(SchemaBuilder& b);
 void addStageFrameKeys(SchemaBuilder& b);  // <stage>.frames subsets (scene_keys_cache.cpp)   // cache: strand cache, checkpoints, USD (scene_keys_cache.cpp)
 void addVdbKeys(SchemaBuilder& b);     // vdb: OpenVDB density caches (scene_keys_vdb.cpp)

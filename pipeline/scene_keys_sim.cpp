@@ -54,3 +54,17 @@ void addSimKeys(SchemaBuilder& b) {
 }
 
 }  // namespace hp
+
+namespace hp {
+
+void addGroomKeys(SchemaBuilder& b) {
+    b.section("hair.groom", "The guides' rest shape at the first frame (the rigid-chain model).")
+        .choice("hair.groom.style", "straight", {"straight", "combed"},
+                "straight: along the root normal (seed 000); combed: leaving the scalp upright and "
+                "turning toward hair.groom.direction, laid over the head.")
+        .number("hair.groom.droop", 0.85, 0, 1, "",
+                "Combed: how far strands turn toward the comb direction (1: the tips point along it).")
+        .vec3("hair.groom.direction", 0, -1, 0, "", "Combed: the world direction hair is combed toward.");
+}
+
+}  // namespace hp

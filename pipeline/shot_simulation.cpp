@@ -6,6 +6,7 @@
 #include "pipeline/sim_settings.h"
 #include "sim/curly_wet.h"
 #include "sim/followers.h"
+#include "sim/groom.h"
 
 #include <tbb/parallel_for.h>
 
@@ -39,7 +40,8 @@ void evaluateRoots(const TriangleMesh& mesh, const std::vector<SurfacePoint>& ro
 class GuideModel {
   public:
     virtual ~GuideModel() = default;
-    virtual void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head) = 0;
+    virtual void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head,
+                            const std::vector<std::vector<Vec3f>>* groom) = 0;
     /// Time of the next step's end.
     virtual double nextTime() const = 0;
     virtual double time() const = 0;
@@ -58,8 +60,9 @@ namespace {
 class RigidChainModel final : public GuideModel {
   public:
     explicit RigidChainModel(const GuideSettings& s) : solver_(s) {}
-    void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
-        solver_.initialize(roots, head);
+    void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head,
+                    const std::vector<std::vector<Vec3f>>* groom) override {
+        solver_.initialize(roots, head, groom);
     }
     double nextTime() const override { return solver_.nextTime(); }
     double time() const override { return solver_.time(); }
@@ -79,7 +82,9 @@ class RigidChainModel final : public GuideModel {
 class CurlyWetModel final : public GuideModel {
   public:
     CurlyWetModel(const Scene& scene, const CurlyWetSettings& s) : scene_(scene), solver_(s) {}
-    void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
+    void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head,
+                    const std::vector<std::vector<Vec3f>>*) override {
+        // The curly model grooms its own helices.
         solver_.setSaturation(sceneSaturation(scene_, head.time));
         solver_.initialize(roots, head);
     }
@@ -158,7 +163,20 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame)
     const double t0 = startFrame / fps;
     pose_ = head_.motion->sample(t0);
     evaluateRoots(pose_.mesh, roots_.guides, guideFrames_);
-    model_->initialize(guideFrames_, pose_);
+    if (!usesCurlyWetModel(scene) && scene.text("hair.groom.style") == "combed") {
+        const GuideSettings gs = guideSettings(scene);
+        GroomSettings groom;
+        groom.style = GroomStyle::Combed;
+        groom.segments = gs.segments;
+        groom.length = gs.length;
+        groom.droop = float(scene.number("hair.groom.droop"));
+        groom.direction = scene.vec3f("hair.groom.direction");
+        groom.clearance = 2.f * gs.collisionRadius;
+        const auto strands = groomStrands(guideFrames_, groom, pose_.collider.get());
+        model_->initialize(guideFrames_, pose_, &strands);
+    } else {
+        model_->initialize(guideFrames_, pose_, nullptr);
+    }
 
     // Followers learn the guides' rest shapes from the guides at t0.
     StrandFrame rest;
