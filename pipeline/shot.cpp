@@ -17,6 +17,8 @@ ShotSettings resolveShot(const Scene& scene, const RunOptions& options) {
     shot.seed = scene.integer("seed");
     shot.force = options.force;
     shot.frames = options.frames ? *options.frames : scene.frames("frames");
+    shot.requireCache = options.cacheOnly;
+    shot.wholeRunOutputs = !options.noReport;
     fs::path out = options.outputDir;
     if (out.empty()) {
         const std::string& configured = scene.text("output.directory");
@@ -77,6 +79,11 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
         progress.advance(cat("frame ", frame));
     }
     // Whole-run outputs (reports) once every frame is done.
+    if (shot.wholeRunOutputs) finishStages(stages, shot, report);
+    return report;
+}
+
+void finishStages(std::vector<StagePtr>& stages, const ShotSettings& shot, RunReport& report) {
     for (StagePtr& stage : stages) {
         try {
             stage->finish(shot);
@@ -85,7 +92,6 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
             logError(stage->name(), ": ", e.what());
         }
     }
-    return report;
 }
 
 }  // namespace hp
