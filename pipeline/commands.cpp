@@ -27,6 +27,8 @@ const std::vector<CommandSpec>& commands() {
         compareCommandSpec(),
         viewCommandSpec(),
         vdbCommandSpec(),
+        exportUsdCommandSpec(),
+        farmCommandSpec(),
         validateCommandSpec(),
         infoCommandSpec(),
         helpCommandSpec(),
