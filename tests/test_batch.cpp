@@ -163,25 +163,31 @@ TEST(Batch, SimKilledMidShotResumesFromItsCheckpointIdentically) {
     expectSameOutputs(dir / "a", dir / "b");
 }
 
-TEST(Batch, RunKilledMidShotCompletesIdenticallyWithoutPartialFiles) {
+TEST(Batch, RenderKilledMidShotCompletesIdenticallyWithoutPartialFiles) {
     TempDir dir;
     const fs::path scene = writeSmallScene(dir.path());
     const ProcessResult full = runHairpipe("run -q " + q(scene) + " --out " + q(dir / "a"));
     ASSERT_EQ(full.exitCode, 0) << full.output;
 
+    const fs::path b = dir / "b";
+    ASSERT_EQ(runHairpipe("sim -q " + q(scene) + " --out " + q(b)).exitCode, 0);
     {
-        Background run({"run", scene.string(), "--out", (dir / "b").string()}, dir.path(), dir / "killed.log");
-        ASSERT_TRUE(waitUntil([&] { return fs::exists(dir / "b/preview/preview.0002.png"); }, 120))
+        Background render({"render", scene.string(), "--out", b.string()}, dir.path(), dir / "killed.log");
+        ASSERT_TRUE(waitUntil([&] { return fs::exists(b / "preview/preview.0002.png"); }, 120))
             << readFile(dir / "killed.log");
-        run.kill(SIGKILL);
-        run.wait();
+        render.kill(SIGKILL);
+        EXPECT_TRUE(WIFSIGNALED(render.wait()));
     }
-    ASSERT_FALSE(fs::exists(dir / "b/preview/preview.0006.png")) << "the run ended before it was killed";
-    const ProcessResult resumed = runHairpipe("run " + q(scene) + " --out " + q(dir / "b"));
+    ASSERT_FALSE(fs::exists(b / "preview/preview.0006.png")) << "the render ended before it was killed";
+    const ProcessResult resumed = runHairpipe("render " + q(scene) + " --out " + q(b));
     ASSERT_EQ(resumed.exitCode, 0) << resumed.output;
     EXPECT_EQ(resumed.output.find(" 0 stage outputs already present"), std::string::npos)
-        << "the rerun should have skipped what the killed run finished:\n" << resumed.output;
-    expectSameOutputs(dir / "a", dir / "b");
+        << "the rerun should have skipped what the killed render finished:\n" << resumed.output;
+    EXPECT_EQ(resumed.output.find("simulation:"), std::string::npos) << "frames come from the cache:\n" << resumed.output;
+    EXPECT_TRUE(temporaries(b).empty()) << ::testing::PrintToString(temporaries(b));
+    // The other stages on top; then everything equals the uninterrupted run.
+    ASSERT_EQ(runHairpipe("run -q " + q(scene) + " --out " + q(b)).exitCode, 0);
+    expectSameOutputs(dir / "a", b);
 }
 
 TEST(Batch, JobsRunKilledTakesItsChildrenAlongAndResumesIdentically) {
