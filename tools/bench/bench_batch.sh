@@ -23,11 +23,14 @@ hp="$root/build/tools/hairpipe"
 mkdir -p "$work"
 
 now() { date +%s.%N; }
-# seconds FOLDER ARGS...: runs hairpipe quietly into FOLDER, prints the wall seconds.
+# seconds FOLDER ARGS...: runs hairpipe quietly into FOLDER, prints the wall
+# seconds. Exit code 2 is accepted: the default scene's compare thresholds
+# flag the preview's drift from the reference, which is not a batch failure.
 seconds() {
   local out="$1"; shift
-  local t0; t0=$(now)
-  "$hp" "$@" --out "$out" -q >"$out.log" 2>&1 || { echo "bench_batch: hairpipe $* failed, see $out.log" >&2; exit 1; }
+  local t0 rc=0; t0=$(now)
+  "$hp" "$@" --out "$out" -q >"$out.log" 2>&1 || rc=$?
+  [ "$rc" -eq 0 ] || [ "$rc" -eq 2 ] || { echo "bench_batch: hairpipe $* failed ($rc), see $out.log" >&2; exit 1; }
   echo "$(now) - $t0" | bc -l
 }
 # frames STAGE FOLDER: how many stage-frames the run wrote (its outputs' frame numbers).
