@@ -24,7 +24,10 @@ float springFraction(float stiffness, float inertia, float h) {
 
 float dampingFactor(float rate, float h) { return std::exp(-rate * h); }
 
-Quatf transport(const Vec3f& from, const Vec3f& to) {
+namespace {
+
+/// transport(), inlined into the joint passes' loops.
+[[gnu::always_inline]] inline Quatf minimalRotation(const Vec3f& from, const Vec3f& to) {
     // For unit a, b the half-way quaternion (1 + a·b, a×b), normalised, is the
     // minimal rotation; only the antiparallel case needs Eigen's general path.
     const float w = 1.f + from.dot(to);
@@ -32,6 +35,10 @@ Quatf transport(const Vec3f& from, const Vec3f& to) {
     const Vec3f v = from.cross(to);
     return Quatf(w, v.x(), v.y(), v.z()).normalized();
 }
+
+}  // namespace
+
+Quatf transport(const Vec3f& from, const Vec3f& to) { return minimalRotation(from, to); }
 
 float angleBetween(const Vec3f& a, const Vec3f& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
@@ -152,56 +159,101 @@ void finish(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams
 
 }  // namespace
 
+namespace {
+
+/// Where the Drive pass stands along one strand: joint j's frame Q and the
+/// carries of the joints above composed into one rigid map (C, c), so that
+/// vertex i's current position is C·x_i + c. Carrying every subtree
+/// explicitly would cost O(n²).
+struct DriveState {
+    Quatf Q;
+    Quatf C = Quatf::Identity();
+    Vec3f c = Vec3f::Zero();
+    DriveState() = default;
+    explicit DriveState(const Mat3f& rootFrame) : Q(rootFrame) {}
+};
+
+/// Joint j of the Drive pass: the implicit spring on the segment's end,
+/// x ← x + f·(x* - x), renormalised onto the segment's length, carrying the
+/// subtree with the spring's turn and the length fix (a joint drive moves
+/// what hangs from it). Inlined into the one-strand and the lockstep loops
+/// alike, so both compute the same values bit for bit.
+[[gnu::always_inline]] inline void driveJoint(DriveState& s, Vec3f* x, int j, const JointParams& p) {
+    const Vec3f parent = x[j];
+    const Vec3f oldChild = s.C * x[j + 1] + s.c;
+    const float length = p.restLength[j];
+    const Vec3f rest = s.Q * p.restDir[j];
+    const Vec3f e = oldChild - parent;
+    const float len = e.norm();
+    const Vec3f d = len > 1e-12f ? Vec3f(e / len) : rest;
+    const float f = p.spring[j];
+    const Vec3f dir = ((1.f - f) * d + f * (s.Q * p.springDir[j])).normalized();
+    const Quatf q = minimalRotation(d, dir);
+    s.C = q * s.C;
+    s.c = parent + length * dir + q * (s.c - oldChild);
+    x[j + 1] = parent + length * dir;
+    s.Q = minimalRotation(rest, dir) * s.Q;
+    s.Q.normalize();  // keep rounding from accumulating over the chain
+}
+
+/// K strands in lockstep, joint by joint.
+template <int K>
+void driveBlock(Vec3f* const* x, int vertexCount, const Mat3f* rootFrames, const JointParams* p) {
+    DriveState s[K];
+    for (int k = 0; k < K; ++k) s[k] = DriveState(rootFrames[k]);
+    for (int j = 0; j + 1 < vertexCount; ++j)
+#pragma GCC unroll 8
+        for (int k = 0; k < K; ++k) driveJoint(s[k], x[k], j, p[k]);
+}
+
+}  // namespace
+
 void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& p,
                  const HeadQuery* head, float radius, Contact* contacts) {
     if (pass == JointPass::Finish) return finish(x, vertexCount, rootFrame, p, head, radius, contacts);
-    // Frames as quaternions: the pass composes two rotations per joint.
-    Quatf Q(rootFrame);
-    // Carrying every subtree explicitly costs O(n²); instead the carries are
-    // composed into one rigid map (C, c) applied to each vertex when its turn
-    // comes: the vertex's current position is C·x + c.
-    Quatf C = Quatf::Identity();
-    Vec3f c = Vec3f::Zero();
+    if (pass == JointPass::Drive) return driveBlock<1>(&x, vertexCount, &rootFrame, &p);
+    // SolvePreload, with the Drive pass's frames and carries.
+    DriveState s(rootFrame);
     for (int j = 0; j + 1 < vertexCount; ++j) {
         const Vec3f parent = x[j];
-        const Vec3f oldChild = C * x[j + 1] + c;
+        const Vec3f oldChild = s.C * x[j + 1] + s.c;
         const float length = p.restLength[j];
-        const Vec3f rest = Q * p.restDir[j];
+        const Vec3f rest = s.Q * p.restDir[j];
         const Vec3f e = oldChild - parent;
         const float len = e.norm();
         const Vec3f d = len > 1e-12f ? Vec3f(e / len) : rest;
         const float f = p.spring[j];
-        Vec3f dir = d;
-        if (pass == JointPass::SolvePreload) {
-            // Aim past the rest direction r so that the spring step lands on
-            // it: normalize((1-f)·d + f·t) = r with |t| = 1 gives
-            // t = (λ·r - (1-f)·d)/f, λ the positive root of
-            // λ² - 2λ(1-f)(r·d) + (1-f)² - f² = 0.
-            Vec3f target = rest;
-            if (f > 0.f) {
-                const float g = 1.f - f, cd = rest.dot(d);
-                const float lambda = g * cd + std::sqrt(std::max(0.f, g * g * cd * cd - g * g + f * f));
-                target = ((lambda * rest - g * d) / f).normalized();
-                // A pre-bend far beyond the joint's limit makes a soft joint
-                // unstable; such a joint keeps some sag instead.
-                if (angleBetween(target, rest) > 2.f * p.limit) target = rotateToAngle(target, rest, 2.f * p.limit);
-            }
-            p.springDir[j] = Q.conjugate() * target;
-            dir = rest;
-        } else if (pass == JointPass::Drive) {
-            // The implicit spring on the segment's end, x ← x + f·(x* - x),
-            // renormalised onto the segment's length.
-            dir = ((1.f - f) * d + f * (Q * p.springDir[j])).normalized();
+        // Aim past the rest direction r so that the spring step lands on it:
+        // normalize((1-f)·d + f·t) = r with |t| = 1 gives
+        // t = (λ·r - (1-f)·d)/f, λ the positive root of
+        // λ² - 2λ(1-f)(r·d) + (1-f)² - f² = 0.
+        Vec3f target = rest;
+        if (f > 0.f) {
+            const float g = 1.f - f, cd = rest.dot(d);
+            const float lambda = g * cd + std::sqrt(std::max(0.f, g * g * cd * cd - g * g + f * f));
+            target = ((lambda * rest - g * d) / f).normalized();
+            // A pre-bend far beyond the joint's limit makes a soft joint
+            // unstable; such a joint keeps some sag instead.
+            if (angleBetween(target, rest) > 2.f * p.limit) target = rotateToAngle(target, rest, 2.f * p.limit);
         }
-        // Carry the subtree with the spring's turn and the length fix: a
-        // joint drive moves what hangs from it.
+        p.springDir[j] = s.Q.conjugate() * target;
+        // The vertex goes back onto the rest shape, what hangs below with it.
+        const Vec3f& dir = rest;
         const Quatf q = transport(d, dir);
-        C = q * C;
-        c = parent + length * dir + q * (c - oldChild);
+        s.C = q * s.C;
+        s.c = parent + length * dir + q * (s.c - oldChild);
         x[j + 1] = parent + length * dir;
-        Q = transport(rest, dir) * Q;
-        Q.normalize();  // keep rounding from accumulating over the chain
+        s.Q = transport(rest, dir) * s.Q;
+        s.Q.normalize();
     }
+}
+
+void driveJoints(int count, Vec3f* const* x, int vertexCount, const Mat3f* rootFrames, const JointParams* joints) {
+    // Four strands at a time (measured in B-sim: see sim/rope_group.cpp).
+    constexpr int kLanes = 4;
+    int b = 0;
+    for (; b + kLanes <= count; b += kLanes) driveBlock<kLanes>(x + b, vertexCount, rootFrames + b, joints + b);
+    for (; b < count; ++b) driveBlock<1>(x + b, vertexCount, rootFrames + b, joints + b);
 }
 
 void bendBounds(const Vec3f* restDir, int segments, float reach, float* restBend, float* cosMostBend,
