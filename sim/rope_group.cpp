@@ -84,8 +84,8 @@ btDefaultCollisionConstructionInfo smallPools() {
 /// m_links[j·B + b]. Bullet's link kernel (PSolve_Links) is Gauss-Seidel in
 /// link order, so each rope sees exactly the same updates in the same order
 /// as a body of its own, but consecutive links now belong to different ropes:
-/// the chain of dependent updates along one rope (each link waits for its
-/// parent's result: a division and ~40 cycles of latency) overlaps with the
+/// the chain of dependent updates along one rope (each link, a division
+/// among its operations, waits for its parent's result) overlaps with the
 /// other ropes' chains instead of stalling the core. Bullet's per-body work
 /// (bounds, trees, solver preparation) is paid once per group, not per rope.
 class Bundle {
