@@ -50,9 +50,9 @@
 //    thread: 14.3 -> 8.3 CPU ms per step, identical results): Bullet's link
 //    kernel overlaps the ropes' dependency chains, and its per-body work
 //    (bounds, node tree, solver preparation) is paid once per group. The
-//    Drive pass likewise runs four ropes in lockstep (strand::driveJoints),
-//    read from the bundle in node order: 9.7 -> 7.9 CPU ms per step (min of
-//    five alternating runs each on a loaded machine), identical results.
+//    Drive pass runs four ropes at a time, in lockstep (9.7 -> 7.9 CPU ms
+//    per step, min of five alternating runs each on a loaded machine) and
+//    then in SIMD lanes (strand::driveJoints; 8.2 -> 6.8): identical results.
 #include "sim/guide_group.h"
 
 #include <BulletSoftBody/btDefaultSoftBodySolver.h>

@@ -163,11 +163,11 @@ void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFra
 
 /// The Drive pass of relaxJoints on `count` strands, x[k] the vertices of
 /// strand k with root frame rootFrames[k] and parameters joints[k]: the same
-/// values bit for bit as one relaxJoints call per strand, computed joint by
-/// joint across a few strands at a time. A strand's pass is one long chain of
-/// dependent operations (each joint waits on its parent's frame: two
-/// quaternion products and five square roots); independent strands
-/// interleaved fill the waits.
+/// values bit for bit as one relaxJoints call per strand, computed for four
+/// strands at a time in SIMD lanes. A strand's pass is one long chain of
+/// dependent operations (each joint waits on its parent's frame: quaternion
+/// products, square roots, divisions); lanes run four chains for the price
+/// of one.
 void driveJoints(int count, Vec3f* const* x, int vertexCount, const Mat3f* rootFrames, const JointParams* joints);
 
 /// Bend limits as spans: the angle between consecutive segments of lengths
