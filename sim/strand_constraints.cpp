@@ -293,7 +293,7 @@ inline Q4 normalized(const Q4& q) {
     return {ok ? q.x / s : q.x, ok ? q.y / s : q.y, ok ? q.z / s : q.z, ok ? q.w / s : q.w};
 }
 /// minimalRotation in lanes; the rare antiparallel lanes take Eigen's general path.
-inline Q4 minimalRotation4(const V3& from, const V3& to) {
+[[gnu::always_inline]] inline Q4 minimalRotation4(const V3& from, const V3& to) {
     const f4 w = splat4(1.f) + dot(from, to);
     const V3 v = cross(from, to);
     Q4 q = normalized(Q4{v.x, v.y, v.z, w});
