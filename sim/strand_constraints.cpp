@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <xmmintrin.h>
+
 namespace hp::strand {
 
 Mat3f rootRotation(const SurfaceFrame& frame) {
@@ -24,7 +26,10 @@ float springFraction(float stiffness, float inertia, float h) {
 
 float dampingFactor(float rate, float h) { return std::exp(-rate * h); }
 
-Quatf transport(const Vec3f& from, const Vec3f& to) {
+namespace {
+
+/// transport(), inlined into the joint passes' loops.
+[[gnu::always_inline]] inline Quatf minimalRotation(const Vec3f& from, const Vec3f& to) {
     // For unit a, b the half-way quaternion (1 + a·b, a×b), normalised, is the
     // minimal rotation; only the antiparallel case needs Eigen's general path.
     const float w = 1.f + from.dot(to);
@@ -32,6 +37,10 @@ Quatf transport(const Vec3f& from, const Vec3f& to) {
     const Vec3f v = from.cross(to);
     return Quatf(w, v.x(), v.y(), v.z()).normalized();
 }
+
+}  // namespace
+
+Quatf transport(const Vec3f& from, const Vec3f& to) { return minimalRotation(from, to); }
 
 float angleBetween(const Vec3f& a, const Vec3f& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
@@ -152,56 +161,211 @@ void finish(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams
 
 }  // namespace
 
+namespace {
+
+/// Where the Drive pass stands along one strand: joint j's frame Q and the
+/// carries of the joints above composed into one rigid map (C, c), so that
+/// vertex i's current position is C·x_i + c. Carrying every subtree
+/// explicitly would cost O(n²).
+struct DriveState {
+    Quatf Q;
+    Quatf C = Quatf::Identity();
+    Vec3f c = Vec3f::Zero();
+    explicit DriveState(const Mat3f& rootFrame) : Q(rootFrame) {}
+};
+
+/// Joint j of the Drive pass: the implicit spring on the segment's end,
+/// x ← x + f·(x* - x), renormalised onto the segment's length, carrying the
+/// subtree with the spring's turn and the length fix (a joint drive moves
+/// what hangs from it). driveLanes repeats these statements in SIMD lanes.
+inline void driveJoint(DriveState& s, Vec3f* x, int j, const JointParams& p) {
+    const Vec3f parent = x[j];
+    const Vec3f oldChild = s.C * x[j + 1] + s.c;
+    const float length = p.restLength[j];
+    const Vec3f rest = s.Q * p.restDir[j];
+    const Vec3f e = oldChild - parent;
+    const float len = e.norm();
+    const Vec3f d = len > 1e-12f ? Vec3f(e / len) : rest;
+    const float f = p.spring[j];
+    const Vec3f dir = ((1.f - f) * d + f * (s.Q * p.springDir[j])).normalized();
+    const Quatf q = minimalRotation(d, dir);
+    s.C = q * s.C;
+    s.c = parent + length * dir + q * (s.c - oldChild);
+    x[j + 1] = parent + length * dir;
+    s.Q = minimalRotation(rest, dir) * s.Q;
+    s.Q.normalize();  // keep rounding from accumulating over the chain
+}
+
+/// The Drive pass of one strand.
+void driveStrand(Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& p) {
+    DriveState s(rootFrame);
+    for (int j = 0; j + 1 < vertexCount; ++j) driveJoint(s, x, j, p);
+}
+
+}  // namespace
+
 void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& p,
                  const HeadQuery* head, float radius, Contact* contacts) {
     if (pass == JointPass::Finish) return finish(x, vertexCount, rootFrame, p, head, radius, contacts);
-    // Frames as quaternions: the pass composes two rotations per joint.
-    Quatf Q(rootFrame);
-    // Carrying every subtree explicitly costs O(n²); instead the carries are
-    // composed into one rigid map (C, c) applied to each vertex when its turn
-    // comes: the vertex's current position is C·x + c.
-    Quatf C = Quatf::Identity();
-    Vec3f c = Vec3f::Zero();
+    if (pass == JointPass::Drive) return driveStrand(x, vertexCount, rootFrame, p);
+    // SolvePreload, with the Drive pass's frames and carries.
+    DriveState s(rootFrame);
     for (int j = 0; j + 1 < vertexCount; ++j) {
         const Vec3f parent = x[j];
-        const Vec3f oldChild = C * x[j + 1] + c;
+        const Vec3f oldChild = s.C * x[j + 1] + s.c;
         const float length = p.restLength[j];
-        const Vec3f rest = Q * p.restDir[j];
+        const Vec3f rest = s.Q * p.restDir[j];
         const Vec3f e = oldChild - parent;
         const float len = e.norm();
         const Vec3f d = len > 1e-12f ? Vec3f(e / len) : rest;
         const float f = p.spring[j];
-        Vec3f dir = d;
-        if (pass == JointPass::SolvePreload) {
-            // Aim past the rest direction r so that the spring step lands on
-            // it: normalize((1-f)·d + f·t) = r with |t| = 1 gives
-            // t = (λ·r - (1-f)·d)/f, λ the positive root of
-            // λ² - 2λ(1-f)(r·d) + (1-f)² - f² = 0.
-            Vec3f target = rest;
-            if (f > 0.f) {
-                const float g = 1.f - f, cd = rest.dot(d);
-                const float lambda = g * cd + std::sqrt(std::max(0.f, g * g * cd * cd - g * g + f * f));
-                target = ((lambda * rest - g * d) / f).normalized();
-                // A pre-bend far beyond the joint's limit makes a soft joint
-                // unstable; such a joint keeps some sag instead.
-                if (angleBetween(target, rest) > 2.f * p.limit) target = rotateToAngle(target, rest, 2.f * p.limit);
-            }
-            p.springDir[j] = Q.conjugate() * target;
-            dir = rest;
-        } else if (pass == JointPass::Drive) {
-            // The implicit spring on the segment's end, x ← x + f·(x* - x),
-            // renormalised onto the segment's length.
-            dir = ((1.f - f) * d + f * (Q * p.springDir[j])).normalized();
+        // Aim past the rest direction r so that the spring step lands on it:
+        // normalize((1-f)·d + f·t) = r with |t| = 1 gives
+        // t = (λ·r - (1-f)·d)/f, λ the positive root of
+        // λ² - 2λ(1-f)(r·d) + (1-f)² - f² = 0.
+        Vec3f target = rest;
+        if (f > 0.f) {
+            const float g = 1.f - f, cd = rest.dot(d);
+            const float lambda = g * cd + std::sqrt(std::max(0.f, g * g * cd * cd - g * g + f * f));
+            target = ((lambda * rest - g * d) / f).normalized();
+            // A pre-bend far beyond the joint's limit makes a soft joint
+            // unstable; such a joint keeps some sag instead.
+            if (angleBetween(target, rest) > 2.f * p.limit) target = rotateToAngle(target, rest, 2.f * p.limit);
         }
-        // Carry the subtree with the spring's turn and the length fix: a
-        // joint drive moves what hangs from it.
+        p.springDir[j] = s.Q.conjugate() * target;
+        // The vertex goes back onto the rest shape, what hangs below with it.
+        const Vec3f& dir = rest;
         const Quatf q = transport(d, dir);
-        C = q * C;
-        c = parent + length * dir + q * (c - oldChild);
+        s.C = q * s.C;
+        s.c = parent + length * dir + q * (s.c - oldChild);
         x[j + 1] = parent + length * dir;
-        Q = transport(rest, dir) * Q;
-        Q.normalize();  // keep rounding from accumulating over the chain
+        s.Q = transport(rest, dir) * s.Q;
+        s.Q.normalize();
     }
+}
+
+namespace {
+
+// Four strands' Drive passes in SIMD lanes (GCC vector extensions, SSE).
+// Each lane repeats exactly the operations, in the same order, that Eigen
+// performs for driveJoint (Eigen 3.4: cross products scalar; 3-term sums
+// split in halves, a + (b + c); quaternion products by its SSE kernel;
+// 4-vector norms as (x² + z²) + (y² + w²)), and IEEE +, -, ×, ÷ and √ are
+// exact per lane, so the lanes give the one-strand results bit for bit
+// (tested).
+typedef float f4 __attribute__((vector_size(16)));
+typedef int32_t i4 __attribute__((vector_size(16)));
+
+inline f4 splat4(float x) { return f4{x, x, x, x}; }
+inline f4 sqrt4(f4 x) { return f4(_mm_sqrt_ps(__m128(x))); }
+inline bool anyLane(i4 m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
+
+struct V3 {
+    f4 x, y, z;
+};
+struct Q4 {
+    f4 x, y, z, w;
+};
+
+inline V3 cross(const V3& a, const V3& b) {
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+/// Eigen's 3-term sums split in halves: a₀b₀ + (a₁b₁ + a₂b₂).
+inline f4 dot(const V3& a, const V3& b) { return a.x * b.x + (a.y * b.y + a.z * b.z); }
+/// Eigen's QuaternionBase::_transformVector.
+inline V3 rotate(const Q4& q, const V3& v) {
+    const V3 qv{q.x, q.y, q.z};
+    V3 uv = cross(qv, v);
+    uv = {uv.x + uv.x, uv.y + uv.y, uv.z + uv.z};
+    const V3 c = cross(qv, uv);
+    return {(v.x + q.w * uv.x) + c.x, (v.y + q.w * uv.y) + c.y, (v.z + q.w * uv.z) + c.z};
+}
+/// Eigen's SSE quaternion product (quat_product, Geometry_SIMD.h).
+inline Q4 multiply(const Q4& a, const Q4& b) {
+    return {(a.x * b.w - a.z * b.y) + (a.y * b.z + a.w * b.x), (a.y * b.w - a.x * b.z) + (a.z * b.x + a.w * b.y),
+            (a.z * b.w - a.y * b.x) + (a.x * b.y + a.w * b.z), (a.w * b.w - a.x * b.x) + -(a.z * b.z + a.y * b.y)};
+}
+/// Quaternion normalize(): coefficients over √ of their SSE-reduced squared norm.
+inline Q4 normalized(const Q4& q) {
+    const f4 n = (q.x * q.x + q.z * q.z) + (q.y * q.y + q.w * q.w);
+    const i4 ok = n > splat4(0.f);
+    const f4 s = sqrt4(n);
+    return {ok ? q.x / s : q.x, ok ? q.y / s : q.y, ok ? q.z / s : q.z, ok ? q.w / s : q.w};
+}
+/// minimalRotation in lanes; the rare antiparallel lanes take Eigen's general path.
+[[gnu::always_inline]] inline Q4 minimalRotation4(const V3& from, const V3& to) {
+    const f4 w = splat4(1.f) + dot(from, to);
+    const V3 v = cross(from, to);
+    Q4 q = normalized(Q4{v.x, v.y, v.z, w});
+    const i4 general = w < splat4(1e-6f);
+    if (anyLane(general))
+        for (int k = 0; k < 4; ++k)
+            if (general[k]) {
+                const Quatf r = minimalRotation(Vec3f(from.x[k], from.y[k], from.z[k]), Vec3f(to.x[k], to.y[k], to.z[k]));
+                q.x[k] = r.x();
+                q.y[k] = r.y();
+                q.z[k] = r.z();
+                q.w[k] = r.w();
+            }
+    return q;
+}
+
+inline V3 gather(const Vec3f* const* a, int j) {
+    return {f4{a[0][j].x(), a[1][j].x(), a[2][j].x(), a[3][j].x()},
+            f4{a[0][j].y(), a[1][j].y(), a[2][j].y(), a[3][j].y()},
+            f4{a[0][j].z(), a[1][j].z(), a[2][j].z(), a[3][j].z()}};
+}
+
+/// Four strands' Drive passes, one per lane: driveJoint's statements one for one.
+void driveLanes(Vec3f* const* x, int vertexCount, const Mat3f* rootFrames, const JointParams* p) {
+    Q4 Q, C{splat4(0.f), splat4(0.f), splat4(0.f), splat4(1.f)};
+    V3 c{splat4(0.f), splat4(0.f), splat4(0.f)};
+    for (int k = 0; k < 4; ++k) {
+        const Quatf q(rootFrames[k]);
+        Q.x[k] = q.x();
+        Q.y[k] = q.y();
+        Q.z[k] = q.z();
+        Q.w[k] = q.w();
+    }
+    const Vec3f* restDir[4] = {p[0].restDir, p[1].restDir, p[2].restDir, p[3].restDir};
+    const Vec3f* springDir[4] = {p[0].springDir, p[1].springDir, p[2].springDir, p[3].springDir};
+    const Vec3f* xs[4] = {x[0], x[1], x[2], x[3]};
+    V3 parent = gather(xs, 0);
+    for (int j = 0; j + 1 < vertexCount; ++j) {
+        const V3 child = gather(xs, j + 1);
+        const V3 rc = rotate(C, child);
+        const V3 oldChild{rc.x + c.x, rc.y + c.y, rc.z + c.z};
+        const f4 length{p[0].restLength[j], p[1].restLength[j], p[2].restLength[j], p[3].restLength[j]};
+        const V3 rest = rotate(Q, gather(restDir, j));
+        const V3 e{oldChild.x - parent.x, oldChild.y - parent.y, oldChild.z - parent.z};
+        const f4 len = sqrt4(dot(e, e));
+        const i4 long_ = len > splat4(1e-12f);
+        const V3 d{long_ ? e.x / len : rest.x, long_ ? e.y / len : rest.y, long_ ? e.z / len : rest.z};
+        const f4 f{p[0].spring[j], p[1].spring[j], p[2].spring[j], p[3].spring[j]};
+        const f4 g = splat4(1.f) - f;
+        const V3 t = rotate(Q, gather(springDir, j));
+        const V3 u{g * d.x + f * t.x, g * d.y + f * t.y, g * d.z + f * t.z};
+        const f4 z = dot(u, u);
+        const i4 nonzero = z > splat4(0.f);
+        const f4 sz = sqrt4(z);
+        const V3 dir{nonzero ? u.x / sz : u.x, nonzero ? u.y / sz : u.y, nonzero ? u.z / sz : u.z};
+        const Q4 q = minimalRotation4(d, dir);
+        C = multiply(q, C);
+        const V3 placed{parent.x + length * dir.x, parent.y + length * dir.y, parent.z + length * dir.z};
+        const V3 r = rotate(q, V3{c.x - oldChild.x, c.y - oldChild.y, c.z - oldChild.z});
+        c = {placed.x + r.x, placed.y + r.y, placed.z + r.z};
+        for (int k = 0; k < 4; ++k) x[k][j + 1] = Vec3f(placed.x[k], placed.y[k], placed.z[k]);
+        Q = normalized(multiply(minimalRotation4(rest, dir), Q));
+        parent = placed;
+    }
+}
+
+}  // namespace
+
+void driveJoints(int count, Vec3f* const* x, int vertexCount, const Mat3f* rootFrames, const JointParams* joints) {
+    int b = 0;
+    for (; b + 4 <= count; b += 4) driveLanes(x + b, vertexCount, rootFrames + b, joints + b);
+    for (; b < count; ++b) driveStrand(x[b], vertexCount, rootFrames[b], joints[b]);
 }
 
 void bendBounds(const Vec3f* restDir, int segments, float reach, float* restBend, float* cosMostBend,

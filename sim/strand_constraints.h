@@ -161,6 +161,15 @@ void bendBounds(const Vec3f* restDir, int segments, float reach, float* restBend
 void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFrame, const JointParams& joints,
                  const HeadQuery* head, float radius, Contact* contacts);
 
+/// The Drive pass of relaxJoints on `count` strands, x[k] the vertices of
+/// strand k with root frame rootFrames[k] and parameters joints[k]: the same
+/// values bit for bit as one relaxJoints call per strand, computed for four
+/// strands at a time in SIMD lanes. A strand's pass is one long chain of
+/// dependent operations (each joint waits on its parent's frame: quaternion
+/// products, square roots, divisions); lanes run four chains for the price
+/// of one.
+void driveJoints(int count, Vec3f* const* x, int vertexCount, const Mat3f* rootFrames, const JointParams* joints);
+
 /// Bend limits as spans: the angle between consecutive segments of lengths
 /// l0, l1 fixes the distance between their outer ends,
 ///   D(φ) = sqrt(l0² + l1² + 2·l0·l1·cos φ),

@@ -165,6 +165,47 @@ TEST(StrandKernels, PreloadSolveMakesRestAnEquilibrium) {
     for (int i = 0; i < n; ++i) EXPECT_LT((x[i] - rest[i]).norm(), 2e-6f) << "vertex " << i;
 }
 
+TEST(StrandKernels, DriveJointsMatchesOneStrandAtATimeBitForBit) {
+    // Seven strands: a lockstep block of four and three on their own, each
+    // with its own rest shape, springs, root frame and displaced input.
+    const int n = 24, count = 7;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    std::vector<std::vector<float>> len(count), spring(count), limitSpring(count), restBend(count), most(count),
+        least(count);
+    std::vector<std::vector<Vec3f>> restDir(count), springDir(count), x(count);
+    std::vector<JointParams> p(count);
+    std::vector<Mat3f> R(count);
+    for (int k = 0; k < count; ++k) {
+        len[k].assign(n - 1, 0.01f + 0.001f * float(k));
+        spring[k].assign(n - 1, 0.1f * float(k + 1));
+        limitSpring[k].assign(n - 1, 0.5f);
+        for (int j = 0; j < n - 1; ++j) {
+            restDir[k].push_back(Vec3f(0.2f * u(rng), 1.f, 0.2f * u(rng)).normalized());
+            springDir[k].push_back(Vec3f(0.3f * u(rng), 1.f, 0.3f * u(rng)).normalized());
+        }
+        restBend[k].resize(n - 1);
+        most[k].resize(n - 1);
+        least[k].resize(n - 1);
+        bendBounds(restDir[k].data(), n - 1, 35 * kDeg, restBend[k].data(), most[k].data(), least[k].data());
+        p[k] = JointParams{len[k].data(),    restDir[k].data(), restBend[k].data(), most[k].data(),
+                           least[k].data(),  springDir[k].data(), spring[k].data(), limitSpring[k].data(),
+                           30 * kDeg,        5 * kDeg};
+        R[k] = Eigen::AngleAxisf(0.4f * float(k), Vec3f(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
+        x[k] = randomChain(rng, n, len[k][0], 0.004f);
+    }
+    std::vector<std::vector<Vec3f>> one = x;
+    for (int k = 0; k < count; ++k) relaxJoints(JointPass::Drive, one[k].data(), n, R[k], p[k], nullptr, 0.f, nullptr);
+    std::vector<Vec3f*> xs;
+    for (auto& v : x) xs.push_back(v.data());
+    driveJoints(count, xs.data(), n, R.data(), p.data());
+    for (int k = 0; k < count; ++k)
+        for (int i = 0; i < n; ++i) {
+            EXPECT_EQ(x[k][i], one[k][i]) << "strand " << k << " vertex " << i;
+            EXPECT_NEAR((x[k][i] - x[k][std::max(i - 1, 0)]).norm(), i ? len[k][i - 1] : 0.f, 1e-5f);
+        }
+}
+
 TEST(StrandKernels, FinishPassKeepsLengthsAndTheProjectionLimit) {
     const int n = 24;
     std::vector<float> len(n - 1, 0.0108f), spring(n - 1, 0.3f), limitSpring(n - 1, 0.5f);

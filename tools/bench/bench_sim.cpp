@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -50,8 +51,17 @@ std::vector<SurfaceFrame> rootsAt(const std::vector<Vec3f>& dirs, float radius, 
     return roots;
 }
 
+/// CPU time of the whole process (all threads), s: on a machine shared with
+/// other jobs it measures the work, where wall-clock measures the contention.
+double processCpuSeconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
 struct RunResult {
     double stepsPerSecond = 0;
+    double cpuMsPerStep = 0;
     GuideStats stats;
 };
 
@@ -64,8 +74,12 @@ RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int 
     solver.initialize(rootsAt(dirs, radius, pose), pose);
     RunResult r;
     std::chrono::steady_clock::time_point start;
+    double cpu0 = 0;
     for (int k = 1; k <= warmup + steps; ++k) {
-        if (k == warmup + 1) start = std::chrono::steady_clock::now();
+        if (k == warmup + 1) {
+            start = std::chrono::steady_clock::now();
+            cpu0 = processCpuSeconds();
+        }
         pose = head.sample(double(k) * settings.timeStep);
         const GuideStats& s = solver.step(rootsAt(dirs, radius, pose), pose);
         if (k > warmup) {
@@ -77,6 +91,7 @@ RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int 
     // a shot driver pays them too (they are small next to the step).
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     r.stepsPerSecond = steps / seconds;
+    r.cpuMsPerStep = 1000.0 * (processCpuSeconds() - cpu0) / steps;
     return r;
 }
 
@@ -118,9 +133,9 @@ int main(int argc, char** argv) {
                 "24 vertices, 0.25 m, collision radius 1 mm; substeps %d, iterations %d, %d guides per world; "
                 "median of %d runs (min-max)\n\n",
                 rate, warmup, steps, substeps, iterations, perWorld, runs);
-    std::printf("| guides | formulation | strand coll. | threads | steps/s median (min-max) | max stretch | "
-                "max penetration mm | NaN | ms/step | strand contacts/step (max) |\n");
-    std::printf("|---:|---|---|---:|---|---:|---:|---:|---:|---:|\n");
+    std::printf("| guides | formulation | strand coll. | threads | steps/s median (min-max) | CPU ms/step (min) | "
+                "max stretch | max penetration mm | NaN | strand contacts/step (max) | load avg |\n");
+    std::printf("|---:|---|---|---:|---|---:|---:|---:|---:|---:|---:|\n");
     for (const std::string& gs : guideList)
         for (const std::string& form : formList)
             for (const std::string& coll : collList)
@@ -135,18 +150,22 @@ int main(int argc, char** argv) {
                     s.preload = preload;
                     std::vector<RunResult> results;
                     for (int r = 0; r < runs; ++r) results.push_back(runOnce(s, std::stoul(gs), rate, warmup, steps));
-                    std::vector<double> sps;
+                    std::vector<double> sps, cpu;
                     GuideStats worst = results[0].stats;
                     for (const RunResult& r : results) {
                         sps.push_back(r.stepsPerSecond);
+                        cpu.push_back(r.cpuMsPerStep);
                         worst.accumulate(r.stats);
                     }
                     std::sort(sps.begin(), sps.end());
+                    std::sort(cpu.begin(), cpu.end());
                     const double median = sps[sps.size() / 2];
-                    std::printf("| %s | %s | %s | %s | %.1f (%.1f-%.1f) | %.2e | %.3f | %zu | %.3f | %zu |\n",
+                    double load[1] = {0};
+                    getloadavg(load, 1);
+                    std::printf("| %s | %s | %s | %s | %.1f (%.1f-%.1f) | %.2f (%.2f) | %.2e | %.3f | %zu | %zu | %.2f |\n",
                                 gs.c_str(), form.c_str(), coll.c_str(), th.c_str(), median, sps.front(), sps.back(),
-                                worst.maxLengthError, worst.maxPenetration * 1000.0, worst.nanCount, 1000.0 / median,
-                                worst.strandContacts);
+                                cpu[cpu.size() / 2], cpu.front(), worst.maxLengthError,
+                                worst.maxPenetration * 1000.0, worst.nanCount, worst.strandContacts, load[0]);
                     std::fflush(stdout);
                 }
     return 0;
