@@ -238,7 +238,8 @@ SampleResult shadeSample(const ShadingContext& ctx, const Vec3f& origin, const V
     r.hit = true;
     const Camera& cam = ctx.view.camera;
     r.depth = (origin + hit.t * dir - cam.position).dot((cam.target - cam.position).normalized());
-    if (hit.kind == SceneHit::Kind::Hair) r.strandId = ctx.scene.strandId(hit.strand);
+    // The id table is large and cold: read it only for the id layer.
+    if (hit.kind == SceneHit::Kind::Hair && ctx.settings.strandIdLayer) r.strandId = ctx.scene.strandId(hit.strand);
     return r;
 }
 
