@@ -17,17 +17,17 @@ float safeAsin(float x) { return std::asin(std::clamp(x, -1.f, 1.f)); }
 /// in (x/3.75)²) and 9.8.2 (x > 3.75: √x e^−x I0(x) in 3.75/x), both with
 /// relative error below 1e-6: one logarithm instead of a series that needs
 /// dozens of terms near x = 12. Working in logs keeps Mp finite for tiny
-/// variances (x in the hundreds).
-double logI0(double x) {
-    if (x <= 3.75) {
-        const double t = (x / 3.75) * (x / 3.75);
-        return std::log(1.0 + t * (3.5156229 + t * (3.0899424 + t * (1.2067492 +
-                                   t * (0.2659732 + t * (0.0360768 + t * 0.0045813))))));
+/// variances (x in the thousands).
+float logI0(float x) {
+    if (x <= 3.75f) {
+        const float t = (x / 3.75f) * (x / 3.75f);
+        return std::log(1.f + t * (3.5156229f + t * (3.0899424f + t * (1.2067492f +
+                                   t * (0.2659732f + t * (0.0360768f + t * 0.0045813f))))));
     }
-    const double r = 3.75 / x;
-    const double p =
-        0.39894228 + r * (0.01328592 + r * (0.00225319 + r * (-0.00157565 + r * (0.00916281 +
-        r * (-0.02057706 + r * (0.02635537 + r * (-0.01647633 + r * 0.00392377)))))));
+    const float r = 3.75f / x;
+    const float p =
+        0.39894228f + r * (0.01328592f + r * (0.00225319f + r * (-0.00157565f + r * (0.00916281f +
+        r * (-0.02057706f + r * (0.02635537f + r * (-0.01647633f + r * 0.00392377f)))))));
     return x + std::log(p / std::sqrt(x));
 }
 
@@ -35,13 +35,16 @@ double logI0(double x) {
 /// ∫ Mp cos θi dθi = 1:
 ///   Mp = csch(1/v) / (2v) · exp(−sin θi sin θo / v) · I0(cos θi cos θo / v),
 /// evaluated in logs: csch(1/v)/(2v) = e^(−1/v) / (v (1 − e^(−2/v))), whose
-/// log (`logNorm`, mpLogNormalization) depends on v only.
+/// log (`logNorm`, mpLogNormalization) depends on v only. The sum of logs is
+/// taken in float (float exp/log cost half the double ones): its terms are of
+/// the order 1/v and cancel, so Mp's relative error is about 1e-7/v, 1e-6 at
+/// the default roughness and below 0.2% at the smallest (β_m = 0.01).
 double mpLogNormalization(double v) { return -1.0 / v - std::log(v) - std::log1p(-std::exp(-2.0 / v)); }
 
 float Mp(float cosThetaI, float cosThetaO, float sinThetaI, float sinThetaO, float v, double logNorm) {
-    const double a = double(cosThetaI) * cosThetaO / v;
-    const double b = double(sinThetaI) * sinThetaO / v;
-    return float(std::exp(logI0(a) - b + logNorm));
+    const float a = cosThetaI * cosThetaO / v;
+    const float b = sinThetaI * sinThetaO / v;
+    return std::exp(logI0(a) - b + float(logNorm));
 }
 
 /// Unpolarised Fresnel reflectance of a dielectric of relative index `eta`
