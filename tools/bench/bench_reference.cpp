@@ -11,7 +11,7 @@
 //   bench_reference [--strands 10000,100000] [--modes physical,kajiya-kay]
 //                   [--width 1920] [--height 1080] [--spp 16] [--bounces 4]
 //                   [--repeat 1] [--threads 2] [--out DIR] [--no-head] [--no-shadows]
-//                   [--melanin 1.3] [--shadow-roulette 0.03125 (0: off)]
+//                   [--melanin 1.3] [--shadow-roulette 0.03125 (0: off)] [--seed 1]
 #include "render/reference.h"
 #include "sim/head.h"
 #include "sim/synthetic.h"
@@ -59,6 +59,7 @@ int main(int argc, char** argv) {
     bool withHead = true, shadows = true;
     float melanin = 1.3f;
     float shadowRoulette = ReferenceSettings{}.shadowRouletteThreshold;
+    uint64_t seed = 1;
     std::string out;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -82,6 +83,7 @@ int main(int argc, char** argv) {
         else if (a == "--no-shadows") shadows = false;
         else if (a == "--melanin") melanin = std::stof(next());
         else if (a == "--shadow-roulette") shadowRoulette = std::stof(next());
+        else if (a == "--seed") seed = std::stoull(next());
         else {
             std::fprintf(stderr, "unknown option %s (see the comment at the top of bench_reference.cpp)\n", a.c_str());
             return 1;
@@ -118,7 +120,7 @@ int main(int argc, char** argv) {
             s.mode = modeName == "physical" ? ReferenceMode::Physical : ReferenceMode::KajiyaKay;
             s.samplesPerPixel = spp;
             s.bounces = bounces;
-            s.seed = 1;
+            s.seed = seed;
             s.frame = 1;
             s.shadows = shadows;
             s.fiber.sigmaA = hairAbsorptionFromMelanin(melanin, 0.f);
