@@ -24,6 +24,11 @@ void addReferenceKeys(SchemaBuilder& b) {
                  "Physical mode: indirect bounces after the first hit, as Cycles' max bounces (0 = direct light "
                  "only).")
         .flag("reference.shadows", true, "Trace shadow rays toward each light.")
+        .number("reference.shadow_roulette", 0.03125, 0, 10, "1/sr",
+                "Physical mode: a light sample whose unshadowed contribution (path throughput x BSDF, max over "
+                "RGB) is below this traces its shadow ray only with probability contribution/threshold, weighted "
+                "by the inverse: unbiased and much faster for dark hair, slightly noisier; 0 traces every shadow "
+                "ray.")
         .number("reference.hair_transmittance", 0.8, 0, 1, "",
                 "Kajiya-Kay mode: fraction of light a shadow ray keeps at each strand it crosses (0 = opaque "
                 "hair, 1 = hair casts no shadow); the head is opaque. Physical mode carries light through hair "

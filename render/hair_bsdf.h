@@ -60,7 +60,12 @@ class HairModel {
 
     const HairFiberParams& params() const { return params_; }
     float variance(int lobe) const { return v_[lobe]; }
+    /// log of Mp's normalisation csch(1/v)/(2v) for the lobe's variance
+    /// (per material, so each Mp costs one exponential less).
+    double logMpNormalization(int lobe) const { return logMpNorm_[lobe]; }
     float logisticScale() const { return s_; }
+    /// 1 / (logistic CDF(π) − CDF(−π)): normalisation of the trimmed Np.
+    float logisticTrimScale() const { return trim_; }
     /// sin/cos of 2^k α, k = 0, 1, 2 (tilt of TT, R and TRT).
     float sin2kAlpha(int k) const { return sin2kAlpha_[k]; }
     float cos2kAlpha(int k) const { return cos2kAlpha_[k]; }
@@ -68,7 +73,9 @@ class HairModel {
   private:
     HairFiberParams params_;
     float v_[kLobes];
+    double logMpNorm_[kLobes];
     float s_;
+    float trim_;
     float sin2kAlpha_[3], cos2kAlpha_[3];
 };
 
@@ -99,6 +106,11 @@ class HairBsdf {
   private:
     struct Angles;
     Angles angles(const Vec3f& wo, const Vec3f& wi) const;
+    /// eval() and, when `pdf` is given, pdf() in one pass: both are sums of
+    /// the same Mp·Np products, weighted by attenuation or by lobe probability.
+    Vec3f evaluate(const Vec3f& wo, const Vec3f& wi, Vec3f* lobes, float* pdf) const;
+    /// Lobe selection probabilities from the lobes' attenuations.
+    static void lobePdf(const Vec3f ap[HairModel::kLobes], float out[HairModel::kLobes]);
     /// Lobe selection probabilities, from the attenuations seen along wo.
     void lobePdf(float sinThetaO, float cosThetaO, float out[HairModel::kLobes]) const;
     /// γt for this h and θo; *T receives one internal chord's transmittance.

@@ -81,6 +81,7 @@ uint64_t renderTile(const ShadingContext& ctx, Image& image, int x0, int y0, int
     const int idChannel = s.strandIdLayer ? nc - 1 : -1;
     const float inv = 1.f / float(s.samplesPerPixel);
     const FlushDenormals flush;
+    const CameraRays camera(cam);
     uint64_t rays = 0;
     for (int y = y0; y < y1; ++y) {
         for (int x = x0; x < x1; ++x) {
@@ -92,7 +93,7 @@ uint64_t renderTile(const ShadingContext& ctx, Image& image, int x0, int y0, int
             for (int i = 0; i < s.samplesPerPixel; ++i) {
                 sampler.start(uint32_t(i));
                 const Vec2f u = sampler.next2D();
-                const Vec3f dir = cam.rayDirection(float(x) + u.x(), float(y) + u.y());
+                const Vec3f dir = camera.direction(float(x) + u.x(), float(y) + u.y());
                 const SceneHit hit = ctx.scene.intersect(cam.position, dir, 0.f, std::numeric_limits<float>::infinity());
                 const SampleResult r = shadeSample(ctx, cam.position, dir, hit, sampler);
                 rays += r.rays;

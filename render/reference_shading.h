@@ -24,7 +24,7 @@ struct SampleResult {
     Vec3f specular = Vec3f::Zero();  ///< kajiya-kay: specular term; physical: R lobe of direct light at the first hit
     bool hit = false;
     float depth = 0.f;               ///< view-space depth of the first hit
-    int64_t strandId = -1;           ///< stable id of the strand hit first, −1 for head or nothing
+    int64_t strandId = -1;           ///< stable id of the strand hit first (with the id layer only), −1 for head or nothing
     uint32_t rays = 0;
 };
 

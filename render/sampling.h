@@ -77,6 +77,7 @@ class PixelSampler {
     void start(uint32_t index) {
         index_ = index;
         dimension_ = 0;
+        side_ = 0;
     }
 
     /// The next stratified 2D point in [0, 1)^2.
@@ -90,10 +91,21 @@ class PixelSampler {
     /// The next number in [0, 1) (one dimension of a fresh pair).
     float next1D() { return next2D().x(); }
 
+    /// The next number of a second, independent dimension sequence, for
+    /// decisions that are made only sometimes (shadow-ray roulette): drawing
+    /// them here leaves the main dimensions where they would be without
+    /// them, so switching such a decision on or off changes nothing else.
+    float nextSide() {
+        const uint64_t h = hashCombine(key_, kSide | side_++);
+        return toUnit(owenScramble(sobol0(owenScramble(index_, uint32_t(h))), uint32_t(h >> 32)));
+    }
+
   private:
     uint64_t key_;
     uint32_t index_ = 0;
     uint64_t dimension_ = 0;
+    uint64_t side_ = 0;
+    static constexpr uint64_t kSide = 1ull << 63;  ///< side dimensions never meet the main ones
 };
 
 /// Cosine-weighted direction on the hemisphere around +Z (pdf cos(theta)/pi).

@@ -30,15 +30,16 @@ Mat4f Camera::projection() const {
     return m;
 }
 
-Vec3f Camera::rayDirection(float x, float y) const {
-    const Vec3f f = (target - position).normalized();
-    const Vec3f s = f.cross(up).normalized();
-    const Vec3f u = s.cross(f);
-    const float tanHalf = std::tan(0.5f * fovY * float(M_PI) / 180.f);
-    const float ndcX = (2.f * x / width - 1.f) * tanHalf * aspect();
-    const float ndcY = (1.f - 2.f * y / height) * tanHalf;
-    return (f + ndcX * s + ndcY * u).normalized();
-}
+CameraRays::CameraRays(const Camera& c)
+    : forward_((c.target - c.position).normalized()),
+      side_(forward_.cross(c.up).normalized()),
+      up_(side_.cross(forward_)),
+      tanHalf_(std::tan(0.5f * c.fovY * float(M_PI) / 180.f)),
+      aspect_(c.aspect()),
+      width_(float(c.width)),
+      height_(float(c.height)) {}
+
+Vec3f Camera::rayDirection(float x, float y) const { return CameraRays(*this).direction(x, y); }
 
 Vec3f Light::toLight(const Vec3f& p, Vec3f* radiance, float* distance) const {
     if (type == LightType::Directional) {

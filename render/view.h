@@ -35,6 +35,24 @@ struct Camera {
     Vec3f rayDirection(float x, float y) const;
 };
 
+/// Camera::rayDirection with the camera basis and field-of-view factors
+/// computed once: renderers call it for millions of rays per frame.
+class CameraRays {
+  public:
+    explicit CameraRays(const Camera& camera);
+    /// Same as camera.rayDirection(x, y), bit for bit.
+    Vec3f direction(float x, float y) const {
+        const float ndcX = (2.f * x / width_ - 1.f) * tanHalf_ * aspect_;
+        const float ndcY = (1.f - 2.f * y / height_) * tanHalf_;
+        return (forward_ + ndcX * side_ + ndcY * up_).normalized();
+    }
+
+  private:
+    Vec3f forward_, side_, up_;
+    float tanHalf_, aspect_;
+    float width_, height_;
+};
+
 enum class LightType { Directional, Point };
 
 struct Light {

@@ -177,6 +177,39 @@ TEST(Reference, SameBitsForOneAndTwoThreads) {
     }
 }
 
+TEST(Reference, ShadowRouletteKeepsTheMeanAndSavesRays) {
+    // Dark hair: most light samples are small, so roulette skips most of
+    // their shadow rays; weighting the traced ones by 1/q keeps the mean.
+    SyntheticHairSettings hs;
+    hs.strands = 3000;
+    const StrandFrame strands = makeSyntheticHair(hs);
+    const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
+    View view = testView(64, 48, Vec3f(-1.f, -1.f, -1.f));
+    view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
+    ReferenceSettings s;
+    s.mode = ReferenceMode::Physical;
+    s.samplesPerPixel = 64;
+    s.bounces = 2;
+    auto render = [&](float threshold, ReferenceStats* stats) {
+        s.shadowRouletteThreshold = threshold;
+        const Image img = ReferenceRenderer().render(view, &strands, &head, s, stats);
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (int y = 0; y < img.height; ++y)
+            for (int x = 0; x < img.width; ++x)
+                for (int c = 0; c < 3; ++c) sum[c] += img.at(x, y, c);
+        return sum;
+    };
+    ReferenceStats all, roulette;
+    const Eigen::Vector3d exact = render(0.f, &all);
+    const Eigen::Vector3d skipped = render(0.25f, &roulette);
+    const double camera = double(view.camera.width) * view.camera.height * s.samplesPerPixel;
+    EXPECT_LT(double(roulette.rays) - camera, 0.75 * (double(all.rays) - camera));  // shadow + bounce rays
+    for (int c = 0; c < 3; ++c) {
+        ASSERT_GT(exact[c], 1.0) << "channel " << c;  // the hair is lit
+        EXPECT_NEAR(skipped[c] / exact[c], 1.0, 0.03) << "channel " << c;
+    }
+}
+
 TEST(Reference, NoEmbreeMemoryGrowthAcrossFrames) {
     ReferenceRenderer renderer;
     const int64_t idle = renderer.embreeBytesInUse();

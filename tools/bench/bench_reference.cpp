@@ -11,7 +11,7 @@
 //   bench_reference [--strands 10000,100000] [--modes physical,kajiya-kay]
 //                   [--width 1920] [--height 1080] [--spp 16] [--bounces 4]
 //                   [--repeat 1] [--threads 2] [--out DIR] [--no-head] [--no-shadows]
-//                   [--melanin 1.3]
+//                   [--melanin 1.3] [--shadow-roulette 0.03125 (0: off)] [--seed 1]
 #include "render/reference.h"
 #include "sim/head.h"
 #include "sim/synthetic.h"
@@ -58,6 +58,8 @@ int main(int argc, char** argv) {
     int width = 1920, height = 1080, spp = 16, bounces = 4, repeat = 1, threads = 2;
     bool withHead = true, shadows = true;
     float melanin = 1.3f;
+    float shadowRoulette = ReferenceSettings{}.shadowRouletteThreshold;
+    uint64_t seed = 1;
     std::string out;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -80,6 +82,8 @@ int main(int argc, char** argv) {
         else if (a == "--no-head") withHead = false;
         else if (a == "--no-shadows") shadows = false;
         else if (a == "--melanin") melanin = std::stof(next());
+        else if (a == "--shadow-roulette") shadowRoulette = std::stof(next());
+        else if (a == "--seed") seed = std::stoull(next());
         else {
             std::fprintf(stderr, "unknown option %s (see the comment at the top of bench_reference.cpp)\n", a.c_str());
             return 1;
@@ -101,8 +105,8 @@ int main(int argc, char** argv) {
     view.environment = Vec3f::Zero();
     const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 32, 64);
 
-    std::printf("# bench_reference: %dx%d, %d spp, %d bounces (physical), %d threads, head %s, synthetic hair\n",
-                width, height, spp, bounces, threads, withHead ? "on" : "off");
+    std::printf("# bench_reference: %dx%d, %d spp, %d bounces (physical), %d threads, head %s, shadow roulette %g, synthetic hair\n",
+                width, height, spp, bounces, threads, withHead ? "on" : "off", shadowRoulette);
     std::printf("%-8s %-11s %8s %9s %9s %9s %8s %8s %8s %10s %10s %9s\n", "strands", "mode", "build_s", "render_s",
                 "frame_s", "spread_s", "bcpu_s", "rcpu_s", "rays/spl", "embree_MB", "emb_peakMB", "rss_MB");
     ReferenceRenderer renderer;
@@ -116,10 +120,11 @@ int main(int argc, char** argv) {
             s.mode = modeName == "physical" ? ReferenceMode::Physical : ReferenceMode::KajiyaKay;
             s.samplesPerPixel = spp;
             s.bounces = bounces;
-            s.seed = 1;
+            s.seed = seed;
             s.frame = 1;
             s.shadows = shadows;
             s.fiber.sigmaA = hairAbsorptionFromMelanin(melanin, 0.f);
+            s.shadowRouletteThreshold = shadowRoulette;
             std::vector<double> frame, build, render, bcpu, rcpu;
             ReferenceStats st;
             Image image;
