@@ -29,6 +29,7 @@ PreviewSettings makePreviewSettings(const Scene& s) {
     sh.sumAlongLight = s.flag("preview.shadow.sum");
     sh.resolution = int(s.integer("preview.shadow.resolution"));
     sh.filter = s.flag("preview.shadow.filter");
+    sh.weight = s.text("preview.shadow.weight") == "fragments" ? VoxelWeight::Fragments : VoxelWeight::Crossings;
     sh.alpha = float(s.number("preview.shadow.alpha"));
     sh.shadowMap = s.flag("preview.shadow.map");
     sh.shadowMapSize = int(s.integer("preview.shadow.map_size"));

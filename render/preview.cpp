@@ -187,7 +187,12 @@ struct PreviewRenderer::Impl {
         set4(u.hairShape, h.shininess, h.secondaryShininess, h.primaryShift, h.secondaryShift);
         set3(u.headColor, view.head.color, view.head.ambient);
         const PreviewShadowSettings& sh = settings.shadow;
-        set4(u.shadow, sh.alpha, float(std::max(0, sh.pcfRadius)), 1.f / float(std::max(1, sh.shadowMapSize)), 0.002f);
+        // Optical depth of one unit of C (shaders/shadow.glsl).
+        const float depthPerUnit = sh.weight == VoxelWeight::Crossings
+                                       ? 1.f - std::clamp(h.transmittance, 0.f, 1.f)
+                                       : -std::log(std::clamp(sh.alpha, 1e-6f, 1.f));
+        set4(u.shadow, depthPerUnit, float(std::max(0, sh.pcfRadius)), 1.f / float(std::max(1, sh.shadowMapSize)),
+             0.002f);
         set4(u.tess, float(std::clamp(settings.tessellationLevel, 1, 64)), settings.tessellationPixels * float(ss),
              settings.curve == CurveType::BSpline ? 1.f : 0.f, settings.minPixelWidth * float(ss));
         set4(u.blend, blendReference, std::max(settings.blendDepthScale, 1e-5f), 0.f, 0.f);
@@ -258,7 +263,10 @@ struct PreviewRenderer::Impl {
             glDepthMask(GL_FALSE);
             glBindImageTexture(0, shadows.voxels, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
             const int mode = sh.mode == VoxelMode::Binary ? 0 : (sh.splat == VoxelSplat::Trilinear ? 2 : 1);
-            for (const GlProgram* p : {&strandVoxel, &furVoxel}) glProgramUniform1i(p->id(), p->uniform("uMode"), mode);
+            for (const GlProgram* p : {&strandVoxel, &furVoxel}) {
+                glProgramUniform1i(p->id(), p->uniform("uMode"), mode);
+                glProgramUniform1i(p->id(), p->uniform("uCrossings"), sh.weight == VoxelWeight::Crossings ? 1 : 0);
+            }
             drawStrands(strandVoxel);
             drawFur(furVoxel);
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
@@ -530,7 +538,7 @@ VoxelSnapshot PreviewRenderer::readVoxels() const {
     std::vector<uint32_t> raw(n);
     glGetTextureImage(m.shadows.voxels, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(n * 4), raw.data());
     snap.raw.resize(n);
-    for (size_t i = 0; i < n; ++i) snap.raw[i] = float(raw[i]) / 256.f;
+    for (size_t i = 0; i < n; ++i) snap.raw[i] = float(raw[i]) / kVoxelUnit;
     snap.summed.resize(n);
     glGetTextureImage(m.shadows.density, 0, GL_RED, GL_FLOAT, GLsizei(n * 4), snap.summed.data());
     return snap;

@@ -56,6 +56,10 @@ enum class VoxelMode { Binary, Additive };
 /// Seed 004's splatting of a fragment into the grid: its voxel, or trilinear
 /// weights over the 8 nearest voxel centres (additive only).
 enum class VoxelSplat { Nearest, Trilinear };
+/// What a voxel counts: expected strand crossings of a light ray (each
+/// fragment weighted by its strand's projected area in the voxel's column),
+/// or fragments (seed 004: each fragment adds 1, whatever the hair's width).
+enum class VoxelWeight { Crossings, Fragments };
 
 /// Shadows of the one shadowed light (other lights are unshadowed).
 struct PreviewShadowSettings {
@@ -70,9 +74,15 @@ struct PreviewShadowSettings {
     /// Average C over 2 x 2 voxels across the beam at lookup: hides the moire
     /// rings regularly spaced hair casts through one-voxel-wide lines.
     bool filter = true;
-    /// Transmittance alpha per unit of C: light reaching a point is alpha^C,
-    /// where C counts strand fragments (Additive) or occupied voxels (Binary)
-    /// between the light and the point.
+    /// Crossings (default): C is the number of strand crossings a light ray
+    /// expects in front of a point (Additive; Binary: each occupied voxel
+    /// counts as one crossing of its widest strand), and light reaching the
+    /// point is exp(-(1 - T) C) with T = View::hair.transmittance, the
+    /// reference renderer's per-crossing transmittance: both renderers derive
+    /// hair shadows from that one parameter. Fragments: the seed's count,
+    /// light = alpha^C with the `alpha` below.
+    VoxelWeight weight = VoxelWeight::Crossings;
+    /// Fragments only: transmittance per counted fragment (or occupied voxel).
     float alpha = 0.85f;
     bool shadowMap = true;        ///< PCF shadow map of the opaque head (hair and head receive it)
     int shadowMapSize = 2048;
@@ -126,7 +136,8 @@ struct PreviewStats {
 };
 
 /// The shadow grid after the last draw: raw voxel values V and the summed C
-/// the shading reads (both in units of one fragment), plus the mapping.
+/// the shading reads (both in strand crossings, or fragments with
+/// VoxelWeight::Fragments), plus the mapping.
 struct VoxelSnapshot {
     int resolution = 0;
     LightGrid grid;

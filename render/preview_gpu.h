@@ -40,6 +40,8 @@ struct FrameUniforms {
 inline constexpr int kFlagVoxels = 1;
 inline constexpr int kFlagShadowMap = 2;
 inline constexpr int kFlagVoxelFilter = 4;
+/// Fixed point of the r32ui voxel grid (kVoxelUnit in shaders/common.glsl).
+inline constexpr float kVoxelUnit = 4096.f;
 
 /// A buffer mapped once for writing and kept mapped (GL 4.4 persistent,
 /// coherent mapping): per-frame uploads are a memcpy, and the storage is only
