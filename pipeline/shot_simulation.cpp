@@ -26,6 +26,16 @@ double msSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+/// The largest step <= maxStep that divides the frame interval, so every
+/// frame falls on a step and is written without interpolation (a root
+/// interpolated between two steps cuts the chord of its arc on a turning head).
+float frameAlignedStep(double fps, double maxStep) {
+    const double frame = 1.0 / fps;
+    // The step keys are floats (0.02f is 0.0199999996): compare with a tolerance.
+    const double steps = std::max(1.0, std::ceil(frame / maxStep - 1e-5));
+    return float(frame / steps);
+}
+
 void evaluateRoots(const TriangleMesh& mesh, const std::vector<SurfacePoint>& roots, std::vector<SurfaceFrame>& out) {
     out.resize(roots.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, roots.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
@@ -50,6 +60,9 @@ class GuideModel {
     virtual size_t guideCount() const = 0;
     /// -1 unless the model has a saturation.
     virtual double saturation() const { return -1; }
+    /// False when the model's state cannot be saved exactly (then a stopped
+    /// simulation restarts from the first frame instead of a checkpoint).
+    virtual bool canCheckpoint() const { return true; }
     virtual std::vector<char> saveState() const = 0;
     virtual void restoreState(const std::vector<char>& state) = 0;
     virtual const char* name() const = 0;
@@ -71,6 +84,7 @@ class RigidChainModel final : public GuideModel {
     }
     void write(StrandFrame& frame, double time) const override { solver_.write(frame, time); }
     size_t guideCount() const override { return solver_.guideCount(); }
+    bool canCheckpoint() const override { return solver_.settings().formulation == GuideFormulation::Rope; }
     std::vector<char> saveState() const override { return solver_.saveState(); }
     void restoreState(const std::vector<char>& state) override { solver_.restoreState(state); }
     const char* name() const override { return formulationName(solver_.settings().formulation); }
@@ -157,8 +171,15 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame)
     head_ = loadHead(scene);
     roots_ = placeGroomRoots(scene, head_);
     if (roots_.guides.empty()) scene.fail("hair.guides.count", "the groom needs at least one guide");
-    if (usesCurlyWetModel(scene)) model_ = std::make_unique<CurlyWetModel>(scene, curlyWetSettings(scene));
-    else model_ = std::make_unique<RigidChainModel>(guideSettings(scene));
+    if (usesCurlyWetModel(scene)) {
+        CurlyWetSettings settings = curlyWetSettings(scene);
+        settings.timeStep = frameAlignedStep(fps, settings.timeStep);
+        model_ = std::make_unique<CurlyWetModel>(scene, settings);
+    } else {
+        GuideSettings settings = guideSettings(scene);
+        settings.timeStep = frameAlignedStep(fps, settings.timeStep);
+        model_ = std::make_unique<RigidChainModel>(settings);
+    }
 
     const double t0 = startFrame / fps;
     pose_ = head_.motion->sample(t0);
@@ -205,16 +226,17 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame)
 ShotSimulation::~ShotSimulation() = default;
 
 size_t ShotSimulation::guideCount() const { return model_->guideCount(); }
+bool ShotSimulation::canCheckpoint() const { return model_->canCheckpoint(); }
 size_t ShotSimulation::followerCount() const { return followers_->followerCount(); }
 
 const StrandFrame& ShotSimulation::advanceTo(int frame) {
     if (frame < frame_) throw std::logic_error(cat("simulation cannot go back from frame ", frame_, " to ", frame));
     if (frame == frame_) return strands_;
     const double target = frame / fps_;
-    // Step while the next step ends no later than the frame (plus rounding);
-    // one more step when the frame falls between steps, so it can be
-    // interpolated from the two steps around it.
-    while (model_->time() < target - 1e-9) {
+    // Steps are frame-aligned, so the frame is a step's end; the tolerance
+    // absorbs the rounding of a float step accumulated over the shot.
+    const double tolerance = 1e-4 / fps_;
+    while (model_->time() < target - tolerance) {
         const double t = model_->nextTime();
         const auto headStart = std::chrono::steady_clock::now();
         const HeadPose pose = head_.motion->sample(t);
@@ -228,7 +250,7 @@ const StrandFrame& ShotSimulation::advanceTo(int frame) {
                                  " non-finite guide values; try a smaller simulation.time_step or more substeps"));
     }
     frame_ = frame;
-    produceFrame(target);
+    produceFrame(std::min(target, model_->time()));
     return strands_;
 }
 

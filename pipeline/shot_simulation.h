@@ -3,11 +3,13 @@
 // and the followers are rebuilt from the guides at every output frame.
 //
 // Time: the shot starts at the scene's first frame (frames.front() / fps),
-// whatever subset of frames a run asks for. Guides step at the model's fixed
-// step (simulation.time_step, 0.02 s by default, as in seed 000); a frame
-// between two steps is written from the two surrounding steps (the solvers
-// interpolate and restore segment lengths), so the step size never depends
-// on the frame rate.
+// whatever subset of frames a run asks for. Guides step at a fixed step: the
+// largest one not above the model's time step (simulation.time_step, 0.02 s
+// as in seed 000) that divides the frame interval, so every frame is a step's
+// end (0.02 s itself at 25 or 50 fps; three steps of 13.9 ms at 24 fps).
+// Writing a frame between two steps instead would interpolate each root
+// along the chord of its arc, off the turning scalp. The solvers' damping
+// does not depend on the step size.
 #pragma once
 
 #include "pipeline/head_setup.h"
@@ -57,6 +59,9 @@ class ShotSimulation {
     size_t guideCount() const;
     size_t followerCount() const;
 
+    /// False for models whose state cannot be restored bit for bit (the rigid
+    /// formulation keeps orientations and warm-start impulses inside Bullet).
+    bool canCheckpoint() const;
     /// Writes the complete simulation state at frame() (the solver state; the
     /// frame's strands themselves are the strand cache's job).
     void saveCheckpoint(const std::filesystem::path& file) const;

@@ -93,6 +93,12 @@ BulletCurlyWorld::BulletCurlyWorld(CurlySet& set, size_t begin, size_t end) : se
         // starts from the rest shape (initialize puts every guide there).
         auto* body = new btSoftBody(&info, n, pos.data(), mass.data());
         for (int j = 0; j + 1 < n; ++j) body->appendLink(j, j + 1);
+        // Bullet fixes link rest lengths from the node positions at a body's
+        // first step (m_bUpdateRtCst); settle them now, from the rest shape,
+        // so a solver restored from a checkpoint before its first step keeps
+        // the rest lengths of the run that saved it.
+        body->updateConstants();
+        body->m_bUpdateRtCst = false;
         btSoftBody::Config& cfg = body->m_cfg;
         cfg.piterations = s.iterations;
         cfg.viterations = 0;

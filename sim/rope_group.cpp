@@ -186,10 +186,14 @@ RopeGroup::RopeGroup(GuideSet& set, size_t begin, size_t end) : GuideGroup(set, 
             pos[i] = bt(set.x[set.vertex(g, i)]);
             mass[i] = set.mass[set.vertex(g, i)];  // root: 0 = kinematic
         }
-        // Bullet takes each link's rest length from the nodes at its first
-        // step, which is always taken from the rest shape.
+        // Bullet fixes link rest lengths from the node positions at a body's
+        // first step (m_bUpdateRtCst); settle them now, from the rest shape,
+        // so a solver restored from a checkpoint before its first step keeps
+        // the rest lengths of the run that saved it.
         auto* body = new btSoftBody(&info, n, pos.data(), mass.data());
         for (int j = 0; j < set.segments; ++j) body->appendLink(j, j + 1);
+        body->updateConstants();
+        body->m_bUpdateRtCst = false;
         btSoftBody::Config& cfg = body->m_cfg;
         cfg.piterations = 0;  // the link iterations run in StrandSoftBodySolver, with the limits
         cfg.viterations = 0;

@@ -11,7 +11,7 @@
 //
 //   bench_sim [--guides 94,845] [--formulation rope,rigid] [--strand-collision off,on]
 //             [--threads 1,2] [--runs 3] [--warmup 20] [--steps 250]
-//             [--substeps 1] [--iterations 20] [--per-world 16] [--rate 90]
+//             [--substeps 1] [--iterations 20] [--per-world 16] [--rate 90] [--preload on|off]
 #include "sim/fibonacci.h"
 #include "sim/guides.h"
 
@@ -87,6 +87,7 @@ int main(int argc, char** argv) {
         threadList{"1", "2"};
     int runs = 3, warmup = 20, steps = 250, substeps = 1, iterations = 20, perWorld = 16;
     float rate = 90.f;
+    bool preload = true;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string {
@@ -107,6 +108,7 @@ int main(int argc, char** argv) {
         else if (a == "--iterations") iterations = std::stoi(next());
         else if (a == "--per-world") perWorld = std::stoi(next());
         else if (a == "--rate") rate = std::stof(next());
+        else if (a == "--preload") preload = next() != "off";
         else {
             std::fprintf(stderr, "bench_sim: unknown option %s\n", a.c_str());
             return 1;
@@ -117,8 +119,8 @@ int main(int argc, char** argv) {
                 "median of %d runs (min-max)\n\n",
                 rate, warmup, steps, substeps, iterations, perWorld, runs);
     std::printf("| guides | formulation | strand coll. | threads | steps/s median (min-max) | max stretch | "
-                "max penetration mm | NaN | ms/step |\n");
-    std::printf("|---:|---|---|---:|---|---:|---:|---:|---:|\n");
+                "max penetration mm | NaN | ms/step | strand contacts/step (max) |\n");
+    std::printf("|---:|---|---|---:|---|---:|---:|---:|---:|---:|\n");
     for (const std::string& gs : guideList)
         for (const std::string& form : formList)
             for (const std::string& coll : collList)
@@ -130,6 +132,7 @@ int main(int argc, char** argv) {
                     s.substeps = substeps;
                     s.iterations = iterations;
                     s.strandsPerWorld = perWorld;
+                    s.preload = preload;
                     std::vector<RunResult> results;
                     for (int r = 0; r < runs; ++r) results.push_back(runOnce(s, std::stoul(gs), rate, warmup, steps));
                     std::vector<double> sps;
@@ -140,10 +143,10 @@ int main(int argc, char** argv) {
                     }
                     std::sort(sps.begin(), sps.end());
                     const double median = sps[sps.size() / 2];
-                    std::printf("| %s | %s | %s | %s | %.1f (%.1f-%.1f) | %.2e | %.3f | %zu | %.3f |\n", gs.c_str(),
-                                form.c_str(), coll.c_str(), th.c_str(), median, sps.front(), sps.back(),
-                                worst.maxLengthError, worst.maxPenetration * 1000.0, worst.nanCount,
-                                1000.0 / median);
+                    std::printf("| %s | %s | %s | %s | %.1f (%.1f-%.1f) | %.2e | %.3f | %zu | %.3f | %zu |\n",
+                                gs.c_str(), form.c_str(), coll.c_str(), th.c_str(), median, sps.front(), sps.back(),
+                                worst.maxLengthError, worst.maxPenetration * 1000.0, worst.nanCount, 1000.0 / median,
+                                worst.strandContacts);
                     std::fflush(stdout);
                 }
     return 0;
