@@ -8,6 +8,7 @@ PreviewSettings makePreviewSettings(const Scene& s) {
     p.supersample = int(s.integer("preview.supersample"));
     p.shadePerFragment = s.text("preview.shading") == "fragment";
     p.minPixelWidth = float(s.number("preview.min_pixel_width"));
+    p.blend = s.text("preview.transparency") == "weighted" ? HairBlend::Weighted : HairBlend::Sorted;
     p.blendDepthScale = float(s.number("preview.blend_depth_scale"));
     p.drawHead = s.flag("preview.head");
     p.curve = s.text("preview.tessellation.curve") == "b-spline" ? CurveType::BSpline : CurveType::CatmullRom;

@@ -23,9 +23,14 @@ void addPreviewKeys(SchemaBuilder& b) {
         .number("preview.min_pixel_width", 1, 0.05, 16, "px",
                 "Thinnest ribbon drawn; thinner hair is drawn this wide with alpha = true width / drawn "
                 "width, so its coverage stays right instead of aliasing away.")
+        .choice("preview.transparency", "sorted", {"sorted", "weighted"},
+                "How semi-transparent hair is composited. sorted: strands sorted back to front (by midpoint depth) "
+                "every frame and blended with the over operator, what the reference's rays see. "
+                "weighted: unsorted weighted blended order-independent transparency (McGuire & Bavoil 2013), "
+                "cheaper, but hair deep in the volume tints the front.")
         .number("preview.blend_depth_scale", 0.02, 1e-4, 10, "m",
-                "Order-independent blending weights colour by exp(-depth behind the scene's front / this): "
-                "smaller lets the nearest hair dominate more.")
+                "transparency: weighted only: blending weights colour by exp(-depth behind the scene's front / "
+                "this); smaller lets the nearest hair dominate more.")
         .flag("preview.head", true, "Draw the head mesh (Lambert + ambient, render.head).");
     b.section("preview.tessellation", "Smoothing of strand polylines by isoline tessellation.")
         .choice("preview.tessellation.curve", "catmull-rom", {"catmull-rom", "b-spline"},

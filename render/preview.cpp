@@ -313,17 +313,27 @@ struct PreviewRenderer::Impl {
         drawHead(head);
         mark("head");
 
-        // Hair: tested against the head's depth, never writing it; weighted
-        // sums into 1, revealage products into 2, min depth into 3.
-        const GLenum hair[] = {GL_NONE, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
-        glDrawBuffers(4, hair);
+        // Hair: tested against the head's depth, never writing it; min depth
+        // into 3. Sorted: premultiplied colour over attachment 0 (the patches
+        // arrive back to front). Weighted: weighted sums into 1, revealage
+        // products into 2.
         glDepthMask(GL_FALSE);
-        glEnablei(GL_BLEND, 1);
-        glBlendEquationi(1, GL_FUNC_ADD);
-        glBlendFunci(1, GL_ONE, GL_ONE);
-        glEnablei(GL_BLEND, 2);
-        glBlendEquationi(2, GL_FUNC_ADD);
-        glBlendFunci(2, GL_ZERO, GL_ONE_MINUS_SRC_COLOR);
+        if (settings.blend == HairBlend::Sorted) {
+            const GLenum hair[] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT3};
+            glDrawBuffers(4, hair);
+            glEnablei(GL_BLEND, 0);
+            glBlendEquationi(0, GL_FUNC_ADD);
+            glBlendFunci(0, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+        } else {
+            const GLenum hair[] = {GL_NONE, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
+            glDrawBuffers(4, hair);
+            glEnablei(GL_BLEND, 1);
+            glBlendEquationi(1, GL_FUNC_ADD);
+            glBlendFunci(1, GL_ONE, GL_ONE);
+            glEnablei(GL_BLEND, 2);
+            glBlendEquationi(2, GL_FUNC_ADD);
+            glBlendFunci(2, GL_ZERO, GL_ONE_MINUS_SRC_COLOR);
+        }
         if (lineWidth > 0.f) {
             glLineWidth(lineWidth);
             drawStrands(strandLines);
@@ -394,7 +404,10 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
     Eigen::AlignedBox3f bounds;
     stats.strandSegments = 0;
     if (drawStrandsNow) {
+        const bool sorted = settings.blend == HairBlend::Sorted;
         strands.upload(*frame.strands);
+        if (sorted)
+            strands.sortBackToFront(*frame.strands, cam.position, (cam.target - cam.position).normalized());
         compileHairPrograms(strands.patchSize);
         stats.strandSegments = strands.segments;
         for (const Vec3f& p : frame.strands->positions) bounds.extend(p);

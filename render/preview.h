@@ -22,11 +22,16 @@
 // - Shading (Kajiya-Kay, mirroring kajiyaKay() in render/view.cpp, times each
 //   light's visibility) runs per tessellated strand point by default and is
 //   interpolated along the strand, or per fragment (`shadePerFragment`).
-// - Hair is semi-transparent and unsorted, so it is composited with weighted
-//   blended order-independent transparency (McGuire & Bavoil 2013): alpha is
-//   exact (1 - prod(1 - a_i)), colour a weighted mean favouring fragments
-//   nearer than the scene's front by `blendDepthScale` metres. Opaque head
-//   fragments hide the hair behind them through the depth test.
+// - Hair is semi-transparent. Sorted (default): strands are sorted back to
+//   front from the camera every frame (by their midpoint depth) and blended
+//   with the over operator onto the opaque head: what a ray tracer sees (the
+//   nearest strand hides what is behind it in proportion to its coverage),
+//   up to strands that cross each other in depth. Weighted:
+//   weighted blended order-independent transparency (McGuire & Bavoil 2013):
+//   alpha is exact (1 - prod(1 - a_i)), colour a weighted mean favouring
+//   fragments nearer than the scene's front by `blendDepthScale` metres,
+//   which lets hair deep in the volume tint the front (unsorted, cheaper).
+//   Opaque head fragments hide the hair behind them through the depth test.
 // - Shadows of one light: the hair voxelized from the light into an r32ui 3D
 //   texture with image atomics (seed 004's binary/additive, nearest/trilinear),
 //   summed along the light in a compute pass, transmittance alpha^C; times a
@@ -53,6 +58,8 @@ namespace hp {
 enum class CurveType { CatmullRom, BSpline };
 /// Seed 004's voxel update: occupancy (set to 1) or density (add 1 per fragment).
 enum class VoxelMode { Binary, Additive };
+/// How semi-transparent hair is composited (see the file comment).
+enum class HairBlend { Sorted, Weighted };
 /// Seed 004's splatting of a fragment into the grid: its voxel, or trilinear
 /// weights over the 8 nearest voxel centres (additive only).
 enum class VoxelSplat { Nearest, Trilinear };
@@ -96,7 +103,8 @@ struct PreviewSettings {
     int tessellationLevel = 8;    ///< most pieces per strand segment (1..64)
     float tessellationPixels = 20.f;  ///< target on-screen length of a piece; 0 = always the most
     float minPixelWidth = 1.f;    ///< thinnest ribbon drawn (output pixels); alpha scales coverage below
-    float blendDepthScale = 0.02f;   ///< metres; smaller = nearer hair dominates more
+    HairBlend blend = HairBlend::Sorted;
+    float blendDepthScale = 0.02f;   ///< Weighted: metres; smaller = nearer hair dominates more
     /// Shade hair per fragment instead of per ribbon vertex (tessellated
     /// piece end). Per vertex is several times faster on llvmpipe; per
     /// fragment resolves sharp highlights and shadow edges along a strand.

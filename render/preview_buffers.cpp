@@ -65,16 +65,18 @@ void StrandBuffers::upload(const StrandFrame& s) {
     if (s.offsets == offsets && indexCount > 0) return;
     // One patch per strand (or per chunk of a strand longer than a patch
     // holds): the driver's per-patch cost dominates on software rasterizers,
-    // so patches are as long as GL allows. A patch holds the vertex before
-    // its first segment, the segments' vertices and the one after; at a root
-    // or tip the missing neighbour repeats the end vertex (the TES mirrors
-    // it) and unused slots repeat the last entry. The TCS reads each patch's
-    // segment count from an SSBO.
+    // so patches are as long as GL allows (sorted hair is therefore sorted
+    // per strand, not per piece). A patch holds the vertex before its first segment, the
+    // segments' vertices and the one after; at a root or tip the missing
+    // neighbour repeats the end vertex (the TES mirrors it) and unused slots
+    // repeat the last entry. The TCS reads each patch's segment count from
+    // an SSBO.
     size_t longest = 2;
     for (size_t k = 0; k < s.strandCount(); ++k) longest = std::max<size_t>(longest, s.vertexCount(k));
     patchSize = int(std::min<size_t>(size_t(maxPatchVertices), longest + 2));
     const uint32_t perPatch = uint32_t(patchSize - 3);  // segments one patch can hold
-    std::vector<uint32_t> list, counts;
+    list.clear();
+    counts.clear();
     list.reserve(s.vertexCount() * 2);
     segments = 0;
     for (size_t k = 0; k < s.strandCount(); ++k) {
@@ -90,12 +92,38 @@ void StrandBuffers::upload(const StrandFrame& s) {
         }
     }
     glNamedBufferData(indices, GLsizeiptr(std::max<size_t>(list.size(), 1) * sizeof(uint32_t)),
-                      list.empty() ? nullptr : list.data(), GL_STATIC_DRAW);
+                      list.empty() ? nullptr : list.data(), GL_DYNAMIC_DRAW);
     glNamedBufferData(patchSegments, GLsizeiptr(std::max<size_t>(counts.size(), 1) * sizeof(uint32_t)),
-                      counts.empty() ? nullptr : counts.data(), GL_STATIC_DRAW);
+                      counts.empty() ? nullptr : counts.data(), GL_DYNAMIC_DRAW);
     glVertexArrayElementBuffer(vao, indices);
     indexCount = list.size();
     offsets = s.offsets;
+}
+
+void StrandBuffers::sortBackToFront(const StrandFrame& s, const Vec3f& eye, const Vec3f& forward) {
+    const size_t patches = counts.size();
+    if (patches == 0) return;
+    const size_t ps = size_t(patchSize);
+    // Depth of each patch (a whole strand, mostly): the midpoint of its first and last vertex.
+    std::vector<std::pair<float, uint32_t>> keys(patches);
+    for (size_t p = 0; p < patches; ++p) {
+        const uint32_t a = list[p * ps + 1], b = list[p * ps + 1 + counts[p]];
+        const Vec3f mid = 0.5f * (s.positions[a] + s.positions[b]);
+        keys[p] = {(mid - eye).dot(forward), uint32_t(p)};
+    }
+    // Farthest first; ties keep strand order, so the result is deterministic.
+    std::sort(keys.begin(), keys.end(), [](const auto& x, const auto& y) {
+        return x.first > y.first || (x.first == y.first && x.second < y.second);
+    });
+    sortedList.resize(list.size());
+    sortedCounts.resize(patches);
+    for (size_t i = 0; i < patches; ++i) {
+        const uint32_t p = keys[i].second;
+        std::copy_n(list.begin() + std::ptrdiff_t(p * ps), ps, sortedList.begin() + std::ptrdiff_t(i * ps));
+        sortedCounts[i] = counts[p];
+    }
+    glNamedBufferSubData(indices, 0, GLsizeiptr(sortedList.size() * sizeof(uint32_t)), sortedList.data());
+    glNamedBufferSubData(patchSegments, 0, GLsizeiptr(sortedCounts.size() * sizeof(uint32_t)), sortedCounts.data());
 }
 
 // ---- head ------------------------------------------------------------------

@@ -78,10 +78,18 @@ struct StrandBuffers {
     std::vector<uint32_t> offsets;  ///< topology of the current index list
     size_t indexCount = 0;
     size_t segments = 0;
+    std::vector<uint32_t> list;     ///< the patch index list in strand order
+    std::vector<uint32_t> counts;   ///< segments per patch, strand order
+    std::vector<uint32_t> sortedList, sortedCounts;
 
     void create();
     void destroy();
+    /// Uploads the vertices; rebuilds the patches when the topology changed.
     void upload(const StrandFrame& strands);
+    /// Reorders the patches back to front along `forward` (the camera's
+    /// viewing direction, from `eye`) by the depth of each patch's midpoint,
+    /// for blending with the over operator.
+    void sortBackToFront(const StrandFrame& strands, const Vec3f& eye, const Vec3f& forward);
 };
 
 /// The head mesh (positions + normals interleaved), its triangle list, and the
