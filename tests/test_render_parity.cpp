@@ -1,6 +1,7 @@
-// Preview (GL) against reference (Embree) on the same StrandFrame, head and
-// View: hair coverage, hair colour without shadows, a small hair scene with
-// shadows (FLIP), and the head alone.
+// Preview (GL) against reference (Embree, kajiya-kay mode) on the same
+// StrandFrame, head and View: the two must render the same picture up to
+// the preview's approximations (voxel shadows, per-vertex shading, thin hair
+// as wide translucent lines), and hair behind the head must stay hidden.
 //
 // Set HAIRPIPE_TEST_DUMP=<folder> to write every rendered pair as EXR there.
 #include "test_support.h"
@@ -12,7 +13,6 @@
 #include "render/reference.h"
 #include "sim/synthetic.h"
 
-#include <cmath>
 #include <cstdlib>
 #include <iostream>
 
@@ -45,30 +45,19 @@ void dump(const std::string& name, const Image& img) {
     writeImage(std::string(dir) + "/" + name + ".exr", img);
 }
 
-struct Pair {
-    Image preview, reference;
-};
-
-Pair renderBoth(const std::string& name, const View& view, const StrandFrame* strands, const TriangleMesh* head,
-                const PreviewSettings& ps, const ReferenceSettings& rs) {
-    Pair p;
-    {
-        PreviewRenderer renderer(ps);
-        PreviewFrame frame;
-        frame.strands = strands;
-        frame.head = head;
-        p.preview = renderer.render(view, frame);
-    }
-    ReferenceRenderer reference;
-    p.reference = reference.render(view, strands, head, rs);
-    dump(name + ".preview", p.preview);
-    dump(name + ".reference", p.reference);
-    return p;
+Image renderPreview(const std::string& name, const View& view, const StrandFrame* strands, const TriangleMesh* head,
+                    PreviewRenderer& renderer) {
+    PreviewFrame frame;
+    frame.strands = strands;
+    frame.head = head;
+    Image img = renderer.render(view, frame);
+    dump(name + ".preview", img);
+    return img;
 }
 
 /// The default scene's look, scaled down: a sphere head of radius 0.1 m with
 /// synthetic drooping hair, seen from the front-right and lit from the upper right.
-View smallView(int w = 160, int h = 90) {
+View smallView(int w, int h) {
     View v;
     v.camera.position = Vec3f(0.42f, 0.08f, 0.62f) * 1.1f;
     v.camera.target = Vec3f(0.f, -0.04f, -0.02f);
@@ -81,53 +70,27 @@ View smallView(int w = 160, int h = 90) {
     return v;
 }
 
-void printStats(const std::string& what, const Pair& p) {
-    double ap = 0, ar = 0;
-    Eigen::Vector3d cp = Eigen::Vector3d::Zero(), cr = cp;
-    long full = 0;
-    for (int y = 0; y < p.preview.height; ++y)
-        for (int x = 0; x < p.preview.width; ++x) {
-            ap += p.preview.at(x, y, 3), ar += p.reference.at(x, y, 3);
-            if (p.preview.at(x, y, 3) > 0.99f && p.reference.at(x, y, 3) > 0.99f) {
-                ++full;
-                for (int c = 0; c < 3; ++c) cp[c] += p.preview.at(x, y, c), cr[c] += p.reference.at(x, y, c);
-            }
-        }
+FrameMetrics hairMetrics(const Image& reference, const Image& preview) {
     CompareSettings cs;
     cs.mask = MaskMode::Hair;
-    const Comparison c = compareImages(p.reference, p.preview, cs);
-    std::cout << what << ": alpha sum preview/reference " << ap / ar << " (" << ap << " / " << ar << "), full px "
-              << full << ", mean colour preview " << (cp / std::max(full, 1L)).transpose() << " reference "
-              << (cr / std::max(full, 1L)).transpose() << ", FLIP " << c.metrics.flip << " SSIM " << c.metrics.ssim
-              << "\n";
+    return compareImages(reference, preview, cs).metrics;
 }
 
-TEST(Parity, ExploreDense) {
-    HP_REQUIRE_GL();
-    SyntheticHairSettings hs;
-    hs.strands = 30000;
-    hs.vertices = 16;
-    hs.length = 0.22f;
-    hs.capMinCosine = -0.2f;
-    hs.rootRadius = 0.00006f;
-    hs.tipRadius = 0.00002f;
-    hs.droop = 0.9f;
-    const StrandFrame hair = makeSyntheticHair(hs);
-    const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 24, 48);
-    View v = smallView(320, 180);
-    ReferenceSettings rs;
-    rs.samplesPerPixel = 32;
-    PreviewSettings ps;
-    PreviewSettings p = ps;
-    p.shadow.voxels = false;
-    p.shadow.shadowMap = false;
-    ReferenceSettings r = rs;
-    r.shadows = false;
-    printStats("dense hair+head, no shadows", renderBoth("dense_noshadow", v, &hair, &head, p, r));
-    printStats("dense hair+head, shadows", renderBoth("dense_shadow", v, &hair, &head, ps, rs));
+double alphaSum(const Image& img) {
+    double a = 0;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) a += img.at(x, y, 3);
+    return a;
 }
 
-TEST(Parity, Explore) {
+// The default scene in miniature (sphere head, 3000 drooping strands of the
+// default radii, shadows on in both), 320 x 180: measured on llvmpipe, the
+// sorted preview against a 64-spp reference gives FLIP 0.074 and SSIM 0.64
+// (most of the SSIM gap is the reference's sampling noise on sub-pixel hair,
+// which the preview's expected coverage does not have), against FLIP 0.139 /
+// SSIM 0.62 with the weighted blended transparency the preview used before.
+// Coverage (alpha) agrees within 1 %.
+TEST(RenderParity, PreviewMatchesReferenceOnSmallHairScene) {
     HP_REQUIRE_GL();
     SyntheticHairSettings hs;
     hs.strands = 3000;
@@ -139,23 +102,77 @@ TEST(Parity, Explore) {
     hs.droop = 0.9f;
     const StrandFrame hair = makeSyntheticHair(hs);
     const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 24, 48);
-    View v = smallView(320, 180);
+    const View view = smallView(320, 180);
     ReferenceSettings rs;
     rs.samplesPerPixel = 64;
-    PreviewSettings ps;
-    {
-        PreviewSettings p = ps;
-        p.shadow.voxels = false;
-        p.shadow.shadowMap = false;
-        ReferenceSettings r = rs;
-        r.shadows = false;
-        printStats("hair+head, no shadows", renderBoth("noshadow", v, &hair, &head, p, r));
-        printStats("hair only, no shadows", renderBoth("hair_noshadow", v, &hair, nullptr, p, r));
-        printStats("head only, no shadows", renderBoth("head_noshadow", v, nullptr, &head, p, r));
+    ReferenceRenderer reference;
+    const Image ref = reference.render(view, &hair, &head, rs);
+    dump("parity.reference", ref);
+
+    PreviewSettings sorted;
+    sorted.tessellationPixels = 8.f;
+    PreviewSettings weighted = sorted;
+    weighted.blend = HairBlend::Weighted;
+    PreviewRenderer renderer(sorted);
+    const Image ps = renderPreview("parity.sorted", view, &hair, &head, renderer);
+    renderer.setSettings(weighted);
+    const Image pw = renderPreview("parity.weighted", view, &hair, &head, renderer);
+    const FrameMetrics ms = hairMetrics(ref, ps), mw = hairMetrics(ref, pw);
+    std::cout << "sorted: FLIP " << ms.flip << " SSIM " << ms.ssim << "; weighted: FLIP " << mw.flip << " SSIM "
+              << mw.ssim << "; alpha preview / reference " << alphaSum(ps) / alphaSum(ref) << "\n";
+    EXPECT_NEAR(alphaSum(ps) / alphaSum(ref), 1.0, 0.03);
+    EXPECT_LT(ms.flip, 0.10);
+    EXPECT_GT(ms.ssim, 0.60);
+    // Sorting is what makes the nearest hair win, as in the ray tracer.
+    EXPECT_LT(ms.flip, mw.flip);
+}
+
+// Hair wholly behind the head (a slab of bright red strands beyond the
+// sphere, smaller than it on screen) must not show over it: the head's
+// pixels are the same with and without that hair.
+TEST(RenderParity, HairBehindHeadIsHidden) {
+    HP_REQUIRE_GL();
+    View view;
+    view.camera.position = Vec3f(0.f, 0.f, 0.6f);
+    view.camera.target = Vec3f::Zero();
+    view.camera.fovY = 30.f;
+    view.camera.width = 96;
+    view.camera.height = 96;
+    view.lights = {Light{}};
+    view.lights[0].direction = Vec3f(0.f, 0.f, -1.f);
+    view.hair.color = Vec3f(1.f, 0.f, 0.f);
+    view.hair.specularColor = Vec3f(1.f, 0.f, 0.f);
+    StrandFrame hair;
+    hair.offsets.push_back(0);
+    const int strands = 200, vertices = 6;
+    for (int s = 0; s < strands; ++s) {
+        const float x = -0.04f + 0.08f * float(s) / float(strands - 1);
+        for (int k = 0; k < vertices; ++k) {
+            hair.positions.push_back(Vec3f(x, -0.04f + 0.016f * float(k), -0.15f));
+            hair.velocities.push_back(Vec3f::Zero());
+            hair.radii.push_back(0.0005f);
+        }
+        hair.offsets.push_back(uint32_t(hair.positions.size()));
+        hair.ids.push_back(uint32_t(s));
     }
-    printStats("hair+head, shadows", renderBoth("shadow", v, &hair, &head, ps, rs));
-    printStats("head only, shadows", renderBoth("head_shadow", v, nullptr, &head, ps, rs));
-    printStats("hair only, shadows", renderBoth("hair_shadow", v, &hair, nullptr, ps, rs));
+    const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 24, 48);
+    PreviewRenderer renderer{PreviewSettings{}};
+    for (HairBlend blend : {HairBlend::Sorted, HairBlend::Weighted}) {
+        PreviewSettings ps;
+        ps.blend = blend;
+        renderer.setSettings(ps);
+        const Image with = renderPreview("behind.hair", view, &hair, &head, renderer);
+        const Image without = renderPreview("behind.nohair", view, nullptr, &head, renderer);
+        const Image hairOnly = renderPreview("behind.haironly", view, &hair, nullptr, renderer);
+        // The slab alone is visible in the middle of the frame...
+        EXPECT_GT(hairOnly.at(48, 48, 3), 0.5f);
+        // ...and hidden there behind the head.
+        float worst = 0.f;
+        for (int y = 30; y < 66; ++y)
+            for (int x = 30; x < 66; ++x)
+                for (int c = 0; c < 4; ++c) worst = std::max(worst, std::abs(with.at(x, y, c) - without.at(x, y, c)));
+        EXPECT_LT(worst, 1e-4f) << (blend == HairBlend::Sorted ? "sorted" : "weighted");
+    }
 }
 
 }  // namespace
