@@ -24,8 +24,8 @@ void addPreviewKeys(SchemaBuilder& b) {
                 "Thinnest ribbon drawn; thinner hair is drawn this wide with alpha = true width / drawn "
                 "width, so its coverage stays right instead of aliasing away.")
         .choice("preview.transparency", "sorted", {"sorted", "weighted"},
-                "How semi-transparent hair is composited. sorted: strands sorted back to front (by midpoint depth) "
-                "every frame and blended with the over operator, what the reference's rays see. "
+                "How semi-transparent hair is composited. sorted: strands cut into 4-segment pieces sorted back "
+                "to front every frame and blended with the over operator, what the reference's rays see. "
                 "weighted: unsorted weighted blended order-independent transparency (McGuire & Bavoil 2013), "
                 "cheaper, but hair deep in the volume tints the front.")
         .number("preview.blend_depth_scale", 0.02, 1e-4, 10, "m",

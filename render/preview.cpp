@@ -22,6 +22,11 @@ namespace {
 
 using Files = std::vector<std::pair<ShaderStage, std::string>>;
 
+/// Segments per patch when hair is sorted: short enough that a piece of
+/// strand rarely straddles another in depth, long enough to keep the
+/// per-patch cost of software rasterizers down.
+constexpr int kSortedPatchSegments = 4;
+
 void copyMatrix(float* dst, const Mat4f& m) { std::memcpy(dst, m.data(), 16 * sizeof(float)); }
 void set4(float* dst, float a, float b, float c, float d) { dst[0] = a, dst[1] = b, dst[2] = c, dst[3] = d; }
 void set3(float* dst, const Vec3f& v, float w) { set4(dst, v.x(), v.y(), v.z(), w); }
@@ -210,7 +215,6 @@ struct PreviewRenderer::Impl {
         if (!strandsVisible || !strands.indexCount) return;
         program.use();
         glBindVertexArray(strands.vao);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, strands.patchSegments);
         glPatchParameteri(GL_PATCH_VERTICES, strands.patchSize);
         glDrawElements(GL_PATCHES, GLsizei(strands.indexCount), GL_UNSIGNED_INT, nullptr);
     }
@@ -405,7 +409,7 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
     stats.strandSegments = 0;
     if (drawStrandsNow) {
         const bool sorted = settings.blend == HairBlend::Sorted;
-        strands.upload(*frame.strands);
+        strands.upload(*frame.strands, sorted ? kSortedPatchSegments : 0);
         if (sorted)
             strands.sortBackToFront(*frame.strands, cam.position, (cam.target - cam.position).normalized());
         compileHairPrograms(strands.patchSize);

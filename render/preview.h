@@ -22,11 +22,12 @@
 // - Shading (Kajiya-Kay, mirroring kajiyaKay() in render/view.cpp, times each
 //   light's visibility) runs per tessellated strand point by default and is
 //   interpolated along the strand, or per fragment (`shadePerFragment`).
-// - Hair is semi-transparent. Sorted (default): strands are sorted back to
-//   front from the camera every frame (by their midpoint depth) and blended
-//   with the over operator onto the opaque head: what a ray tracer sees (the
-//   nearest strand hides what is behind it in proportion to its coverage),
-//   up to strands that cross each other in depth. Weighted:
+// - Hair is semi-transparent. Sorted (default): strands are cut into pieces
+//   of 4 segments (one patch each), sorted back to front from the camera
+//   every frame (by their midpoint depth) and blended with the over operator
+//   onto the opaque head: what a ray tracer sees (the nearest strand hides
+//   what is behind it in proportion to its coverage), up to pieces that
+//   overlap in depth. Weighted:
 //   weighted blended order-independent transparency (McGuire & Bavoil 2013):
 //   alpha is exact (1 - prod(1 - a_i)), colour a weighted mean favouring
 //   fragments nearer than the scene's front by `blendDepthScale` metres,
