@@ -351,6 +351,7 @@ TEST(Preview, VoxelTransmittanceMatchesCpuVoxelization) {
                                std::pair{VoxelMode::Additive, VoxelSplat::Trilinear}}) {
         PreviewSettings s;
         s.shadow.resolution = res;
+        s.shadow.weight = VoxelWeight::Fragments;  // the seed's count, which cpuVoxelize mirrors
         s.shadow.alpha = alpha;
         s.shadow.mode = mode;
         s.shadow.splat = splat;
