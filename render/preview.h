@@ -27,7 +27,7 @@
 //   every frame (by their midpoint depth) and blended with the over operator
 //   onto the opaque head: what a ray tracer sees (the nearest strand hides
 //   what is behind it in proportion to its coverage), up to pieces that
-//   overlap in depth. Weighted:
+//   overlap in depth. Generated hair is blended after them, unsorted. Weighted:
 //   weighted blended order-independent transparency (McGuire & Bavoil 2013):
 //   alpha is exact (1 - prod(1 - a_i)), colour a weighted mean favouring
 //   fragments nearer than the scene's front by `blendDepthScale` metres,
