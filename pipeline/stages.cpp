@@ -39,7 +39,15 @@ class FrameSubset final : public FrameStage {
     void run(const FrameData& data) override {
         if (selected(data.frame)) stage_->run(data);
     }
-    void finish(const ShotSettings& shot) override { stage_->finish(shot); }
+    /// The stage's finish sees only its own frames (e.g. the compare table
+    /// lists the compared frames, not every frame of the shot as missing).
+    void finish(const ShotSettings& shot) override {
+        ShotSettings mine = shot;
+        mine.frames.clear();
+        for (int frame : shot.frames)
+            if (selected(frame)) mine.frames.push_back(frame);
+        stage_->finish(mine);
+    }
 
   private:
     bool selected(int frame) const { return std::binary_search(frames_.begin(), frames_.end(), frame); }
