@@ -8,6 +8,7 @@ PreviewSettings makePreviewSettings(const Scene& s) {
     p.supersample = int(s.integer("preview.supersample"));
     p.shadePerFragment = s.text("preview.shading") == "fragment";
     p.minPixelWidth = float(s.number("preview.min_pixel_width"));
+    p.blend = s.text("preview.transparency") == "weighted" ? HairBlend::Weighted : HairBlend::Sorted;
     p.blendDepthScale = float(s.number("preview.blend_depth_scale"));
     p.drawHead = s.flag("preview.head");
     p.curve = s.text("preview.tessellation.curve") == "b-spline" ? CurveType::BSpline : CurveType::CatmullRom;
@@ -29,6 +30,7 @@ PreviewSettings makePreviewSettings(const Scene& s) {
     sh.sumAlongLight = s.flag("preview.shadow.sum");
     sh.resolution = int(s.integer("preview.shadow.resolution"));
     sh.filter = s.flag("preview.shadow.filter");
+    sh.weight = s.text("preview.shadow.weight") == "fragments" ? VoxelWeight::Fragments : VoxelWeight::Crossings;
     sh.alpha = float(s.number("preview.shadow.alpha"));
     sh.shadowMap = s.flag("preview.shadow.map");
     sh.shadowMapSize = int(s.integer("preview.shadow.map_size"));

@@ -23,9 +23,14 @@ void addPreviewKeys(SchemaBuilder& b) {
         .number("preview.min_pixel_width", 1, 0.05, 16, "px",
                 "Thinnest ribbon drawn; thinner hair is drawn this wide with alpha = true width / drawn "
                 "width, so its coverage stays right instead of aliasing away.")
+        .choice("preview.transparency", "sorted", {"sorted", "weighted"},
+                "How semi-transparent hair is composited. sorted: strands cut into 4-segment pieces sorted back "
+                "to front every frame and blended with the over operator, what the reference's rays see. "
+                "weighted: unsorted weighted blended order-independent transparency (McGuire & Bavoil 2013), "
+                "cheaper, but hair deep in the volume tints the front.")
         .number("preview.blend_depth_scale", 0.02, 1e-4, 10, "m",
-                "Order-independent blending weights colour by exp(-depth behind the scene's front / this): "
-                "smaller lets the nearest hair dominate more.")
+                "transparency: weighted only: blending weights colour by exp(-depth behind the scene's front / "
+                "this); smaller lets the nearest hair dominate more.")
         .flag("preview.head", true, "Draw the head mesh (Lambert + ambient, render.head).");
     b.section("preview.tessellation", "Smoothing of strand polylines by isoline tessellation.")
         .choice("preview.tessellation.curve", "catmull-rom", {"catmull-rom", "b-spline"},
@@ -52,9 +57,15 @@ void addPreviewKeys(SchemaBuilder& b) {
         .flag("preview.shadow.filter", true,
               "Average C over 2 x 2 voxels across the light when shading (hides the moire rings regularly spaced "
               "hair casts); off = the seed's single lookup.")
+        .choice("preview.shadow.weight", "crossings", {"crossings", "fragments"},
+                "What the grid counts. crossings: each strand fragment adds the strand crossings a light ray "
+                "through its voxel column expects (its projected area there), so C counts crossings and light "
+                "reaching a point is exp(-(1 - T) C) with T = render.hair.transmittance, the reference's "
+                "per-crossing transmittance (binary: an occupied voxel counts as one crossing of its widest "
+                "strand). fragments: the seed's count, 1 per fragment whatever the hair's width, light = alpha^C.")
         .number("preview.shadow.alpha", 0.85, 0.001, 1, "",
-                "Transmittance per unit of C: light reaching a point is alpha^C, C counting strand fragments "
-                "(additive) or occupied voxels (binary) in front of it.")
+                "weight: fragments only: transmittance per unit of C (strand fragments with voxel_mode additive, "
+                "occupied voxels with binary).")
         .flag("preview.shadow.map", true, "Shadow map of the opaque head.")
         .integer("preview.shadow.map_size", 2048, 64, 16384, "px", "Shadow map resolution.")
         .integer("preview.shadow.pcf_radius", 1, 0, 8, "texels", "Percentage-closer filter: (2r+1)^2 taps.");

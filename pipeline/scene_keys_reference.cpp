@@ -29,10 +29,6 @@ void addReferenceKeys(SchemaBuilder& b) {
                 "RGB) is below this traces its shadow ray only with probability contribution/threshold, weighted "
                 "by the inverse: unbiased and much faster for dark hair, slightly noisier; 0 traces every shadow "
                 "ray.")
-        .number("reference.hair_transmittance", 0.8, 0, 1, "",
-                "Kajiya-Kay mode: fraction of light a shadow ray keeps at each strand it crosses (0 = opaque "
-                "hair, 1 = hair casts no shadow); the head is opaque. Physical mode carries light through hair "
-                "with the BSDF instead.")
         .number("reference.scale", 1, 0.01, 4, "",
                 "Image size relative to render.camera.width and height (e.g. 0.25 for a quick look).");
     b.section("reference.layers", "Extra EXR layers.")

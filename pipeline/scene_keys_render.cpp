@@ -36,7 +36,12 @@ void addRenderKeys(SchemaBuilder& b) {
         .number("render.hair.secondary_shift", -0.1, -1, 1, "", "Tangent shift of the second lobe.")
         .number("render.hair.secondary_ks", 0.15, 0, 10, "", "Weight of the second lobe.")
         .number("render.hair.secondary_shininess", 20, 1, 10000, "", "Exponent of the second lobe.")
-        .vec3("render.hair.secondary_color", 0.6, 0.45, 0.3, "", "Colour of the second lobe.");
+        .vec3("render.hair.secondary_color", 0.6, 0.45, 0.3, "", "Colour of the second lobe.")
+        .number("render.hair.transmittance", 0.8, 0, 1, "",
+                "Fraction of light a shadow ray keeps at each strand it crosses (0 = opaque hair, 1 = hair casts "
+                "no shadow): hair self-shadowing in both renderers. The reference traces the crossings (kajiya-kay "
+                "mode; physical mode carries light through hair with its BSDF); the preview's voxel grid counts "
+                "the expected crossings C (preview.shadow.weight: crossings) and lets exp(-(1 - T) C) through.");
     b.section("render.head", "The opaque head's simple lit material.")
         .vec3("render.head.color", 0.75, 0.6, 0.5, "", "Diffuse albedo (linear RGB).")
         .number("render.head.ambient", 0.05, 0, 1, "", "Ambient term.");

@@ -23,7 +23,6 @@ ReferenceSettings referenceSettings(const Scene& s, const View& view, const Shot
     r.bounces = int(s.integer("reference.depth"));
     r.seed = uint64_t(shot.seed);
     r.shadows = s.flag("reference.shadows");
-    r.hairTransmittance = float(s.number("reference.hair_transmittance"));
     r.shadowRouletteThreshold = float(s.number("reference.shadow_roulette"));
     r.diffuseSpecularLayers = s.flag("reference.layers.diffuse_specular");
     r.strandIdLayer = s.flag("reference.layers.strand_id");

@@ -45,6 +45,7 @@ View makeView(const Scene& s) {
     h.secondaryKs = float(s.number("render.hair.secondary_ks"));
     h.secondaryShininess = float(s.number("render.hair.secondary_shininess"));
     h.secondaryColor = s.vec3f("render.hair.secondary_color");
+    h.transmittance = float(s.number("render.hair.transmittance"));
 
     v.head.color = s.vec3f("render.head.color");
     v.head.ambient = float(s.number("render.head.ambient"));

@@ -22,6 +22,11 @@ namespace {
 
 using Files = std::vector<std::pair<ShaderStage, std::string>>;
 
+/// Segments per patch when hair is sorted: short enough that a piece of
+/// strand rarely straddles another in depth, long enough to keep the
+/// per-patch cost of software rasterizers down.
+constexpr int kSortedPatchSegments = 4;
+
 void copyMatrix(float* dst, const Mat4f& m) { std::memcpy(dst, m.data(), 16 * sizeof(float)); }
 void set4(float* dst, float a, float b, float c, float d) { dst[0] = a, dst[1] = b, dst[2] = c, dst[3] = d; }
 void set3(float* dst, const Vec3f& v, float w) { set4(dst, v.x(), v.y(), v.z(), w); }
@@ -187,7 +192,12 @@ struct PreviewRenderer::Impl {
         set4(u.hairShape, h.shininess, h.secondaryShininess, h.primaryShift, h.secondaryShift);
         set3(u.headColor, view.head.color, view.head.ambient);
         const PreviewShadowSettings& sh = settings.shadow;
-        set4(u.shadow, sh.alpha, float(std::max(0, sh.pcfRadius)), 1.f / float(std::max(1, sh.shadowMapSize)), 0.002f);
+        // Optical depth of one unit of C (shaders/shadow.glsl).
+        const float depthPerUnit = sh.weight == VoxelWeight::Crossings
+                                       ? 1.f - std::clamp(h.transmittance, 0.f, 1.f)
+                                       : -std::log(std::clamp(sh.alpha, 1e-6f, 1.f));
+        set4(u.shadow, depthPerUnit, float(std::max(0, sh.pcfRadius)), 1.f / float(std::max(1, sh.shadowMapSize)),
+             0.002f);
         set4(u.tess, float(std::clamp(settings.tessellationLevel, 1, 64)), settings.tessellationPixels * float(ss),
              settings.curve == CurveType::BSpline ? 1.f : 0.f, settings.minPixelWidth * float(ss));
         set4(u.blend, blendReference, std::max(settings.blendDepthScale, 1e-5f), 0.f, 0.f);
@@ -205,7 +215,6 @@ struct PreviewRenderer::Impl {
         if (!strandsVisible || !strands.indexCount) return;
         program.use();
         glBindVertexArray(strands.vao);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, strands.patchSegments);
         glPatchParameteri(GL_PATCH_VERTICES, strands.patchSize);
         glDrawElements(GL_PATCHES, GLsizei(strands.indexCount), GL_UNSIGNED_INT, nullptr);
     }
@@ -258,7 +267,10 @@ struct PreviewRenderer::Impl {
             glDepthMask(GL_FALSE);
             glBindImageTexture(0, shadows.voxels, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
             const int mode = sh.mode == VoxelMode::Binary ? 0 : (sh.splat == VoxelSplat::Trilinear ? 2 : 1);
-            for (const GlProgram* p : {&strandVoxel, &furVoxel}) glProgramUniform1i(p->id(), p->uniform("uMode"), mode);
+            for (const GlProgram* p : {&strandVoxel, &furVoxel}) {
+                glProgramUniform1i(p->id(), p->uniform("uMode"), mode);
+                glProgramUniform1i(p->id(), p->uniform("uCrossings"), sh.weight == VoxelWeight::Crossings ? 1 : 0);
+            }
             drawStrands(strandVoxel);
             drawFur(furVoxel);
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
@@ -305,17 +317,27 @@ struct PreviewRenderer::Impl {
         drawHead(head);
         mark("head");
 
-        // Hair: tested against the head's depth, never writing it; weighted
-        // sums into 1, revealage products into 2, min depth into 3.
-        const GLenum hair[] = {GL_NONE, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
-        glDrawBuffers(4, hair);
+        // Hair: tested against the head's depth, never writing it; min depth
+        // into 3. Sorted: premultiplied colour over attachment 0 (the patches
+        // arrive back to front). Weighted: weighted sums into 1, revealage
+        // products into 2.
         glDepthMask(GL_FALSE);
-        glEnablei(GL_BLEND, 1);
-        glBlendEquationi(1, GL_FUNC_ADD);
-        glBlendFunci(1, GL_ONE, GL_ONE);
-        glEnablei(GL_BLEND, 2);
-        glBlendEquationi(2, GL_FUNC_ADD);
-        glBlendFunci(2, GL_ZERO, GL_ONE_MINUS_SRC_COLOR);
+        if (settings.blend == HairBlend::Sorted) {
+            const GLenum hair[] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT3};
+            glDrawBuffers(4, hair);
+            glEnablei(GL_BLEND, 0);
+            glBlendEquationi(0, GL_FUNC_ADD);
+            glBlendFunci(0, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+        } else {
+            const GLenum hair[] = {GL_NONE, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
+            glDrawBuffers(4, hair);
+            glEnablei(GL_BLEND, 1);
+            glBlendEquationi(1, GL_FUNC_ADD);
+            glBlendFunci(1, GL_ONE, GL_ONE);
+            glEnablei(GL_BLEND, 2);
+            glBlendEquationi(2, GL_FUNC_ADD);
+            glBlendFunci(2, GL_ZERO, GL_ONE_MINUS_SRC_COLOR);
+        }
         if (lineWidth > 0.f) {
             glLineWidth(lineWidth);
             drawStrands(strandLines);
@@ -386,7 +408,10 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
     Eigen::AlignedBox3f bounds;
     stats.strandSegments = 0;
     if (drawStrandsNow) {
-        strands.upload(*frame.strands);
+        const bool sorted = settings.blend == HairBlend::Sorted;
+        strands.upload(*frame.strands, sorted ? kSortedPatchSegments : 0);
+        if (sorted)
+            strands.sortBackToFront(*frame.strands, cam.position, (cam.target - cam.position).normalized());
         compileHairPrograms(strands.patchSize);
         stats.strandSegments = strands.segments;
         for (const Vec3f& p : frame.strands->positions) bounds.extend(p);
@@ -530,7 +555,7 @@ VoxelSnapshot PreviewRenderer::readVoxels() const {
     std::vector<uint32_t> raw(n);
     glGetTextureImage(m.shadows.voxels, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(n * 4), raw.data());
     snap.raw.resize(n);
-    for (size_t i = 0; i < n; ++i) snap.raw[i] = float(raw[i]) / 256.f;
+    for (size_t i = 0; i < n; ++i) snap.raw[i] = float(raw[i]) / kVoxelUnit;
     snap.summed.resize(n);
     glGetTextureImage(m.shadows.density, 0, GL_RED, GL_FLOAT, GLsizei(n * 4), snap.summed.data());
     return snap;

@@ -22,11 +22,17 @@
 // - Shading (Kajiya-Kay, mirroring kajiyaKay() in render/view.cpp, times each
 //   light's visibility) runs per tessellated strand point by default and is
 //   interpolated along the strand, or per fragment (`shadePerFragment`).
-// - Hair is semi-transparent and unsorted, so it is composited with weighted
-//   blended order-independent transparency (McGuire & Bavoil 2013): alpha is
-//   exact (1 - prod(1 - a_i)), colour a weighted mean favouring fragments
-//   nearer than the scene's front by `blendDepthScale` metres. Opaque head
-//   fragments hide the hair behind them through the depth test.
+// - Hair is semi-transparent. Sorted (default): strands are cut into pieces
+//   of 4 segments (one patch each), sorted back to front from the camera
+//   every frame (by their midpoint depth) and blended with the over operator
+//   onto the opaque head: what a ray tracer sees (the nearest strand hides
+//   what is behind it in proportion to its coverage), up to pieces that
+//   overlap in depth. Generated hair is blended after them, unsorted. Weighted:
+//   weighted blended order-independent transparency (McGuire & Bavoil 2013):
+//   alpha is exact (1 - prod(1 - a_i)), colour a weighted mean favouring
+//   fragments nearer than the scene's front by `blendDepthScale` metres,
+//   which lets hair deep in the volume tint the front (unsorted, cheaper).
+//   Opaque head fragments hide the hair behind them through the depth test.
 // - Shadows of one light: the hair voxelized from the light into an r32ui 3D
 //   texture with image atomics (seed 004's binary/additive, nearest/trilinear),
 //   summed along the light in a compute pass, transmittance alpha^C; times a
@@ -53,9 +59,15 @@ namespace hp {
 enum class CurveType { CatmullRom, BSpline };
 /// Seed 004's voxel update: occupancy (set to 1) or density (add 1 per fragment).
 enum class VoxelMode { Binary, Additive };
+/// How semi-transparent hair is composited (see the file comment).
+enum class HairBlend { Sorted, Weighted };
 /// Seed 004's splatting of a fragment into the grid: its voxel, or trilinear
 /// weights over the 8 nearest voxel centres (additive only).
 enum class VoxelSplat { Nearest, Trilinear };
+/// What a voxel counts: expected strand crossings of a light ray (each
+/// fragment weighted by its strand's projected area in the voxel's column),
+/// or fragments (seed 004: each fragment adds 1, whatever the hair's width).
+enum class VoxelWeight { Crossings, Fragments };
 
 /// Shadows of the one shadowed light (other lights are unshadowed).
 struct PreviewShadowSettings {
@@ -70,9 +82,15 @@ struct PreviewShadowSettings {
     /// Average C over 2 x 2 voxels across the beam at lookup: hides the moire
     /// rings regularly spaced hair casts through one-voxel-wide lines.
     bool filter = true;
-    /// Transmittance alpha per unit of C: light reaching a point is alpha^C,
-    /// where C counts strand fragments (Additive) or occupied voxels (Binary)
-    /// between the light and the point.
+    /// Crossings (default): C is the number of strand crossings a light ray
+    /// expects in front of a point (Additive; Binary: each occupied voxel
+    /// counts as one crossing of its widest strand), and light reaching the
+    /// point is exp(-(1 - T) C) with T = View::hair.transmittance, the
+    /// reference renderer's per-crossing transmittance: both renderers derive
+    /// hair shadows from that one parameter. Fragments: the seed's count,
+    /// light = alpha^C with the `alpha` below.
+    VoxelWeight weight = VoxelWeight::Crossings;
+    /// Fragments only: transmittance per counted fragment (or occupied voxel).
     float alpha = 0.85f;
     bool shadowMap = true;        ///< PCF shadow map of the opaque head (hair and head receive it)
     int shadowMapSize = 2048;
@@ -86,7 +104,8 @@ struct PreviewSettings {
     int tessellationLevel = 8;    ///< most pieces per strand segment (1..64)
     float tessellationPixels = 20.f;  ///< target on-screen length of a piece; 0 = always the most
     float minPixelWidth = 1.f;    ///< thinnest ribbon drawn (output pixels); alpha scales coverage below
-    float blendDepthScale = 0.02f;   ///< metres; smaller = nearer hair dominates more
+    HairBlend blend = HairBlend::Sorted;
+    float blendDepthScale = 0.02f;   ///< Weighted: metres; smaller = nearer hair dominates more
     /// Shade hair per fragment instead of per ribbon vertex (tessellated
     /// piece end). Per vertex is several times faster on llvmpipe; per
     /// fragment resolves sharp highlights and shadow edges along a strand.
@@ -126,7 +145,8 @@ struct PreviewStats {
 };
 
 /// The shadow grid after the last draw: raw voxel values V and the summed C
-/// the shading reads (both in units of one fragment), plus the mapping.
+/// the shading reads (both in strand crossings, or fragments with
+/// VoxelWeight::Fragments), plus the mapping.
 struct VoxelSnapshot {
     int resolution = 0;
     LightGrid grid;

@@ -36,7 +36,6 @@ void StrandBuffers::create() {
     glVertexArrayAttribFormat(vao, 0, 4, GL_FLOAT, GL_FALSE, 0);
     glVertexArrayAttribBinding(vao, 0, 0);
     glCreateBuffers(1, &indices);
-    glCreateBuffers(1, &patchSegments);
     GLint limit = 32;
     glGetIntegerv(GL_MAX_PATCH_VERTICES, &limit);
     maxPatchVertices = std::clamp(limit, 4, 32);  // 32: the TCS's array size
@@ -44,12 +43,11 @@ void StrandBuffers::create() {
 
 void StrandBuffers::destroy() {
     if (vao) glDeleteVertexArrays(1, &vao);
-    GLuint buffers[] = {indices, patchSegments};
-    glDeleteBuffers(2, buffers);
-    vao = indices = patchSegments = 0;
+    if (indices) glDeleteBuffers(1, &indices);
+    vao = indices = 0;
 }
 
-void StrandBuffers::upload(const StrandFrame& s) {
+void StrandBuffers::upload(const StrandFrame& s, int maxSegments) {
     const size_t n = s.vertexCount();
     if (vertices.reserve(n * 4 * sizeof(float))) {
         glVertexArrayVertexBuffer(vao, 0, vertices.id(), 0, 4 * sizeof(float));
@@ -62,19 +60,21 @@ void StrandBuffers::upload(const StrandFrame& s) {
         out[4 * i + 2] = s.positions[i].z();
         out[4 * i + 3] = radii ? s.radii[i] : 0.00004f;
     }
-    if (s.offsets == offsets && indexCount > 0) return;
+    if (s.offsets == offsets && maxSegments == chunkSegments && indexCount > 0) return;
     // One patch per strand (or per chunk of a strand longer than a patch
-    // holds): the driver's per-patch cost dominates on software rasterizers,
-    // so patches are as long as GL allows. A patch holds the vertex before
-    // its first segment, the segments' vertices and the one after; at a root
-    // or tip the missing neighbour repeats the end vertex (the TES mirrors
-    // it) and unused slots repeat the last entry. The TCS reads each patch's
-    // segment count from an SSBO.
+    // holds, or than maxSegments): the driver's per-patch cost dominates on
+    // software rasterizers, so patches are as long as GL allows unless they
+    // are sorted. A patch holds the vertex before its first segment, the
+    // segments' vertices and the one after; at a root or tip the missing
+    // neighbour repeats the end vertex (the TES mirrors it) and unused slots
+    // repeat the last entry, from which the TCS reads the segment count.
     size_t longest = 2;
     for (size_t k = 0; k < s.strandCount(); ++k) longest = std::max<size_t>(longest, s.vertexCount(k));
+    if (maxSegments > 0) longest = std::min<size_t>(longest, size_t(maxSegments) + 1);
     patchSize = int(std::min<size_t>(size_t(maxPatchVertices), longest + 2));
     const uint32_t perPatch = uint32_t(patchSize - 3);  // segments one patch can hold
-    std::vector<uint32_t> list, counts;
+    list.clear();
+    counts.clear();
     list.reserve(s.vertexCount() * 2);
     segments = 0;
     for (size_t k = 0; k < s.strandCount(); ++k) {
@@ -90,12 +90,34 @@ void StrandBuffers::upload(const StrandFrame& s) {
         }
     }
     glNamedBufferData(indices, GLsizeiptr(std::max<size_t>(list.size(), 1) * sizeof(uint32_t)),
-                      list.empty() ? nullptr : list.data(), GL_STATIC_DRAW);
-    glNamedBufferData(patchSegments, GLsizeiptr(std::max<size_t>(counts.size(), 1) * sizeof(uint32_t)),
-                      counts.empty() ? nullptr : counts.data(), GL_STATIC_DRAW);
+                      list.empty() ? nullptr : list.data(), GL_DYNAMIC_DRAW);
     glVertexArrayElementBuffer(vao, indices);
     indexCount = list.size();
     offsets = s.offsets;
+    chunkSegments = maxSegments;
+}
+
+void StrandBuffers::sortBackToFront(const StrandFrame& s, const Vec3f& eye, const Vec3f& forward) {
+    const size_t patches = counts.size();
+    if (patches == 0) return;
+    const size_t ps = size_t(patchSize);
+    // Depth of each patch: the midpoint of its first and last vertex.
+    std::vector<std::pair<float, uint32_t>> keys(patches);
+    for (size_t p = 0; p < patches; ++p) {
+        const uint32_t a = list[p * ps + 1], b = list[p * ps + 1 + counts[p]];
+        const Vec3f mid = 0.5f * (s.positions[a] + s.positions[b]);
+        keys[p] = {(mid - eye).dot(forward), uint32_t(p)};
+    }
+    // Farthest first; ties keep strand order, so the result is deterministic.
+    std::sort(keys.begin(), keys.end(), [](const auto& x, const auto& y) {
+        return x.first > y.first || (x.first == y.first && x.second < y.second);
+    });
+    sortedList.resize(list.size());
+    for (size_t i = 0; i < patches; ++i) {
+        const uint32_t p = keys[i].second;
+        std::copy_n(list.begin() + std::ptrdiff_t(p * ps), ps, sortedList.begin() + std::ptrdiff_t(i * ps));
+    }
+    glNamedBufferSubData(indices, 0, GLsizeiptr(sortedList.size() * sizeof(uint32_t)), sortedList.data());
 }
 
 // ---- head ------------------------------------------------------------------

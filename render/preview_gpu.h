@@ -40,6 +40,8 @@ struct FrameUniforms {
 inline constexpr int kFlagVoxels = 1;
 inline constexpr int kFlagShadowMap = 2;
 inline constexpr int kFlagVoxelFilter = 4;
+/// Fixed point of the r32ui voxel grid (kVoxelUnit in shaders/common.glsl).
+inline constexpr float kVoxelUnit = 4096.f;
 
 /// A buffer mapped once for writing and kept mapped (GL 4.4 persistent,
 /// coherent mapping): per-frame uploads are a memcpy, and the storage is only
@@ -65,21 +67,30 @@ class PersistentBuffer {
 
 /// Simulated strands on the GPU: vertices (xyz, radius), the patch index list
 /// (a patch per strand, `patchSize` indices each) and each patch's segment
-/// count (SSBO), rebuilt only when the topology changes.
+/// count (CPU side, for sorting), rebuilt only when the topology changes.
 struct StrandBuffers {
     PersistentBuffer vertices;
     unsigned indices = 0;
-    unsigned patchSegments = 0;
     unsigned vao = 0;
     int maxPatchVertices = 32;
     int patchSize = 4;
     std::vector<uint32_t> offsets;  ///< topology of the current index list
     size_t indexCount = 0;
     size_t segments = 0;
+    std::vector<uint32_t> list;     ///< the patch index list in strand order
+    std::vector<uint32_t> counts;   ///< segments per patch, strand order
+    std::vector<uint32_t> sortedList;
 
     void create();
     void destroy();
-    void upload(const StrandFrame& strands);
+    int chunkSegments = 0;          ///< most segments per patch asked for (0: as many as fit)
+    /// Uploads the vertices; rebuilds the patches when the topology or
+    /// `maxSegments` (segments per patch, 0 = as many as a patch holds) changed.
+    void upload(const StrandFrame& strands, int maxSegments = 0);
+    /// Reorders the patches back to front along `forward` (the camera's
+    /// viewing direction, from `eye`) by the depth of each patch's midpoint,
+    /// for blending with the over operator.
+    void sortBackToFront(const StrandFrame& strands, const Vec3f& eye, const Vec3f& forward);
 };
 
 /// The head mesh (positions + normals interleaved), its triangle list, and the

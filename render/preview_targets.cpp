@@ -51,7 +51,7 @@ void RenderTargets::ensure(int w, int h, int s, int ss) {
     destroy();
     width = w, height = h, samples = s, supersample = ss;
     const int tw = w * ss, th = h * ss;
-    opaque = makeTarget(tw, th, s, GL_RGBA16F);
+    opaque = makeTarget(tw, th, s, GL_RGBA32F);  // sorted hair blends into it: half floats drift over many faint strands
     accum = makeTarget(tw, th, s, GL_RGBA32F);
     reveal = makeTarget(tw, th, s, GL_R32F);
     minDepth = makeTarget(tw, th, s, GL_R32F);

@@ -53,8 +53,8 @@ void checkSettings(const View& view, const ReferenceSettings& s) {
     if (s.samplesPerPixel < 1) throw FrameError(cat("reference: ", s.samplesPerPixel, " samples per pixel"));
     if (s.bounces < 0) throw FrameError(cat("reference: ", s.bounces, " bounces"));
     if (s.tileSize < 1) throw FrameError(cat("reference: tile size ", s.tileSize));
-    if (!(s.hairTransmittance >= 0.f && s.hairTransmittance <= 1.f))
-        throw FrameError(cat("reference: hair transmittance ", s.hairTransmittance, " is outside [0, 1]"));
+    const float t = view.hair.transmittance;
+    if (!(t >= 0.f && t <= 1.f)) throw FrameError(cat("reference: hair transmittance ", t, " is outside [0, 1]"));
 }
 
 /// Flush-to-zero and denormals-are-zero for the current thread while alive:

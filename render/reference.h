@@ -4,8 +4,8 @@
 // Two shading modes share one camera, light set and geometry:
 // - kajiya-kay: the preview's model, exactly kajiyaKay() of render/view.h
 //   with the View's HairMaterial, direct light only, with ray-traced shadows
-//   through semi-transparent hair (a fixed transmittance per strand crossing,
-//   the reference counterpart of the preview's voxel shadows). Any difference
+//   through semi-transparent hair (HairMaterial::transmittance per strand
+//   crossing, the same parameter the preview's voxel shadows derive from). Any difference
 //   to the preview is then visibility, shadows and anti-aliasing, not shading.
 // - physical: a path tracer with Chiang et al.'s hair BSDF (render/hair_bsdf.h)
 //   and a Lambertian head; shadow rays see hair as opaque because light that
@@ -44,7 +44,6 @@ struct ReferenceSettings {
     uint64_t seed = 1;
     int frame = 0;               ///< part of the random sequence, so frames decorrelate
     bool shadows = true;
-    float hairTransmittance = 0.8f;  ///< kajiya-kay shadow rays: light passing each strand crossing (0..1)
     HairFiberParams fiber;           ///< physical mode
     /// physical: light samples whose unshadowed contribution is below this
     /// fraction of the light's radiance (max over RGB of path throughput ×

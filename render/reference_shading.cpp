@@ -89,7 +89,7 @@ Vec3f incident(const ShadingContext& ctx, const Light& light, const Vec3f& p, fl
 SampleResult shadeKajiyaKay(const ShadingContext& ctx, const Vec3f& o, const Vec3f& d, const SceneHit& hit) {
     SampleResult r;
     const View& view = ctx.view;
-    const float T = ctx.settings.hairTransmittance;
+    const float T = view.hair.transmittance;
     const Vec3f p = o + hit.t * d;
     const Vec3f v = -d;
     Vec3f l;

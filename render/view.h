@@ -79,6 +79,12 @@ struct HairMaterial {
     float secondaryKs = 0.15f;
     float secondaryShininess = 20.f;
     Vec3f secondaryColor{0.6f, 0.45f, 0.3f};
+    /// Fraction of light a shadow ray keeps at each strand it crosses (0..1):
+    /// the one parameter of hair self-shadowing in both renderers. The
+    /// reference multiplies it per traced crossing; the preview's voxel grid
+    /// counts expected crossings C and uses exp(-(1 - T) C), the mean of T^n
+    /// over the Poisson-distributed crossing counts n of thin fibres.
+    float transmittance = 0.8f;
 };
 
 /// Opaque head material (simple Lambert + ambient).

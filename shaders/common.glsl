@@ -17,7 +17,7 @@ layout(std140, binding = 0) uniform Frame {
     vec4 uSecondColor;  // rgb, secondary ks
     vec4 uHairShape;    // shininess, secondary shininess, primary shift, secondary shift
     vec4 uHeadColor;    // rgb albedo, ambient
-    vec4 uShadow;       // alpha, pcf radius, 1 / shadow map size, shadow-map depth bias
+    vec4 uShadow;       // optical depth per unit of C, pcf radius, 1 / shadow map size, shadow-map depth bias
     vec4 uTess;         // max level, target pixels per piece, curve (0 Catmull-Rom, 1 B-spline), min width (px)
     vec4 uBlend;        // reference depth (m), depth scale (m), thin strands drawn as lines (0/1)
     vec4 uGravity;      // generated hair: xyz gravity
@@ -30,6 +30,11 @@ layout(std140, binding = 0) uniform Frame {
 const int kFlagVoxels = 1;
 const int kFlagShadowMap = 2;
 const int kFlagVoxelFilter = 4;
+
+// Fixed point of the r32ui voxel grid: this many units make 1 (one strand
+// crossing, or one fragment in the seed's count). Mirrors kVoxelUnit in
+// render/preview_gpu.h.
+const float kVoxelUnit = 4096.0;
 
 // Grid coordinates of a world point in the light's box (render/light_grid.h).
 vec3 lightGrid(vec3 world) {

@@ -11,6 +11,8 @@ layout(triangles) in;
 #ifdef VOXEL_PASS
 layout(line_strip, max_vertices = 17) out;
 layout(location = 0) out vec3 gWorld;
+layout(location = 1) out vec3 gTangent;
+layout(location = 2) out float gRadius;
 #else
 layout(triangle_strip, max_vertices = 34) out;
 #include "ribbon.glsl"
@@ -36,13 +38,15 @@ void main() {
     vec3 force = uGravity.xyz + uWind.xyz * (1.0 + uWind.w * sin(phase));
     vec3 prevDir = dir;
     for (int k = 0; k <= segments; ++k) {
+        vec3 tangent = k == 0 ? dir : (k == segments ? prevDir : normalize(prevDir + dir));
+        float radius = mix(shape.z, shape.w, float(k) / float(segments));
 #ifdef VOXEL_PASS
         gWorld = position;
+        gTangent = tangent;
+        gRadius = radius;
         gl_Position = uViewProj * vec4(position, 1.0);
         EmitVertex();
 #else
-        vec3 tangent = k == 0 ? dir : (k == segments ? prevDir : normalize(prevDir + dir));
-        float radius = mix(shape.z, shape.w, float(k) / float(segments));
         emitRibbonEdges(position, tangent, radius, look.rgb);
 #endif
         position += shape.x * dir;

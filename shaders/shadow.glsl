@@ -1,5 +1,9 @@
 // Visibility of the shadowed light (seed 004, 2.3): hair transmittance
-// alpha^C from the summed voxel grid, times the PCF shadow map of the head.
+// exp(-k C) = alpha^C from the summed voxel grid, times the PCF shadow map of
+// the head. C counts strand crossings in front of the point (or fragments,
+// the seed's count) and k = uShadow.x is the optical depth of one: 1 - T for
+// a per-crossing transmittance T (render/preview.h says why), -ln(alpha) for
+// the seed's alpha.
 
 layout(binding = 0) uniform sampler3D uDensity;        // C (or V when the sum is off), trilinear
 layout(binding = 1) uniform sampler2DShadow uShadowMap; // head depth from the light, compare mode on
@@ -36,7 +40,7 @@ float voxelDensity(vec3 world) {
 float lightVisibility(int light, vec3 world) {
     if (light != uCounts.y) return 1.0;
     float v = 1.0;
-    if ((uCounts.z & kFlagVoxels) != 0) v *= pow(uShadow.x, voxelDensity(world));
+    if ((uCounts.z & kFlagVoxels) != 0) v *= exp(-uShadow.x * voxelDensity(world));
     if ((uCounts.z & kFlagShadowMap) != 0) v *= shadowMapVisibility(world);
     return v;
 }

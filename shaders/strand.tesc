@@ -13,15 +13,26 @@
 
 layout(vertices = PATCH_SIZE) out;
 in vec4 vPoint[];
+in float vIndex[];
 out vec4 cPoint[];
 patch out float pSegments;
 
-layout(std430, binding = 4) readonly buffer PatchSegments { uint uPatchSegments[]; };
+// Segments in this patch, read off its vertex indices: slots 1, 2, ... are
+// consecutive vertices of the strand up to its last segment's end; after it
+// comes the next vertex (a chunk that does not end at the tip) or the tip
+// again, repeated. (Not a per-patch buffer indexed by gl_PrimitiveID: Mesa
+// 22.3's llvmpipe numbers patches per batch there, which gave chunks of long
+// strands the wrong counts.)
+int patchSegments() {
+    int n = 0;
+    for (int k = 2; k < PATCH_SIZE && vIndex[k] == vIndex[k - 1] + 1.0; ++k) ++n;
+    return min(n, PATCH_SIZE - 3);
+}
 
 void main() {
     cPoint[gl_InvocationID] = vPoint[gl_InvocationID];
     if (gl_InvocationID != 0) return;
-    int segments = int(uPatchSegments[gl_PrimitiveID]);
+    int segments = patchSegments();
     // Screen length of the polyline and whether it lies beyond one clip plane.
     float pixels = 0.0;
     bvec4 outside = bvec4(true);

@@ -326,6 +326,52 @@ std::vector<float> cpuVoxelize(const std::vector<std::pair<Vec3f, Vec3f>>& lines
 /// The summed voxel grid the GPU shades with equals a CPU voxelization summed
 /// along the same light rays: transmittance alpha^C per voxel, for the seed's
 /// three voxelization modes.
+// With preview.shadow.weight: crossings (the default) the additive grid holds
+// expected strand crossings of a light ray: summed over the grid and times a
+// voxel column's cross-section it is the hair's projected area seen from the
+// light, sum of 2 r |segment| sin(theta) (theta between strand and light).
+TEST(Preview, VoxelCrossingsAddUpToProjectedArea) {
+    HP_REQUIRE_GL();
+    View v = testView(64, 48);
+    v.lights[0].direction = Vec3f(0.f, 0.f, -1.f);
+    StrandFrame strands;
+    uint32_t seed = 777;
+    auto random = [&seed] {
+        seed = seed * 1664525u + 1013904223u;
+        return float(seed >> 8) / float(1u << 24);
+    };
+    const float radius = 0.0001f;
+    double projected = 0.0;
+    for (int i = 0; i < 200; ++i) {
+        // Strands at up to ~60 degrees to the light and in every direction across it.
+        const Vec3f a(-0.04f + 0.02f * random(), -0.04f + 0.08f * random(), -0.04f + 0.02f * random());
+        const Vec3f b(0.04f - 0.02f * random(), -0.04f + 0.08f * random(), 0.04f - 0.02f * random());
+        addLine(strands, a, b, radius);
+        projected += 2.0 * radius * double((b - a).head<2>().norm());
+    }
+    for (VoxelSplat splat : {VoxelSplat::Nearest, VoxelSplat::Trilinear}) {
+        PreviewSettings s;
+        s.shadow.resolution = 64;
+        s.shadow.mode = VoxelMode::Additive;
+        s.shadow.splat = splat;
+        PreviewRenderer renderer(s);
+        PreviewFrame frame;
+        frame.strands = &strands;
+        renderer.draw(v, frame);
+        const VoxelSnapshot snap = renderer.readVoxels();
+        ASSERT_EQ(snap.resolution, 64);
+        ASSERT_FALSE(snap.grid.perspective);
+        double crossings = 0.0;
+        for (float c : snap.raw) crossings += c;
+        const double column = 1.0 / (double(snap.grid.scale.x()) * 64.0 * double(snap.grid.scale.y()) * 64.0);
+        EXPECT_NEAR(crossings * column / projected, 1.0, 0.05)
+            << (splat == VoxelSplat::Nearest ? "nearest" : "trilinear") << ": grid " << crossings * column
+            << " m^2, strands " << projected << " m^2";
+        std::cout << (splat == VoxelSplat::Nearest ? "nearest" : "trilinear") << ": grid / projected area "
+                  << crossings * column / projected << "\n";
+    }
+}
+
 TEST(Preview, VoxelTransmittanceMatchesCpuVoxelization) {
     HP_REQUIRE_GL();
     View v = testView(64, 48);
@@ -351,6 +397,7 @@ TEST(Preview, VoxelTransmittanceMatchesCpuVoxelization) {
                                std::pair{VoxelMode::Additive, VoxelSplat::Trilinear}}) {
         PreviewSettings s;
         s.shadow.resolution = res;
+        s.shadow.weight = VoxelWeight::Fragments;  // the seed's count, which cpuVoxelize mirrors
         s.shadow.alpha = alpha;
         s.shadow.mode = mode;
         s.shadow.splat = splat;
