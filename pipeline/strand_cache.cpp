@@ -107,8 +107,11 @@ StrandFrame readStrandCache(const std::filesystem::path& path) {
     in.seekg(0);
     in.read(data.data(), std::streamsize(data.size()));
     if (!in) throw AssetError(path.string(), "cannot read strand cache");
+    return parseStrandCache(data, path.string());
+}
 
-    Reader r(data, path.string());
+StrandFrame parseStrandCache(const std::vector<char>& data, const std::string& name) {
+    Reader r(data, name);
     char magic[8];
     r.bytes(magic, sizeof magic);
     if (std::memcmp(magic, kMagic, sizeof magic) != 0) r.fail("has a wrong magic number (not a hairpipe strand cache)");
