@@ -13,6 +13,7 @@ FollowerSettings followerSettings(const Scene& s) {
     f.fixedOffset = float(s.number("hair.followers.fixed_offset"));
     f.maxVelocity = float(s.number("hair.followers.max_velocity"));
     f.collide = s.flag("hair.followers.collide");
+    f.parallel = s.flag("hair.followers.parallel");
     f.seed = uint32_t(s.integer("seed"));
     // Followers taper like the guides (hair.radius.*; the curly model has its own).
     f.rootRadius = float(s.number("hair.radius.root"));

@@ -54,7 +54,13 @@ class HairFrameSource final : public FrameSource {
         data.strands = &sim_->advanceTo(frame);
         data.head = &sim_->pose();
         data.simulation = &sim_->stats();
-        if (shot_.writesCache && scene_.flag("cache.checkpoints")) {
+        if (shot_.writesCache && scene_.flag("cache.checkpoints") && !sim_->canCheckpoint() && !warned_) {
+            logWarning("no checkpoints: the ", scene_.text("simulation.formulation"),
+                       " formulation cannot be restored exactly, so a stopped simulation restarts from frame ",
+                       first_);
+            warned_ = true;
+        }
+        if (shot_.writesCache && scene_.flag("cache.checkpoints") && sim_->canCheckpoint()) {
             const fs::path checkpoint = cachePath(scene_, shot_, "cache.checkpoint", frame);
             writeAtomically(checkpoint, [&](const fs::path& tmp) { sim_->saveCheckpoint(tmp); });
         }
@@ -95,6 +101,7 @@ class HairFrameSource final : public FrameSource {
     std::unique_ptr<HeadSetup> head_;  ///< for cached frames, loaded on first use
     StrandFrame cached_;
     HeadPose pose_;
+    bool warned_ = false;
 };
 
 }  // namespace

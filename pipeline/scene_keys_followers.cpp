@@ -25,7 +25,10 @@ void addFollowerKeys(SchemaBuilder& b) {
                 "random variation.")
         .flag("hair.followers.collide", true,
               "Push follower vertices that end up inside the head back out along the distance gradient, "
-              "keeping segment lengths (follow-the-leader).");
+              "keeping segment lengths (follow-the-leader).")
+        .flag("hair.followers.parallel", true,
+              "Update followers on all threads (false: on one thread, seed 000's prototype without "
+              "parallelisation; results are identical either way).");
 }
 
 }  // namespace hp

@@ -31,7 +31,8 @@ double msSince(std::chrono::steady_clock::time_point start) {
 /// interpolated between two steps cuts the chord of its arc on a turning head).
 float frameAlignedStep(double fps, double maxStep) {
     const double frame = 1.0 / fps;
-    const double steps = std::ceil(frame / maxStep - 1e-9);
+    // The step keys are floats (0.02f is 0.0199999996): compare with a tolerance.
+    const double steps = std::max(1.0, std::ceil(frame / maxStep - 1e-5));
     return float(frame / steps);
 }
 
@@ -59,6 +60,9 @@ class GuideModel {
     virtual size_t guideCount() const = 0;
     /// -1 unless the model has a saturation.
     virtual double saturation() const { return -1; }
+    /// False when the model's state cannot be saved exactly (then a stopped
+    /// simulation restarts from the first frame instead of a checkpoint).
+    virtual bool canCheckpoint() const { return true; }
     virtual std::vector<char> saveState() const = 0;
     virtual void restoreState(const std::vector<char>& state) = 0;
     virtual const char* name() const = 0;
@@ -80,6 +84,7 @@ class RigidChainModel final : public GuideModel {
     }
     void write(StrandFrame& frame, double time) const override { solver_.write(frame, time); }
     size_t guideCount() const override { return solver_.guideCount(); }
+    bool canCheckpoint() const override { return solver_.settings().formulation == GuideFormulation::Rope; }
     std::vector<char> saveState() const override { return solver_.saveState(); }
     void restoreState(const std::vector<char>& state) override { solver_.restoreState(state); }
     const char* name() const override { return formulationName(solver_.settings().formulation); }
@@ -221,6 +226,7 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame)
 ShotSimulation::~ShotSimulation() = default;
 
 size_t ShotSimulation::guideCount() const { return model_->guideCount(); }
+bool ShotSimulation::canCheckpoint() const { return model_->canCheckpoint(); }
 size_t ShotSimulation::followerCount() const { return followers_->followerCount(); }
 
 const StrandFrame& ShotSimulation::advanceTo(int frame) {

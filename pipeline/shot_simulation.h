@@ -59,6 +59,9 @@ class ShotSimulation {
     size_t guideCount() const;
     size_t followerCount() const;
 
+    /// False for models whose state cannot be restored bit for bit (the rigid
+    /// formulation keeps orientations and warm-start impulses inside Bullet).
+    bool canCheckpoint() const;
     /// Writes the complete simulation state at frame() (the solver state; the
     /// frame's strands themselves are the strand cache's job).
     void saveCheckpoint(const std::filesystem::path& file) const;

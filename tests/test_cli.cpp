@@ -76,3 +76,14 @@ TEST(Cli, ThreadsMustBePositive) {
     EXPECT_EQ(runHairpipe("validate ok.yaml --threads 0", dir.path()).exitCode, 1);
     EXPECT_EQ(runHairpipe("validate ok.yaml --threads 2", dir.path()).exitCode, 0);
 }
+
+TEST(Cli, EveryBundledSceneValidates) {
+    size_t count = 0;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(sourcePath("scenes"))) {
+        if (entry.path().extension() != ".yaml") continue;
+        ++count;
+        const ProcessResult r = runHairpipe("validate '" + entry.path().string() + "'");
+        EXPECT_EQ(r.exitCode, 0) << entry.path() << ":\n" << r.output;
+    }
+    EXPECT_GE(count, 7u) << "default, curly_wet and the Table 5.1 rows";
+}

@@ -4,15 +4,19 @@
 // matches.
 //
 //   make_head OUT.glb [--rings N] [--sectors N] [--key-rate HZ]
+//   make_head OUT.glb --sphere RADIUS    a static UV sphere, the seed's and
+//                                        the benchmarks' head (scenes/assets/sphere.glb)
 #include "core/errors.h"
 #include "pipeline/default_head.h"
 #include "pipeline/output.h"
+#include "sim/head.h"
 
 #include <assimp/Exporter.hpp>
 #include <assimp/material.h>
 #include <assimp/scene.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -23,6 +27,25 @@
 using namespace hp;
 
 namespace {
+
+/// A static sphere rig: one node, one mesh with the "scalp" material, no clip.
+HeadRig sphereRig(float radius) {
+    HeadRig rig;
+    rig.nodes.push_back(RigNode{"Sphere", -1, Affine3f::Identity()});
+    const TriangleMesh m = makeSphereMesh(Vec3f::Zero(), radius, 48, 96);
+    RigMesh mesh;
+    mesh.name = "sphere";
+    mesh.node = 0;
+    mesh.material = 0;
+    mesh.positions = m.positions;
+    mesh.normals = m.normals;
+    mesh.uvs = m.uvs;
+    mesh.triangles = m.triangles;
+    mesh.colors.assign(m.positions.size(), Eigen::Vector4f(1.f, 1.f, 1.f, 1.f));  // all scalp
+    rig.meshes.push_back(std::move(mesh));
+    rig.materials = {"scalp"};
+    return rig;
+}
 
 aiMatrix4x4 toAssimp(const Affine3f& a) {
     aiMatrix4x4 m;
@@ -176,18 +199,22 @@ int main(int argc, char** argv) {
     try {
         DefaultHeadOptions options;
         std::string out;
+        double sphere = 0;
         for (int i = 1; i < argc; ++i) {
             const std::string a = argv[i];
             if (a == "--rings") options.rings = intOption(a, i + 1 < argc ? argv[++i] : nullptr);
             else if (a == "--sectors") options.sectors = intOption(a, i + 1 < argc ? argv[++i] : nullptr);
             else if (a == "--key-rate") options.keyRate = intOption(a, i + 1 < argc ? argv[++i] : nullptr);
+            else if (a == "--sphere" && i + 1 < argc) sphere = std::atof(argv[++i]);
             else if (a == "-h" || a == "--help" || (!a.empty() && a[0] == '-') || !out.empty())
                 throw UsageError("usage: make_head OUT.glb [--rings N] [--sectors N] [--key-rate HZ]");
             else out = a;
         }
         if (out.empty()) throw UsageError("usage: make_head OUT.glb [--rings N] [--sectors N] [--key-rate HZ]");
 
-        const HeadRig rig = makeDefaultHead(options);
+        if (sphere < 0 || (sphere == 0 && std::find(argv, argv + argc, std::string("--sphere")) != argv + argc))
+            throw UsageError("make_head: --sphere needs a positive radius in metres");
+        const HeadRig rig = sphere > 0 ? sphereRig(float(sphere)) : makeDefaultHead(options);
         aiScene scene;
         scene.mRootNode = buildNodes(rig, 0);
         scene.mNumMeshes = unsigned(rig.meshes.size());
@@ -197,7 +224,7 @@ int main(int argc, char** argv) {
         scene.mMaterials = new aiMaterial*[2]{buildMaterial("scalp", aiColor4D(0.25f, 0.16f, 0.1f, 1.f)),
                                               buildMaterial("skin", aiColor4D(0.75f, 0.6f, 0.5f, 1.f))};
         scene.mNumAnimations = unsigned(rig.clips.size());
-        scene.mAnimations = new aiAnimation*[scene.mNumAnimations];
+        scene.mAnimations = scene.mNumAnimations ? new aiAnimation*[scene.mNumAnimations] : nullptr;
         for (unsigned c = 0; c < scene.mNumAnimations; ++c) scene.mAnimations[c] = buildClip(rig, rig.clips[c]);
 
         writeAtomically(out, [&](const std::filesystem::path& tmp) {
@@ -207,8 +234,9 @@ int main(int argc, char** argv) {
             zeroUnusedGlbBytes(tmp);
         });
         std::cout << "make_head: wrote " << out << " (" << rig.triangleCount() << " triangles, "
-                  << rig.vertexCount() << " vertices, clip " << rig.clips[0].name << " " << rig.clips[0].duration
-                  << " s)\n";
+                  << rig.vertexCount() << " vertices";
+        if (!rig.clips.empty()) std::cout << ", clip " << rig.clips[0].name << " " << rig.clips[0].duration << " s";
+        std::cout << ")\n";
         return 0;
     } catch (const UsageError& e) {
         std::cerr << e.what() << "\n";
