@@ -19,7 +19,7 @@ void addSceneKeys(SchemaBuilder& b) {
     addVdbKeys(b);
     addCompareKeys(b);
     addStageFrameKeys(b);
-    addLimitKeys(b);
+    addBudgetKeys(b);
 }
 
 void addShotKeys(SchemaBuilder& b) {
