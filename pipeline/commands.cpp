@@ -4,6 +4,7 @@
 #include "pipeline/curly_settings.h"
 #include "pipeline/frame_range.h"
 #include "pipeline/head_setup.h"
+#include "pipeline/output.h"
 #include "pipeline/progress.h"
 #include "pipeline/schema.h"
 #include "pipeline/view_settings.h"
@@ -81,6 +82,7 @@ int runShotCommand(const CommandContext& ctx, const std::set<std::string>& only)
     for (const StagePtr& s : stages) names += (names.empty() ? "" : ", ") + s->name();
     logInfo("hairpipe: ", ctx.scene.name(), ": frames ", formatFrameRange(shot.frames), " -> ",
             shot.outputDir.string(), " (stages: ", names.empty() ? "none" : names, ")");
+    if (!stages.empty()) checkOutputDirectory(shot.outputDir);  // exit 1 now, not a failure per frame
     std::unique_ptr<FrameSource> source = makeFrameSource(ctx.scene, shot);
     const RunReport report = runFrames(*source, stages, shot);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

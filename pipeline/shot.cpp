@@ -57,12 +57,16 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
         if (needsData) {
             try {
                 data = source.get(frame);
-            } catch (const Error& e) {
+            } catch (const FrameError& e) {
                 // Without the frame's data no data stage can run; later frames may still work.
                 report.failures.push_back(cat("frame ", frame, ": ", e.what()));
                 logError("frame ", frame, ": ", e.what());
                 sourceFailed = true;
             }
+            // Any other error (a scene key, an unreadable head, a scalp that
+            // grows no hair) would fail every frame the same way: it ends the
+            // run with exit code 1, as a scene error found at load would.
+
         }
         for (FrameStage* stage : todo) {
             if (sourceFailed && stage->needsFrameData()) continue;
