@@ -4,7 +4,7 @@
 # first error by default, -fno-sanitize-recover makes UBSan do the same.
 # Build it in a second folder, e.g.
 #   cmake -S . -B build-asan -DHAIRPIPE_SANITIZE=ON && cmake --build build-asan -j2
-# and run `tools/test --sanitize` (README, "Sanitizer and fuzz builds").
+# or just run tools/sanitize/run (docs/hardening.md).
 option(HAIRPIPE_SANITIZE "Build with AddressSanitizer + UndefinedBehaviorSanitizer" OFF)
 
 if(HAIRPIPE_SANITIZE)
@@ -12,8 +12,11 @@ if(HAIRPIPE_SANITIZE)
     message(FATAL_ERROR "HAIRPIPE_SANITIZE needs GCC or Clang")
   endif()
   # -g1: line tables for readable reports at a fraction of full debug info's cost.
+  # -O1 (after the build type's -O3, so it wins): about half the compile time
+  # of -O3 with instrumentation, which dominates the CI budget; the fast
+  # tests barely notice the slower code.
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer
-                      -fno-sanitize-recover=all -g1)
+                      -fno-sanitize-recover=all -g1 -O1)
   add_link_options(-fsanitize=address,undefined)
   # Embedded runtime defaults (halt on error, exit code, leak suppressions),
   # so a sanitized binary behaves the same whether CTest, a test's

@@ -4,6 +4,8 @@
 // line, key, what is wrong) and that nothing was left in the output folder.
 // Under the sanitizer build a memory error exits 86, so "exit 1" also means
 // "no crash".
+#include "core/errors.h"
+#include "pipeline/scene.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -19,6 +21,17 @@ namespace {
 void expectRejected(const ProcessResult& r, std::initializer_list<const char*> needles) {
     EXPECT_EQ(r.exitCode, 1) << r.output;
     for (const char* n : needles) EXPECT_NE(r.output.find(n), std::string::npos) << "missing '" << n << "' in\n" << r.output;
+}
+
+/// In-process twin of a `validate` run (same loader, same message), for the
+/// long tables; each table also goes through the binary once.
+std::string loadError(const std::filesystem::path& file) {
+    try {
+        hp::Scene::load(file);
+    } catch (const hp::Error& e) {
+        return e.what();
+    }
+    return "(loaded without error)";
 }
 
 /// Number of files (of any kind) under `dir`; 0 if it does not exist.
@@ -93,14 +106,16 @@ TEST(Hostile, NanAndInfinityInNumericKeys) {
         {"fps: nan\n", "n.yaml:1:6: 'fps': must be a finite number, got 'nan'"},
         {"hair:\n  guides:\n    length: .inf\n", "n.yaml:3:13: 'hair.guides.length': must be a finite number, got '.inf'"},
         {"hair:\n  guides:\n    length: -.Inf\n", "'hair.guides.length': must be a finite number, got '-.Inf'"},
-        {"head:\n  translate: [0, inf, 0]\n", "n.yaml:2:17: 'head.translate': must be a finite number, got 'inf'"},
+        {"head:\n  translate: [0, inf, 0]\n", "n.yaml:2:18: 'head.translate': must be a finite number, got 'inf'"},
         {"fps: 1e999\n", "n.yaml:1:6: 'fps': must be a finite number, got '1e999'"},
         {"render:\n  camera:\n    fov: NaN\n", "'render.camera.fov': must be a finite number"},
     };
     for (const auto& [yaml, message] : cases) {
         writeFile(dir / "n.yaml", yaml);
-        expectRejected(runHairpipe("validate n.yaml", dir.path()), {message});
+        EXPECT_NE(loadError(dir / "n.yaml").find(message), std::string::npos) << loadError(dir / "n.yaml");
     }
+    writeFile(dir / "n.yaml", cases[0].first);
+    expectRejected(runHairpipe("validate n.yaml", dir.path()), {cases[0].second});
 }
 
 TEST(Hostile, NegativeAndZeroCounts) {
@@ -115,8 +130,10 @@ TEST(Hostile, NegativeAndZeroCounts) {
     };
     for (const auto& [yaml, message] : cases) {
         writeFile(dir / "z.yaml", yaml);
-        expectRejected(runHairpipe("validate z.yaml", dir.path()), {message});
+        EXPECT_NE(loadError(dir / "z.yaml").find(message), std::string::npos) << loadError(dir / "z.yaml");
     }
+    writeFile(dir / "z.yaml", cases[0].first);
+    expectRejected(runHairpipe("validate z.yaml", dir.path()), {cases[0].second});
 }
 
 TEST(Hostile, AbsurdSizesAreRejectedAtLoad) {
@@ -134,18 +151,21 @@ TEST(Hostile, AbsurdSizesAreRejectedAtLoad) {
         {"render:\n  camera: {width: 16384, height: 16384}\nreference: {scale: 4}\n",
          "'render.camera.width': reference pixels (width × height × reference.scale²) would be 4.29497e+09"},
         {"render:\n  camera: {width: 8192, height: 8192}\nreference: {samples: 4096}\n",
-         "a.yaml:4:23: 'reference.samples': reference camera samples per frame"},
+         "a.yaml:3:22: 'reference.samples': reference camera samples per frame"},
     };
     for (const auto& [yaml, message] : cases) {
         writeFile(dir / "a.yaml", yaml);
-        // `run` too: the scene is refused before an output folder or any
-        // stage exists.
-        expectRejected(runHairpipe("validate a.yaml", dir.path()), {message});
-        expectRejected(runHairpipe("run a.yaml --out out", dir.path()), {message});
-        EXPECT_FALSE(fs::exists(dir / "out")) << yaml;
+        EXPECT_NE(loadError(dir / "a.yaml").find(message), std::string::npos) << loadError(dir / "a.yaml");
+    }
+    // Through the binary, with `run`: the scene is refused before an output
+    // folder or any stage exists.
+    for (size_t i : {size_t(0), size_t(3)}) {
+        writeFile(dir / "a.yaml", cases[i].first);
+        expectRejected(runHairpipe("run a.yaml --out out", dir.path()), {cases[i].second});
+        EXPECT_FALSE(fs::exists(dir / "out"));
     }
     // A bigger machine raises the budget.
-    writeFile(dir / "a.yaml", "hair:\n  guides:\n    count: 1000000\n    segments: 200\nbudget:\n  guide_vertices: 3e8\n");
+    writeFile(dir / "a.yaml", "hair:\n  guides:\n    count: 1000000\n    segments: 200\nbudget:\n  guide_vertices: 3e8\n  strand_vertices: 3e8\n");
     EXPECT_EQ(runHairpipe("validate a.yaml", dir.path()).exitCode, 0);
 }
 
