@@ -189,7 +189,8 @@ TEST(Hostile, DegenerateTriangles) {
     // Only zero-area triangles: no scalp area to grow roots on.
     writeFile(dir / "flat.obj", "v 0 0 0\nv 0.1 0 0\nv 0.2 0 0\nv 0.3 0 0\nf 1 2 3\nf 2 3 4\n");
     writeFile(dir / "s.yaml", shotWithHead("flat.obj"));
-    expectRejected(runHairpipe("sim s.yaml --out out", dir.path()), {"reaches only 0 of 6 roots on the scalp"});
+    expectRejected(runHairpipe("sim s.yaml --out out", dir.path()),
+                   {"s.yaml:2:", "'head.file': the scalp's 2 triangles have zero area (degenerate) in"});
     EXPECT_EQ(filesUnder(dir / "out"), 0u);
     // Degenerate triangles beside good ones are harmless: hair grows on the
     // rest. An octahedron of radius 0.1 m plus two zero-area triangles.
@@ -201,6 +202,25 @@ TEST(Hostile, DegenerateTriangles) {
     const ProcessResult ok = runHairpipe("sim s.yaml --out out", dir.path());
     EXPECT_EQ(ok.exitCode, 0) << ok.output;
     EXPECT_TRUE(fs::exists(dir / "out/cache/strands.0002.hpc")) << ok.output;
+}
+
+TEST(Hostile, OpenHeadIsWarnedAbout) {
+    TempDir dir;
+    // One triangle: three boundary edges. Scanned heads are often open at the
+    // neck, so the shot runs, with a warning about the level-set collider.
+    writeFile(dir / "open.obj", "v 0 0.1 0\nv 0.1 0 0\nv 0 0 0.1\nf 1 3 2\n");
+    writeFile(dir / "s.yaml", shotWithHead("open.obj"));
+    const ProcessResult r = runHairpipe("sim s.yaml --out out", dir.path());
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("open.obj is open (3 boundary edges)"), std::string::npos) << r.output;
+    // A closed mesh (the mixed octahedron above without its extras) is not.
+    writeFile(dir / "closed.obj",
+              "v 0.1 0 0\nv -0.1 0 0\nv 0 0.1 0\nv 0 -0.1 0\nv 0 0 0.1\nv 0 0 -0.1\n"
+              "f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n");
+    writeFile(dir / "c.yaml", shotWithHead("closed.obj"));
+    const ProcessResult c = runHairpipe("sim c.yaml --out out2", dir.path());
+    EXPECT_EQ(c.exitCode, 0) << c.output;
+    EXPECT_EQ(c.output.find("boundary edges"), std::string::npos) << c.output;
 }
 
 TEST(Hostile, ScalpSelectionThatSelectsNothing) {
