@@ -6,6 +6,7 @@
 // "no crash".
 #include "core/errors.h"
 #include "pipeline/scene.h"
+#include "pipeline/strand_cache.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -221,6 +222,22 @@ TEST(Hostile, OpenHeadIsWarnedAbout) {
     const ProcessResult c = runHairpipe("sim c.yaml --out out2", dir.path());
     EXPECT_EQ(c.exitCode, 0) << c.output;
     EXPECT_EQ(c.output.find("boundary edges"), std::string::npos) << c.output;
+}
+
+TEST(Hostile, ZeroLengthClip) {
+    TempDir dir;
+    // A glTF whose only clip has a single key at t = 0: duration 0. Looping
+    // it must not divide by zero; the head holds its keyed pose.
+    writeFile(dir / "still.gltf", "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0,\"name\":\"Head\"}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],\"buffers\":[{\"byteLength\":52,\"uri\":\"data:application/octet-stream;base64,AAAAAM3MzD0AAAAAzczMPQAAAAAAAAAAAAAAAAAAAADNzMw9AAAAAAAAAAAK1yM8AAAAAA==\"}],\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":4},{\"buffer\":0,\"byteOffset\":40,\"byteLength\":12}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[0.1,0.1,0.1]},{\"bufferView\":1,\"componentType\":5126,\"count\":1,\"type\":\"SCALAR\",\"min\":[0],\"max\":[0]},{\"bufferView\":2,\"componentType\":5126,\"count\":1,\"type\":\"VEC3\"}],\"animations\":[{\"name\":\"still\",\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}],\"samplers\":[{\"input\":1,\"output\":2,\"interpolation\":\"LINEAR\"}]}]}");
+    writeFile(dir / "s.yaml", "frames: 1-3\nhead: {file: still.gltf, loop: true}\n"
+                              "hair:\n  guides: {count: 6, segments: 4}\n  followers: {count: 10}\n");
+    const ProcessResult info = runHairpipe("info s.yaml", dir.path());
+    EXPECT_NE(info.output.find("0: still, 0.00 s"), std::string::npos) << info.output;
+    const ProcessResult r = runHairpipe("sim s.yaml --out out", dir.path());
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    // readStrandCache validates (finite positions, consistent sizes).
+    const hp::StrandFrame f = hp::readStrandCache(dir / "out/cache/strands.0003.hpc");
+    EXPECT_EQ(f.strandCount(), 16u);
 }
 
 TEST(Hostile, ScalpSelectionThatSelectsNothing) {
