@@ -81,6 +81,8 @@ TEST(SimGuards, LongViolentRunStaysBoundedAndFinite) {
             ASSERT_LE(st.maxLengthError, 1e-2) << "step " << k;
         }
     }
+    RecordProperty("peak_speed_mm_per_s", int(peakSpeed * 1000));
+    RecordProperty("peak_energy_uj", int(peakEnergy * 1e6));
     EXPECT_LT(peakSpeed, speedBound);
     EXPECT_LT(peakEnergy, energyBound);
     EXPECT_GT(peakEnergy, 1e-4) << "the shaking moved the hair";
