@@ -14,6 +14,8 @@ CommandSpec vdbCommandSpec() {
         "and writes vdb.output (default vdb/hair.####.vdb) under the output folder. Frames\n"
         "whose file exists are skipped unless --force. The scene must set vdb.enabled: true\n"
         "(or pass --set vdb.enabled=true).";
+    c.options = {{"--jobs", "N", "write N frames at once in child processes (simulating missing cache frames first)"},
+                 {"--chunk", "N", "--jobs: frames per child process"}};
     c.run = [](const CommandLine& cl) {
         CommandContext ctx(cl);
         if (!ctx.scene.flag("vdb.enabled"))

@@ -2,9 +2,13 @@
 
 #include "core/log.h"
 #include "pipeline/curly_settings.h"
+#include "pipeline/frame_jobs.h"
 #include "pipeline/frame_range.h"
+#include "pipeline/hair_source.h"
 #include "pipeline/head_setup.h"
 #include "pipeline/output.h"
+#include "pipeline/shot_outputs.h"
+#include "pipeline/stages.h"
 #include "pipeline/progress.h"
 #include "pipeline/schema.h"
 #include "pipeline/view_settings.h"
@@ -24,6 +28,8 @@ const std::vector<CommandSpec>& commands() {
         compareCommandSpec(),
         viewCommandSpec(),
         vdbCommandSpec(),
+        exportUsdCommandSpec(),
+        farmCommandSpec(),
         validateCommandSpec(),
         infoCommandSpec(),
         helpCommandSpec(),
@@ -49,6 +55,31 @@ long positiveInteger(const CommandLine& cl, const std::string& option, long max)
     return n;
 }
 
+/// --jobs, --chunk (run, render, vdb) and --stages, --cache-only,
+/// --no-report (run); a command that does not list one never sees it.
+void parseBatchOptions(const CommandLine& cl, RunOptions& options) {
+    if (cl.has("--jobs")) options.jobs = int(positiveInteger(cl, "--jobs", 256));
+    if (cl.has("--chunk")) options.chunk = int(positiveInteger(cl, "--chunk", 1000000));
+    options.cacheOnly = cl.has("--cache-only");
+    options.noReport = cl.has("--no-report");
+    if (cl.has("--stages")) {
+        const std::string list = cl.value("--stages");
+        size_t start = 0;
+        while (start <= list.size()) {
+            const size_t end = std::min(list.find(',', start), list.size());
+            const std::string name = list.substr(start, end - start);
+            const std::vector<std::string>& known = stageNames();
+            if (std::find(known.begin(), known.end(), name) == known.end()) {
+                std::string all;
+                for (const std::string& k : known) all += (all.empty() ? "" : ", ") + k;
+                throw UsageError("option --stages: unknown stage '" + name + "' (stages: " + all + ")");
+            }
+            options.only.insert(name);
+            start = end + 1;
+        }
+    }
+}
+
 }  // namespace
 
 CommandContext::CommandContext(const CommandLine& cl) {
@@ -64,11 +95,15 @@ CommandContext::CommandContext(const CommandLine& cl) {
     if (cl.has("--threads")) {
         const long n = positiveInteger(cl, "--threads", 1024);
         threads_ = std::make_shared<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(n));
+        options.threads = int(n);
     }
+    options.sceneFile = sceneArgument(cl);
     scene = Scene::load(sceneArgument(cl), sets);
+    options.sets = sets;
     if (cl.has("--frames")) options.frames = parseFrameRange(cl.value("--frames"));
     if (cl.has("--out")) options.outputDir = cl.value("--out");
     options.force = cl.has("--force");
+    parseBatchOptions(cl, options);
 }
 
 CommandContext::~CommandContext() = default;
@@ -83,8 +118,19 @@ int runShotCommand(const CommandContext& ctx, const std::set<std::string>& only)
     logInfo("hairpipe: ", ctx.scene.name(), ": frames ", formatFrameRange(shot.frames), " -> ",
             shot.outputDir.string(), " (stages: ", names.empty() ? "none" : names, ")");
     if (!stages.empty()) checkOutputDirectory(shot.outputDir);  // exit 1 now, not a failure per frame
-    std::unique_ptr<FrameSource> source = makeFrameSource(ctx.scene, shot);
-    const RunReport report = runFrames(*source, stages, shot);
+    // A killed run leaves temporaries beside its outputs; drop those of dead writers.
+    std::set<std::filesystem::path> cacheFolders;
+    if (sceneHasHair(ctx.scene) && !shot.frames.empty())
+        cacheFolders.insert(cachePath(ctx.scene, shot, "cache.checkpoint", shot.frames.front()).parent_path());
+    cleanStaleTemporaries(stages, shot.frames, cacheFolders);
+    RunReport report;
+    if (ctx.options.jobs > 1) {
+        stages.clear();
+        report = runShotInJobs(ctx.scene, ctx.options, only);
+    } else {
+        std::unique_ptr<FrameSource> source = makeFrameSource(ctx.scene, shot);
+        report = runFrames(*source, stages, shot);
+    }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     logInfo("hairpipe: ", report.framesDone, " frames in ", formatDuration(seconds), ", ", report.outputsSkipped,
             " stage outputs already present (skipped)", report.failures.empty() ? "" : ", FAILURES:");
@@ -100,10 +146,21 @@ CommandSpec runCommandSpec() {
     c.details =
         "Frames whose outputs all exist are skipped (use --force to redo them), so an\n"
         "interrupted batch resumes where it stopped. Each file is written under a\n"
-        "temporary name and renamed when complete.";
+        "temporary name and renamed when complete.\n\n"
+        "With --jobs N the simulation runs first (writing the strand cache), then the\n"
+        "frame stages run in N child processes at a time, each a chunk of frames read\n"
+        "from the cache; outputs are identical to --jobs 1. --stages, --cache-only and\n"
+        "--no-report run one chunk of a larger run (what --jobs and farm tasks run).";
+    c.options = {
+        {"--jobs", "N", "run the frame stages in N processes at once (after the simulation)"},
+        {"--chunk", "N", "--jobs: frames per child process (default: about 4 chunks per job)"},
+        {"--stages", "LIST", "run only these stages, e.g. preview,vdb (sim, preview, reference, vdb, compare)"},
+        {"--cache-only", "", "read strands only from the strand cache; a frame without one fails"},
+        {"--no-report", "", "skip whole-run outputs (the compare report): for one chunk of a larger run"},
+    };
     c.run = [](const CommandLine& cl) {
         CommandContext ctx(cl);
-        return runShotCommand(ctx, {});
+        return runShotCommand(ctx, ctx.options.only);
     };
     return c;
 }
@@ -114,7 +171,10 @@ CommandSpec renderCommandSpec() {
     c.usage = "[--preview] [--reference] [options] scene.yaml";
     c.summary = "render preview (GL) and/or reference (Embree) frames";
     c.details = "Without --preview or --reference, renders whichever of the two the scene enables.";
-    c.options = {{"--preview", "", "render the GL preview"}, {"--reference", "", "render the Embree reference"}};
+    c.options = {{"--preview", "", "render the GL preview"},
+                 {"--reference", "", "render the Embree reference"},
+                 {"--jobs", "N", "render N frames at once in child processes (simulating missing cache frames first)"},
+                 {"--chunk", "N", "--jobs: frames per child process"}};
     c.run = [](const CommandLine& cl) {
         CommandContext ctx(cl);
         std::set<std::string> only;

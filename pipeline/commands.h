@@ -18,6 +18,8 @@ CommandSpec infoCommandSpec();
 CommandSpec helpCommandSpec();
 CommandSpec compareCommandSpec();
 CommandSpec viewCommandSpec();  // command_view.cpp
+CommandSpec farmCommandSpec();       // command_farm.cpp
+CommandSpec exportUsdCommandSpec();  // command_export_usd.cpp
 
 /// A scene loaded from a command line (scene path, --set, --seed) with the
 /// run options (--frames, --out, --force) and the --threads limit, which

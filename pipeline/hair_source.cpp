@@ -38,7 +38,10 @@ class HairFrameSource final : public FrameSource {
         data.time = frame / shot_.fps;
         const fs::path cache = cachePath(scene_, shot_, "cache.strands", frame);
         std::error_code ec;
-        if (!shot_.force && scene_.flag("cache.enabled") && fs::is_regular_file(cache, ec)) {
+        if (shot_.requireCache && !fs::is_regular_file(cache, ec))
+            throw FrameError(cat("no strand cache for frame ", frame, ": ", cache.string(),
+                                 " is missing (run `hairpipe sim` for this frame first)"));
+        if ((shot_.requireCache || (!shot_.force && scene_.flag("cache.enabled"))) && fs::is_regular_file(cache, ec)) {
             try {
                 cached_ = readStrandCache(cache);
             } catch (const AssetError& e) {

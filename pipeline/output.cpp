@@ -4,18 +4,69 @@
 
 #include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstring>
 #include <fstream>
+#include <string>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
 
 namespace hp {
 
+namespace {
+
+/// This machine's host name up to the first dot ('@' never occurs in it).
+const std::string& hostName() {
+    static const std::string name = [] {
+        char buf[256] = {};
+        if (::gethostname(buf, sizeof buf - 1) != 0) return std::string("unknown");
+        std::string n(buf);
+        n = n.substr(0, n.find('.'));
+        for (char& c : n)
+            if (c == '@' || c == '/') c = '_';
+        return n.empty() ? std::string("unknown") : n;
+    }();
+    return name;
+}
+
+}  // namespace
+
 fs::path temporaryPath(const fs::path& final) {
     static std::atomic<unsigned> counter{0};
-    return final.parent_path() /
-           cat(kTemporaryPrefix, ::getpid(), "-", counter.fetch_add(1), "-", final.filename().string());
+    return final.parent_path() / cat(kTemporaryPrefix, ::getpid(), "-", counter.fetch_add(1), "@", hostName(), "@",
+                                      final.filename().string());
+}
+
+bool isTemporary(const fs::path& path) { return path.filename().string().rfind(kTemporaryPrefix, 0) == 0; }
+
+std::vector<fs::path> findTemporaries(const std::set<fs::path>& folders) {
+    std::vector<fs::path> found;
+    for (const fs::path& folder : folders) {
+        std::error_code ec;
+        for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec))
+            if (isTemporary(it->path())) found.push_back(it->path());
+    }
+    return found;
+}
+
+size_t removeStaleTemporaries(const std::set<fs::path>& folders) {
+    size_t removed = 0;
+    for (const fs::path& tmp : findTemporaries(folders)) {
+        // ".hairpipe-tmp-<pid>-<n>@<host>@<name>"; anything else is left alone.
+        const std::string name = tmp.filename().string().substr(std::strlen(kTemporaryPrefix));
+        const size_t at1 = name.find('@');
+        const size_t at2 = at1 == std::string::npos ? at1 : name.find('@', at1 + 1);
+        if (at2 == std::string::npos || name.substr(at1 + 1, at2 - at1 - 1) != hostName()) continue;
+        char* end = nullptr;
+        const long pid = std::strtol(name.c_str(), &end, 10);
+        if (pid <= 0 || *end != '-') continue;
+        // kill(pid, 0) fails with ESRCH only when no such process exists.
+        if (pid == long(::getpid()) || ::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;
+        std::error_code ec;
+        if (fs::remove(tmp, ec)) ++removed;
+    }
+    return removed;
 }
 
 void writeAtomically(const fs::path& final, const std::function<void(const fs::path&)>& write) {
@@ -45,7 +96,7 @@ void checkOutputDirectory(const fs::path& dir) {
     }
     // Permission bits alone do not tell (root ignores them; a read-only mount
     // does not show in them): write a probe file.
-    const fs::path probe = dir / cat(kTemporaryPrefix, ::getpid(), "-probe");
+    const fs::path probe = temporaryPath(dir / "write-probe");  // a temporary's name: stale-file cleanup knows it
     std::ofstream out(probe, std::ios::binary | std::ios::trunc);
     if (!out) {
         const int err = errno;

@@ -3,11 +3,13 @@
 // Every frame file is written to a temporary name in the same folder (so the
 // rename is atomic on one filesystem) and renamed over the final name once
 // complete. An interrupted batch therefore leaves either the finished file or
-// a stale ".hairpipe-tmp-*" file that resume logic ignores.
+// a stale ".hairpipe-tmp-*" file that resume logic ignores and the next run
+// on the same host removes (removeStaleTemporaries).
 #pragma once
 
 #include <filesystem>
 #include <functional>
+#include <set>
 #include <vector>
 
 namespace hp {
@@ -16,7 +18,10 @@ namespace hp {
 inline constexpr const char* kTemporaryPrefix = ".hairpipe-tmp-";
 
 /// A unique temporary path beside `final` that keeps its extension (image
-/// writers choose the format from it).
+/// writers choose the format from it): ".hairpipe-tmp-<pid>-<n>@<host>@<name>".
+/// The writer's process id and host name let a later run tell a stale file
+/// (its writer is gone) from one another process is still writing, also on
+/// shared storage that several farm nodes write to.
 std::filesystem::path temporaryPath(const std::filesystem::path& final);
 
 /// Creates the parent folder, calls `write(temporary)`, checks the file is
@@ -33,5 +38,19 @@ void checkOutputDirectory(const std::filesystem::path& dir);
 
 /// True when every path exists as a non-empty regular file.
 bool allExist(const std::vector<std::filesystem::path>& paths);
+
+/// True when `path`'s file name starts with kTemporaryPrefix.
+bool isTemporary(const std::filesystem::path& path);
+
+/// The temporaries (see temporaryPath) directly inside `folders` (missing
+/// folders are skipped).
+std::vector<std::filesystem::path> findTemporaries(const std::set<std::filesystem::path>& folders);
+
+/// Removes the temporaries in `folders` whose writer is gone: written on this
+/// host by a process that no longer runs (a killed run). Temporaries of other
+/// hosts, of live processes, and of unknown origin are kept, so concurrent
+/// runs on shared storage never lose a file being written. Returns how many
+/// were removed.
+size_t removeStaleTemporaries(const std::set<std::filesystem::path>& folders);
 
 }  // namespace hp

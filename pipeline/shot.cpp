@@ -19,6 +19,8 @@ ShotSettings resolveShot(const Scene& scene, const RunOptions& options) {
     shot.seed = scene.integer("seed");
     shot.force = options.force;
     shot.frames = options.frames ? *options.frames : scene.frames("frames");
+    shot.requireCache = options.cacheOnly;
+    shot.wholeRunOutputs = !options.noReport;
     fs::path out = options.outputDir;
     if (out.empty()) {
         const std::string& configured = scene.text("output.directory");
@@ -82,7 +84,6 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
             // Any other error (a scene key, an unreadable head, a scalp that
             // grows no hair) would fail every frame the same way: it ends the
             // run with exit code 1, as a scene error found at load would.
-
         }
         for (FrameStage* stage : todo) {
             if (sourceFailed && stage->needsFrameData()) continue;
@@ -98,6 +99,11 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
         progress.advance(cat("frame ", frame));
     }
     // Whole-run outputs (reports) once every frame is done.
+    if (shot.wholeRunOutputs) finishStages(stages, shot, report);
+    return report;
+}
+
+void finishStages(std::vector<StagePtr>& stages, const ShotSettings& shot, RunReport& report) {
     for (StagePtr& stage : stages) {
         try {
             stage->finish(shot);
@@ -106,7 +112,6 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
             logError(stage->name(), ": ", e.what());
         }
     }
-    return report;
 }
 
 }  // namespace hp

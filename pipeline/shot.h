@@ -17,6 +17,19 @@ struct RunOptions {
     bool force = false;
     /// Stage names to run (e.g. {"preview"}); empty = every stage the scene enables.
     std::set<std::string> only;
+    /// --jobs: frame-parallel stages run in this many processes at once
+    /// (pipeline/frame_jobs.h); 1 runs everything in this process.
+    int jobs = 1;
+    int chunk = 0;               ///< --chunk: frames per child process; 0 = automatic
+    bool cacheOnly = false;      ///< --cache-only: ShotSettings::requireCache
+    bool noReport = false;       ///< --no-report: not ShotSettings::wholeRunOutputs
+    /// The command line's scene overrides (--set, --seed as seed=N) and
+    /// --threads, so child processes can be given the same scene.
+    std::vector<std::string> sets;
+    int threads = 0;             ///< --threads; 0 = not given
+    /// The scene file as given (relative to the current folder): outputs
+    /// record the scene by this name, so children get it unchanged.
+    std::filesystem::path sceneFile;
 };
 
 ShotSettings resolveShot(const Scene& scene, const RunOptions& options);
@@ -34,7 +47,11 @@ struct RunReport {
     std::vector<std::string> failures;  ///< "frame 12 preview: ..." per failed stage-frame
 };
 
-/// Runs `stages` over the shot's frames. Frame failures are collected, not thrown.
+/// Runs `stages` over the shot's frames, then (shot.wholeRunOutputs) their
+/// finish. Frame failures are collected, not thrown.
 RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const ShotSettings& shot);
+
+/// Calls each stage's finish (whole-run outputs), adding failures to `report`.
+void finishStages(std::vector<StagePtr>& stages, const ShotSettings& shot, RunReport& report);
 
 }  // namespace hp

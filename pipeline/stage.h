@@ -42,6 +42,14 @@ struct ShotSettings {
     /// The run writes the strand cache (the "sim" stage runs), so the
     /// simulation also writes its checkpoints for resuming.
     bool writesCache = false;
+    /// Strands come only from the strand cache: a frame without its cache
+    /// file fails instead of being simulated (chunks of a parallel or farm
+    /// run, which must not each re-simulate the shot).
+    bool requireCache = false;
+    /// Call each stage's finish() at the end (whole-run outputs such as the
+    /// compare report); false for one chunk of a larger run, whose last step
+    /// writes them once over all frames.
+    bool wholeRunOutputs = true;
 };
 
 class FrameSource {

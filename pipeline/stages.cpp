@@ -39,7 +39,14 @@ class FrameSubset final : public FrameStage {
     void run(const FrameData& data) override {
         if (selected(data.frame)) stage_->run(data);
     }
-    void finish(const ShotSettings& shot) override { stage_->finish(shot); }
+    void finish(const ShotSettings& shot) override {
+        // The whole-run outputs cover the run's frames this stage ran on.
+        ShotSettings subset = shot;
+        subset.frames.clear();
+        for (int f : shot.frames)
+            if (selected(f)) subset.frames.push_back(f);
+        if (!subset.frames.empty()) stage_->finish(subset);  // none: keep what an earlier run wrote
+    }
 
   private:
     bool selected(int frame) const { return std::binary_search(frames_.begin(), frames_.end(), frame); }
@@ -55,6 +62,11 @@ StagePtr withFrameSubset(StagePtr stage, const Scene& scene) {
 }
 
 }  // namespace
+
+const std::vector<std::string>& stageNames() {
+    static const std::vector<std::string> names = {"sim", "preview", "reference", "vdb", "compare"};
+    return names;
+}
 
 std::unique_ptr<FrameSource> makeFrameSource(const Scene& scene, const ShotSettings& shot) {
     if (sceneHasHair(scene)) return makeHairFrameSource(scene, shot);

@@ -18,4 +18,7 @@ StagePtr makeReferenceStage(const Scene& scene, const ShotSettings& shot);
 /// OpenVDB density caches (stage_vdb.cpp); null unless vdb.enabled.
 StagePtr makeVdbStage(const Scene& scene, const ShotSettings& shot);
 
+/// Every stage name makeStages knows, in run order ("sim", "preview", ...).
+const std::vector<std::string>& stageNames();
+
 }  // namespace hp

@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <memory>
 
 namespace hp {
@@ -32,15 +33,27 @@ void scalarArray(FILE* f, const std::vector<T>& v, const char* format, double sc
 
 }  // namespace
 
-void writeUsdCurves(const std::filesystem::path& path, const std::vector<const StrandFrame*>& frames,
-                    const UsdExportSettings& s) {
-    if (frames.empty()) throw Error("USD export: no frames");
-    const StrandFrame& first = *frames.front();
-    for (const StrandFrame* fr : frames) {
-        fr->validate();
-        if (fr->offsets != first.offsets)
-            throw Error(cat("USD export: frame ", fr->frame, " has different strands than frame ", first.frame));
-    }
+namespace {
+
+/// The writer behind both overloads: `frame(i)` returns frame i of `count`,
+/// valid until the next call, so a caller may load frames one at a time.
+/// Frames are visited once per time-sampled attribute (points, velocities,
+/// widths), in order.
+void writeCurves(const std::filesystem::path& path, size_t count,
+                 const std::function<const StrandFrame&(size_t)>& frame, const UsdExportSettings& s) {
+    if (count == 0) throw Error("USD export: no frames");
+    // The first frame fixes the topology; copies of the little we need later.
+    const StrandFrame& f0 = frame(0);
+    f0.validate();
+    const std::vector<uint32_t> offsets = f0.offsets;
+    const std::vector<uint32_t> ids = f0.ids;
+    const uint32_t guideCount = f0.guideCount;
+    const int firstFrame = f0.frame;
+    const bool velocities = !f0.velocities.empty();
+    std::vector<int> counts(f0.strandCount());
+    for (size_t i = 0; i < counts.size(); ++i) counts[i] = int(f0.vertexCount(i));
+    const int lastFrame = count > 1 ? frame(count - 1).frame : firstFrame;
+
     File f(std::fopen(path.c_str(), "w"), &std::fclose);
     if (!f) throw IoError(path.string(), std::strerror(errno));
     FILE* out = f.get();
@@ -48,41 +61,59 @@ void writeUsdCurves(const std::filesystem::path& path, const std::vector<const S
                  "#usda 1.0\n(\n    defaultPrim = \"%s\"\n    metersPerUnit = 1\n    upAxis = \"Y\"\n"
                  "    timeCodesPerSecond = %g\n    startTimeCode = %d\n    endTimeCode = %d\n"
                  "    doc = \"hairpipe strands\"\n)\n\n",
-                 s.primPath.substr(1).c_str(), s.fps, first.frame, frames.back()->frame);
+                 s.primPath.substr(1).c_str(), s.fps, firstFrame, lastFrame);
     std::fprintf(out, "def BasisCurves \"%s\" (\n    kind = \"component\"\n)\n{\n", s.primPath.substr(1).c_str());
     std::fputs("    uniform token type = \"linear\"\n    uniform token wrap = \"nonperiodic\"\n", out);
-    std::vector<int> counts(first.strandCount());
-    for (size_t i = 0; i < counts.size(); ++i) counts[i] = int(first.vertexCount(i));
     std::fputs("    int[] curveVertexCounts = ", out);
     scalarArray(out, counts, "%.0f");
-    std::fputs("\n    point3f[] points.timeSamples = {\n", out);
-    for (const StrandFrame* fr : frames) {
-        std::fprintf(out, "        %d: ", fr->frame);
-        vec3Array(out, fr->positions);
-        std::fputs(",\n", out);
-    }
-    std::fputs("    }\n", out);
-    if (!first.velocities.empty()) {
-        std::fputs("    vector3f[] velocities.timeSamples = {\n", out);
-        for (const StrandFrame* fr : frames) {
-            std::fprintf(out, "        %d: ", fr->frame);
-            vec3Array(out, fr->velocities);
+    // One pass over the frames per attribute; the first pass checks them.
+    auto samples = [&](const char* declaration, auto&& write, bool check) {
+        std::fprintf(out, "\n    %s.timeSamples = {\n", declaration);
+        for (size_t i = 0; i < count; ++i) {
+            const StrandFrame& fr = frame(i);
+            if (check) {
+                fr.validate();
+                if (fr.offsets != offsets)
+                    throw Error(cat("USD export: frame ", fr.frame, " has different strands than frame ", firstFrame));
+                if (fr.velocities.empty() == velocities)
+                    throw Error(cat("USD export: frame ", fr.frame, (velocities ? " lacks" : " has"),
+                                    " velocities, unlike frame ", firstFrame));
+            }
+            std::fprintf(out, "        %d: ", fr.frame);
+            write(fr);
             std::fputs(",\n", out);
         }
-        std::fputs("    }\n", out);
-    }
-    std::fputs("    float[] widths.timeSamples = {\n", out);
-    for (const StrandFrame* fr : frames) {
-        std::fprintf(out, "        %d: ", fr->frame);
-        scalarArray(out, fr->radii, "%.9g", 2.0);
-        std::fputs(",\n", out);
-    }
-    std::fputs("    }\n    uniform token widths:interpolation = \"vertex\"\n", out);
+        std::fputs("    }", out);
+    };
+    samples("point3f[] points", [&](const StrandFrame& fr) { vec3Array(out, fr.positions); }, true);
+    if (velocities) samples("vector3f[] velocities", [&](const StrandFrame& fr) { vec3Array(out, fr.velocities); }, false);
+    samples("float[] widths", [&](const StrandFrame& fr) { scalarArray(out, fr.radii, "%.9g", 2.0); }, false);
+    std::fputs("\n    uniform token widths:interpolation = \"vertex\"\n", out);
     std::fputs("    int[] primvars:hairpipe:strandId = ", out);
-    scalarArray(out, first.ids, "%.0f");
+    scalarArray(out, ids, "%.0f");
     std::fputs("\n    uniform token primvars:hairpipe:strandId:interpolation = \"uniform\"\n", out);
-    std::fprintf(out, "    int primvars:hairpipe:guideCount = %u\n}\n", first.guideCount);
+    std::fprintf(out, "    int primvars:hairpipe:guideCount = %u\n}\n", guideCount);
     if (std::ferror(out) || std::fflush(out) != 0) throw IoError(path.string(), "write failed (disk full?)");
+    if (std::fclose(f.release()) != 0) throw IoError(path.string(), "write failed (disk full?)");
+}
+
+}  // namespace
+
+void writeUsdCurves(const std::filesystem::path& path, const std::vector<const StrandFrame*>& frames,
+                    const UsdExportSettings& s) {
+    writeCurves(path, frames.size(), [&](size_t i) -> const StrandFrame& { return *frames[i]; }, s);
+}
+
+void writeUsdCurves(const std::filesystem::path& path, const std::vector<int>& frames,
+                    const std::function<StrandFrame(int)>& load, const UsdExportSettings& s) {
+    StrandFrame current;
+    size_t loaded = size_t(-1);
+    writeCurves(path, frames.size(),
+                [&](size_t i) -> const StrandFrame& {
+                    if (i != loaded) current = load(frames[i]), loaded = i;
+                    return current;
+                },
+                s);
 }
 
 void writeUsdCurves(const std::filesystem::path& path, const StrandFrame& frame, const UsdExportSettings& s) {

@@ -11,6 +11,7 @@
 #include "sim/strand.h"
 
 #include <filesystem>
+#include <functional>
 #include <vector>
 
 namespace hp {
@@ -27,5 +28,11 @@ void writeUsdCurves(const std::filesystem::path& path, const StrandFrame& frame,
 /// All frames must have the same strand counts (topology is not animated).
 void writeUsdCurves(const std::filesystem::path& path, const std::vector<const StrandFrame*>& frames,
                     const UsdExportSettings& settings);
+
+/// The same for a whole shot without holding it in memory: `load(frame)`
+/// returns each of `frames` (e.g. from the strand cache) and is called a few
+/// times per frame (once per time-sampled attribute), never holding two.
+void writeUsdCurves(const std::filesystem::path& path, const std::vector<int>& frames,
+                    const std::function<StrandFrame(int)>& load, const UsdExportSettings& settings);
 
 }  // namespace hp
