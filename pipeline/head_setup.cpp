@@ -174,8 +174,8 @@ HeadSetup loadHead(const Scene& scene) {
     for (uint8_t s : h.scalp) scalpTriangles += s;
     if (scalpTriangles > 0 && !(surfaceArea(h.rest, h.scalp) > 0.0))
         scene.fail(scalp.method == ScalpMethod::All ? "head.file" : "head.scalp.method",
-                   cat("the scalp's ", scalpTriangles, " triangles have zero area (degenerate) in ",
-                       h.rig->file, ": no hair can grow on them"));
+                   cat("the scalp (", scalpTriangles, scalpTriangles == 1 ? " triangle" : " triangles",
+                       ") has zero area in ", h.rig->file, ": only degenerate triangles, no hair can grow"));
     warnIfOpen(h.rest, scene.text("head.collider.method"), h.rig->file);
     logVerbose("head: ", h.rest.triangleCount(), " triangles, ", scalpTriangles, " on the scalp (",
                surfaceArea(h.rest, h.scalp) * 1e4, " cm²), set up in ", seconds(start), " s");
