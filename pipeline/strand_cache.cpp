@@ -46,6 +46,7 @@ class Reader {
     }
     void bytes(void* out, size_t n) {
         if (n > remaining()) fail("truncated");
+        if (n == 0) return;  // an empty array's data() may be null: memcpy(nullptr, ..., 0) is UB (UBSan)
         std::memcpy(out, data_.data() + pos_, n);
         pos_ += n;
     }
