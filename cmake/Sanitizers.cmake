@@ -17,10 +17,6 @@ if(HAIRPIPE_SANITIZE)
   # barely notice the slower code.
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer
                       -fno-sanitize-recover=all -g1 -O1)
-  # GCC 12 reports -Wmaybe-uninitialized false positives inside libstdc++
-  # (std::function in <regex>) once ASan instruments the code; the Release
-  # build keeps the warning.
-  add_compile_options($<$<CXX_COMPILER_ID:GNU>:-Wno-maybe-uninitialized>)
   add_link_options(-fsanitize=address,undefined)
   # Embedded runtime defaults (halt on error, exit code, leak suppressions),
   # so a sanitized binary behaves the same whether CTest, a test's
