@@ -6,4 +6,5 @@ function(hairpipe_warnings target)
   if(HAIRPIPE_WERROR)
     target_compile_options(${target} PRIVATE -Werror)
   endif()
+  hairpipe_sanitizer_defaults(${target})  # cmake/Sanitizers.cmake
 endfunction()

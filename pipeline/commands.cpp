@@ -6,6 +6,7 @@
 #include "pipeline/frame_range.h"
 #include "pipeline/hair_source.h"
 #include "pipeline/head_setup.h"
+#include "pipeline/output.h"
 #include "pipeline/shot_outputs.h"
 #include "pipeline/stages.h"
 #include "pipeline/progress.h"
@@ -116,6 +117,7 @@ int runShotCommand(const CommandContext& ctx, const std::set<std::string>& only)
     for (const StagePtr& s : stages) names += (names.empty() ? "" : ", ") + s->name();
     logInfo("hairpipe: ", ctx.scene.name(), ": frames ", formatFrameRange(shot.frames), " -> ",
             shot.outputDir.string(), " (stages: ", names.empty() ? "none" : names, ")");
+    if (!stages.empty()) checkOutputDirectory(shot.outputDir);  // exit 1 now, not a failure per frame
     // A killed run leaves temporaries beside its outputs; drop those of dead writers.
     std::set<std::filesystem::path> cacheFolders;
     if (sceneHasHair(ctx.scene) && !shot.frames.empty())

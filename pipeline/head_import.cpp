@@ -203,7 +203,13 @@ HeadRig importHead(const HeadImportSettings& settings) {
     const aiScene* scene =
         importer.ReadFile(file, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_GenSmoothNormals |
                                     aiProcess_SortByPType | aiProcess_ValidateDataStructure);
-    if (!scene) throw AssetError(file, cat("cannot read it as a mesh file: ", importer.GetErrorString()));
+    if (!scene) {
+        const std::string why = importer.GetErrorString();
+        // SortByPType removed every mesh: the file has only points or lines.
+        if (why.find("No meshes remaining") != std::string::npos)
+            throw AssetError(file, "contains no triangle mesh (only points or lines)");
+        throw AssetError(file, cat("cannot read it as a mesh file: ", why));
+    }
     if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !scene->mRootNode || scene->mNumMeshes == 0)
         throw AssetError(file, "contains no triangle mesh");
 

@@ -2,7 +2,11 @@
 
 #include "core/log.h"
 
+#include "sim/mesh_collider.h"
+#include "sim/roots.h"
+
 #include <chrono>
+#include <map>
 #include <sstream>
 
 namespace hp {
@@ -118,6 +122,33 @@ ScalpSettings scalpSettings(const Scene& scene) {
     return s;
 }
 
+namespace {
+
+/// Warns when the rest mesh has boundary edges (after welding seams), i.e. is
+/// open: a signed-distance collider's inside is only trustworthy for closed
+/// meshes (sim/level_set.h), so hair may be pushed the wrong way near holes.
+/// Scanned heads are often open at the neck, so this is a warning, not an
+/// error; the exact collider and `none` do not depend on a closed mesh.
+void warnIfOpen(const TriangleMesh& mesh, const std::string& colliderMethod, const std::string& file) {
+    if (colliderMethod != "rigid" && colliderMethod != "per_frame") return;
+    const std::vector<uint32_t> weld = weldVertices(mesh.positions);
+    std::map<std::pair<uint32_t, uint32_t>, int> edges;
+    for (const auto& t : mesh.triangles)
+        for (int e = 0; e < 3; ++e) {
+            uint32_t a = weld[t[e]], b = weld[t[(e + 1) % 3]];
+            if (a == b) continue;  // a degenerate triangle's collapsed edge
+            if (a > b) std::swap(a, b);
+            ++edges[{a, b}];
+        }
+    size_t boundary = 0;
+    for (const auto& [edge, uses] : edges) boundary += uses == 1;
+    if (boundary > 0)
+        logWarning("head: ", file, " is open (", boundary, " boundary edges): the collider's inside/outside is "
+                   "unreliable near the holes; close the mesh or use head.collider.method: exact");
+}
+
+}  // namespace
+
 HeadSetup loadHead(const Scene& scene) {
     if (!sceneHasHead(scene)) scene.fail("head.file", "the scene has no head file");
     const auto start = std::chrono::steady_clock::now();
@@ -141,6 +172,11 @@ HeadSetup loadHead(const Scene& scene) {
     h.motion = std::move(motion);
     size_t scalpTriangles = 0;
     for (uint8_t s : h.scalp) scalpTriangles += s;
+    if (scalpTriangles > 0 && !(surfaceArea(h.rest, h.scalp) > 0.0))
+        scene.fail(scalp.method == ScalpMethod::All ? "head.file" : "head.scalp.method",
+                   cat("the scalp (", scalpTriangles, scalpTriangles == 1 ? " triangle" : " triangles",
+                       ") has zero area in ", h.rig->file, ": only degenerate triangles, no hair can grow"));
+    warnIfOpen(h.rest, scene.text("head.collider.method"), h.rig->file);
     logVerbose("head: ", h.rest.triangleCount(), " triangles, ", scalpTriangles, " on the scalp (",
                surfaceArea(h.rest, h.scalp) * 1e4, " cm²), set up in ", seconds(start), " s");
     return h;

@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstring>
+#include <fstream>
 #include <string>
 #include <unistd.h>
 
@@ -84,6 +85,28 @@ void writeAtomically(const fs::path& final, const std::function<void(const fs::p
         fs::remove(tmp, ec);
         throw;
     }
+}
+
+void checkOutputDirectory(const fs::path& dir) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec || !fs::is_directory(dir)) {
+        throw IoError(dir.string(), "cannot create the output folder: " +
+                                        (ec ? ec.message() : std::string("a file of that name exists")));
+    }
+    // Permission bits alone do not tell (root ignores them; a read-only mount
+    // does not show in them): write a probe file.
+    const fs::path probe = temporaryPath(dir / "write-probe");  // a temporary's name: stale-file cleanup knows it
+    std::ofstream out(probe, std::ios::binary | std::ios::trunc);
+    if (!out) {
+        const int err = errno;
+        throw IoError(dir.string(), cat("the output folder is not writable: ", std::strerror(err)));
+    }
+    out << 'x';
+    out.close();
+    const bool written = bool(out);
+    fs::remove(probe, ec);
+    if (!written) throw IoError(dir.string(), "the output folder is not writable (write failed; disk full?)");
 }
 
 bool allExist(const std::vector<fs::path>& paths) {

@@ -30,6 +30,12 @@ std::filesystem::path temporaryPath(const std::filesystem::path& final);
 void writeAtomically(const std::filesystem::path& final,
                      const std::function<void(const std::filesystem::path&)>& write);
 
+/// @brief Creates `dir` (and its parents) and proves it writable by creating
+/// and removing a probe file; throws IoError naming the folder otherwise.
+/// Run before the first frame, so an unwritable output folder is one clear
+/// error (exit code 1) instead of the same failure on every frame.
+void checkOutputDirectory(const std::filesystem::path& dir);
+
 /// True when every path exists as a non-empty regular file.
 bool allExist(const std::vector<std::filesystem::path>& paths);
 

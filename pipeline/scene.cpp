@@ -1,8 +1,10 @@
 #include "pipeline/scene.h"
 
 #include "pipeline/frame_range.h"
+#include "pipeline/scene_budget.h"
 #include "pipeline/schema.h"
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -170,6 +172,14 @@ class SceneLoader {
         throw SceneError(locate(node, origin), path, message);
     }
 
+    /// YAML 1.2's spellings of infinity and not-a-number (.inf, -.Inf, .NAN...),
+    /// which strtod does not read: reported as non-finite, not as "not a number".
+    static bool isYamlNonFinite(const std::string& s) {
+        std::string t = s;
+        if (!t.empty() && (t[0] == '+' || t[0] == '-')) t.erase(0, 1);
+        return t == ".inf" || t == ".Inf" || t == ".INF" || t == ".nan" || t == ".NaN" || t == ".NAN";
+    }
+
     static std::string show(const YAML::Node& v) {
         if (v.IsScalar()) return "'" + v.Scalar() + "'";
         if (v.IsSequence()) return "a list";
@@ -184,6 +194,7 @@ class SceneLoader {
         char* end = nullptr;
         errno = 0;
         const double x = std::strtod(s.c_str(), &end);
+        if (isYamlNonFinite(s)) fail(v, o, path, cat("must be a finite number, got ", show(v)));
         if (s.empty() || end != s.c_str() + s.size()) fail(v, o, path, cat("expected ", what, ", got ", show(v)));
         if (!std::isfinite(x) || errno == ERANGE) fail(v, o, path, cat("must be a finite number, got ", show(v)));
         if (x < spec.min || x > spec.max)
@@ -284,6 +295,23 @@ class SceneLoader {
     const Schema& schema_;
 };
 
+namespace {
+
+constexpr uintmax_t kMaxSceneFileBytes = 16u << 20;
+
+/// True if some line holds more than blanks or a comment.
+bool hasContent(const std::string& text) {
+    std::istringstream lines(text);
+    std::string line;
+    while (std::getline(lines, line)) {
+        const size_t first = line.find_first_not_of(" \t\r");
+        if (first != std::string::npos && line[first] != '#') return true;
+    }
+    return false;
+}
+
+}  // namespace
+
 Scene Scene::parse(const std::string& yaml, const std::string& displayName, const std::filesystem::path& baseDir,
                    const std::vector<std::string>& overrides) {
     Scene scene;
@@ -292,6 +320,11 @@ Scene Scene::parse(const std::string& yaml, const std::string& displayName, cons
     YAML::Node root;
     try {
         root = YAML::Load(yaml);
+    } catch (const YAML::DeepRecursion& e) {
+        // yaml-cpp's recursive parser stops at 2000 levels instead of
+        // overflowing the stack; say so instead of its generic "bad file".
+        throw SceneError({displayName, e.mark.line + 1, e.mark.column + 1}, "",
+                         "YAML nested too deeply (a scene needs a handful of levels)");
     } catch (const YAML::ParserException& e) {
         throw SceneError({displayName, e.mark.line + 1, e.mark.column + 1}, "", "YAML syntax error: " + e.msg);
     } catch (const YAML::Exception& e) {
@@ -308,18 +341,30 @@ Scene Scene::parse(const std::string& yaml, const std::string& displayName, cons
     loader.fillListDefaults();
     for (const std::string& o : overrides) loader.applyOverride(o);
     loader.fillDefaults();
+    checkSceneBudget(scene);  // before any stage allocates for the scene
     return scene;
 }
 
 Scene Scene::load(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec)) throw AssetError(file.string(), "scene file not found");
+    // A scene is a few kilobytes; a huge file is the wrong file (a cache, an
+    // image), refused before reading it into memory and parsing it.
+    const uintmax_t size = std::filesystem::file_size(file, ec);
+    if (ec) throw AssetError(file.string(), "cannot read scene file: " + ec.message());
+    if (size > kMaxSceneFileBytes)
+        throw AssetError(file.string(), cat("scene file is ", size, " bytes; scenes over ", kMaxSceneFileBytes,
+                                            " bytes are refused (is this the right file?)"));
     std::ifstream in(file, std::ios::binary);
     std::ostringstream text;
     text << in.rdbuf();
     if (!in.good() && !in.eof()) throw AssetError(file.string(), "cannot read scene file");
+    const std::string& t = text.str();
+    if (const size_t nul = t.find('\0'); nul != std::string::npos)
+        throw AssetError(file.string(), cat("is not a text file (a NUL byte at offset ", nul, ")"));
+    if (!hasContent(t)) throw AssetError(file.string(), "scene file is empty (no keys, only blanks or comments)");
     const std::filesystem::path dir = std::filesystem::absolute(file).parent_path();
-    return parse(text.str(), file.string(), dir, overrides);
+    return parse(t, file.string(), dir, overrides);
 }
 
 const Scene::Entry& Scene::entry(const std::string& key, const char* expected) const {

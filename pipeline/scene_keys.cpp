@@ -19,6 +19,7 @@ void addSceneKeys(SchemaBuilder& b) {
     addVdbKeys(b);
     addCompareKeys(b);
     addStageFrameKeys(b);
+    addBudgetKeys(b);
 }
 
 void addShotKeys(SchemaBuilder& b) {

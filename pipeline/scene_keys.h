@@ -23,5 +23,6 @@ void addStageFrameKeys(SchemaBuilder& b);  // <stage>.frames subsets (scene_keys
 void addVdbKeys(SchemaBuilder& b);     // vdb: OpenVDB density caches (scene_keys_vdb.cpp)
 void addCurlyKeys(SchemaBuilder& b);   // hair.model, hair.curly, hair.wet: the curly/wet model (scene_keys_curly.cpp)
 void addSimKeys(SchemaBuilder& b);     // simulation.*, hair.guides shape, hair.radius (scene_keys_sim.cpp)
+void addBudgetKeys(SchemaBuilder& b);  // budget: resource budgets across keys (scene_keys_budget.cpp)
 
 }  // namespace hp

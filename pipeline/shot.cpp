@@ -5,6 +5,8 @@
 #include "pipeline/output.h"
 #include "pipeline/stages.h"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 
 namespace fs = std::filesystem;
@@ -29,6 +31,19 @@ ShotSettings resolveShot(const Scene& scene, const RunOptions& options) {
     shot.outputDir = fs::absolute(out).lexically_normal();
     return shot;
 }
+
+namespace {
+
+/// Peak resident set of this process so far, MB (getrusage: ru_maxrss is KiB
+/// on Linux). Logged per stage with --verbose: the peak only grows, so the
+/// stage that raised it is the one that needed the memory (docs/hardening.md).
+double peakResidentMb() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_maxrss) / 1024.0;
+}
+
+}  // namespace
 
 RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const ShotSettings& shot) {
     RunReport report;
@@ -59,17 +74,22 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
         if (needsData) {
             try {
                 data = source.get(frame);
-            } catch (const Error& e) {
+                logVerbose("frame ", frame, " data (simulation or cache): peak RSS ", int(peakResidentMb()), " MB");
+            } catch (const FrameError& e) {
                 // Without the frame's data no data stage can run; later frames may still work.
                 report.failures.push_back(cat("frame ", frame, ": ", e.what()));
                 logError("frame ", frame, ": ", e.what());
                 sourceFailed = true;
             }
+            // Any other error (a scene key, an unreadable head, a scalp that
+            // grows no hair) would fail every frame the same way: it ends the
+            // run with exit code 1, as a scene error found at load would.
         }
         for (FrameStage* stage : todo) {
             if (sourceFailed && stage->needsFrameData()) continue;
             try {
                 stage->run(data);
+                logVerbose("frame ", frame, " ", stage->name(), ": peak RSS ", int(peakResidentMb()), " MB");
             } catch (const Error& e) {
                 report.failures.push_back(cat("frame ", frame, " ", stage->name(), ": ", e.what()));
                 logError("frame ", frame, " ", stage->name(), ": ", e.what());

@@ -247,7 +247,9 @@ const StrandFrame& ShotSimulation::advanceTo(int frame) {
         else pending_.accumulate(s);
         if (s.nanCount > 0)
             throw FrameError(cat("simulation diverged before frame ", frame, " (t = ", t, " s): ", s.nanCount,
-                                 " non-finite guide values; try a smaller simulation.time_step or more substeps"));
+                                 " non-finite guide values",
+                                 s.firstNonFinite >= 0 ? cat(", first in guide strand ", s.firstNonFinite) : "",
+                                 "; try a smaller simulation.time_step or more substeps"));
     }
     frame_ = frame;
     produceFrame(std::min(target, model_->time()));

@@ -32,6 +32,7 @@ GuideSettings guideSettings(const Scene& scene) {
     s.projectionDistance = float(scene.number("simulation.limits.projection_distance"));
     s.teleportDistance = float(scene.number("simulation.teleport.distance"));
     s.teleportAngle = float(scene.number("simulation.teleport.angle"));
+    s.maxSpeed = float(scene.number("simulation.max_speed"));
 
     const float segment = s.length / float(s.segments);
     if (2.f * s.collisionRadius >= segment)

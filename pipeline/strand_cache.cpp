@@ -46,6 +46,7 @@ class Reader {
     }
     void bytes(void* out, size_t n) {
         if (n > remaining()) fail("truncated");
+        if (n == 0) return;  // an empty array's data() may be null: memcpy(nullptr, ..., 0) is UB (UBSan)
         std::memcpy(out, data_.data() + pos_, n);
         pos_ += n;
     }
@@ -107,8 +108,11 @@ StrandFrame readStrandCache(const std::filesystem::path& path) {
     in.seekg(0);
     in.read(data.data(), std::streamsize(data.size()));
     if (!in) throw AssetError(path.string(), "cannot read strand cache");
+    return parseStrandCache(data, path.string());
+}
 
-    Reader r(data, path.string());
+StrandFrame parseStrandCache(const std::vector<char>& data, const std::string& name) {
+    Reader r(data, name);
     char magic[8];
     r.bytes(magic, sizeof magic);
     if (std::memcmp(magic, kMagic, sizeof magic) != 0) r.fail("has a wrong magic number (not a hairpipe strand cache)");

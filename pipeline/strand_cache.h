@@ -24,6 +24,8 @@
 #include "sim/strand.h"
 
 #include <filesystem>
+#include <string>
+#include <vector>
 
 namespace hp {
 
@@ -34,5 +36,10 @@ void writeStrandCache(const std::filesystem::path& path, const StrandFrame& fram
 
 /// Reads a cache file; throws AssetError naming the file and the problem.
 StrandFrame readStrandCache(const std::filesystem::path& path);
+
+/// Decodes a whole cache file's bytes (what readStrandCache does after
+/// reading the file); `name` is the file named in errors. For tools and the
+/// fuzz target (tools/fuzz/fuzz_strand_cache.cpp).
+StrandFrame parseStrandCache(const std::vector<char>& data, const std::string& name);
 
 }  // namespace hp

@@ -47,6 +47,7 @@ void GuideSettings::validate() const {
     check(bendLimit > 0.f && bendLimit < 180.f, "bend limit must be in (0, 180) degrees");
     check(twistLimit > 0.f && twistLimit < 90.f, "twist limit must be in (0, 90) degrees");
     check(projectionAngle >= 0.f && projectionDistance >= 0.f, "projection limits must be ≥ 0");
+    check(maxSpeed >= 0.f, "max speed must be ≥ 0");
     check(strandsPerWorld >= 1, "strands per world must be ≥ 1");
     check(threads >= 0, "threads must be ≥ 0");
     check(gravity.allFinite(), "gravity must be finite");
@@ -59,6 +60,8 @@ void GuideStats::accumulate(const GuideStats& s) {
     maxPenetration = std::max(maxPenetration, s.maxPenetration);
     kineticEnergy = s.kineticEnergy;
     nanCount += s.nanCount;
+    if (firstNonFinite < 0) firstNonFinite = s.firstNonFinite;
+    clampedCount += s.clampedCount;
     strandContacts = std::max(strandContacts, s.strandContacts);
     msPerStep = (msPerStep * double(steps) + s.msPerStep * double(s.steps)) / double(steps + s.steps);
     steps += s.steps;
@@ -70,10 +73,10 @@ std::string GuideStats::json(int frame, double time) const {
     std::snprintf(buf, sizeof buf,
                   "{\"frame\": %d, \"time\": %.6f, \"max_length_error\": %.3e, \"mean_length_error\": %.3e, "
                   "\"penetrations\": %zu, \"max_penetration_m\": %.3e, \"kinetic_energy_j\": %.6e, "
-                  "\"nan\": %zu, \"strand_contacts\": %zu, \"ms_per_step\": %.3f, \"steps\": %zu, "
-                  "\"reset\": %s}",
+                  "\"nan\": %zu, \"clamped\": %zu, \"strand_contacts\": %zu, \"ms_per_step\": %.3f, "
+                  "\"steps\": %zu, \"reset\": %s}",
                   frame, time, maxLengthError, meanLengthError, penetrationCount, maxPenetration, kineticEnergy,
-                  nanCount, strandContacts, msPerStep, steps, reset ? "true" : "false");
+                  nanCount, clampedCount, strandContacts, msPerStep, steps, reset ? "true" : "false");
     return buf;
 }
 
@@ -322,6 +325,21 @@ const GuideStats& GuideSolver::step(const std::vector<SurfaceFrame>& roots, cons
             }
         }
     }
+    // Velocity guard (GuideSettings::maxSpeed). A NaN speed fails the
+    // comparison and is left for measure() to report. Rope only: its groups
+    // reload x / v from the set when the version moves, while the rigid
+    // formulation's bodies keep their own state (set.v is a read-back).
+    size_t clamped = 0;
+    if (s.maxSpeed > 0.f && !teleport && s.formulation == GuideFormulation::Rope) {
+        for (Vec3f& v : set.v) {
+            const float speed = v.norm();
+            if (speed > s.maxSpeed) {
+                v *= s.maxSpeed / speed;
+                ++clamped;
+            }
+        }
+        if (clamped) ++set.version;  // the groups reload the clamped state
+    }
     for (size_t g = 0; g < set.count; ++g) {
         set.rootPos0[g] = set.rootPos1[g];
         set.rootRot0[g] = set.rootRot1[g];
@@ -334,6 +352,7 @@ const GuideStats& GuideSolver::step(const std::vector<SurfaceFrame>& roots, cons
     m.last = m.measure(head.collider.get());
     m.last.reset = teleport;
     m.last.strandContacts = strandContacts;
+    m.last.clampedCount = clamped;
     m.last.msPerStep =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - clock0).count();
     return m.last;
@@ -343,6 +362,7 @@ GuideStats GuideSolver::Impl::measure(const Collider* collider) const {
     struct Partial {
         double maxErr = 0, sumErr = 0, maxDepth = 0, energy = 0;
         size_t inside = 0, nan = 0;
+        long firstNan = -1;
     };
     std::vector<Partial> parts(groups.size());
     auto body = [&](size_t gi) {
@@ -357,7 +377,10 @@ GuideStats GuideSolver::Impl::measure(const Collider* collider) const {
             }
             for (int i = 0; i < set.vertices; ++i) {
                 const size_t k = set.vertex(g, i);
-                if (!set.x[k].allFinite() || !set.v[k].allFinite()) ++p.nan;
+                if (!set.x[k].allFinite() || !set.v[k].allFinite()) {
+                    ++p.nan;
+                    if (p.firstNan < 0) p.firstNan = long(g);
+                }
                 // The root sits on the scalp by definition; only the free vertices count.
                 if (i > 0 && collider) {
                     const float d = collider->signedDistance(set.x[k]);
@@ -383,6 +406,7 @@ GuideStats GuideSolver::Impl::measure(const Collider* collider) const {
         s.maxPenetration = std::max(s.maxPenetration, p.maxDepth);
         s.penetrationCount += p.inside;
         s.nanCount += p.nan;
+        if (s.firstNonFinite < 0) s.firstNonFinite = p.firstNan;  // groups in guide order
         s.kineticEnergy += p.energy;
     }
     const size_t segs = set.count * size_t(set.segments);

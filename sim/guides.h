@@ -79,6 +79,12 @@ struct GuideSettings {
     float teleportDistance = 0.1f;  ///< m per step
     float teleportAngle = 45.f;     ///< deg per step
 
+    // Guard: a vertex faster than this after a step is numerical, not
+    // physical (a violent head turn moves tips a few m/s); its velocity is
+    // scaled back to it so one bad step cannot pump energy into the next.
+    // Rope formulation only; 0 disables the clamp.
+    float maxSpeed = 50.f;          ///< m/s
+
     // Parallelism. Guides are partitioned into Bullet worlds of this many
     // strands (a fixed mapping, so results do not depend on the thread count).
     int strandsPerWorld = 16;
@@ -96,6 +102,8 @@ struct GuideStats {
     double maxPenetration = 0;      ///< deepest vertex below the head surface, m (0 = none)
     double kineticEnergy = 0;       ///< J, end of step
     size_t nanCount = 0;            ///< non-finite vertex positions or velocities
+    long firstNonFinite = -1;       ///< lowest guide index with a non-finite value (-1: none)
+    size_t clampedCount = 0;        ///< vertex velocities scaled back to maxSpeed
     size_t strandContacts = 0;      ///< strand-strand contacts resolved in the step
     double msPerStep = 0;           ///< wall-clock milliseconds of step()
     bool reset = false;             ///< a teleport / scene cut reset the guides this step

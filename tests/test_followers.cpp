@@ -111,7 +111,12 @@ TEST(FollowerNeighbours, GridEqualsBruteForce) {
             if (set != 1) p = 0.1f * p.normalized();  // on a sphere, like scalp roots
             pts.push_back(p);
         }
-        for (int i = 0; i < 20; ++i) pts.push_back(pts[i * 7]);  // exact duplicates: ties by index
+        // Exact duplicates: ties by index. Copy first: push_back(pts[k]) reads a
+        // reference the reallocation may free (heap-buffer-overflow under ASan).
+        for (int i = 0; i < 20; ++i) {
+            const Vec3f dup = pts[size_t(i) * 7];
+            pts.push_back(dup);
+        }
         const PointGrid grid(pts);
         for (int q = 0; q < 2000; ++q) {
             const Vec3f query = q % 10 == 0 ? Vec3f(3.f * u(rng), 3.f * u(rng), 3.f * u(rng))   // outside the grid

@@ -1,0 +1,25 @@
+# Included by CTest after the discovered GoogleTest cases (tests/CMakeLists.txt
+# adds it to TEST_INCLUDE_FILES): labels the cases that are compute-bound and
+# take a second or more in Release as "slow", so the sanitizer pass
+# (tools/sanitize/run: `ctest -LE slow`, several times slower per test) skips
+# them. They still run in every normal `ctest`. Entries are
+# "<executable>:<Suite.Case>"; the executable stays a label too.
+set(_hp_slow_tests
+  test_hair_bsdf:HairBsdf.WhiteFurnaceConservesEnergy          # 10^6 BSDF samples
+  test_hair_bsdf:HairBsdf.SampledWhiteFurnaceConservesEnergy
+  test_compare:CompareReport.IsSelfContainedAndRendersInHeadlessChromium  # Chromium start-up
+  test_preview:Preview.VoxelShadowsDarkenStrandBehindSlab      # llvmpipe raster
+  test_preview_stage:PreviewStage.ViewerRendersUnderXvfb       # Xvfb start-up
+  test_guides:Guides.StableOverTenThousandStepsWithATeleport   # 10^4 solver steps
+  test_vdb:VdbFile.BytesAreIdenticalForOneAndTwoThreadsAndRepeatedWrites
+  test_shot_simulation:ShotSimulation.DefaultClipKeepsLengthsRootsAndClearance
+  test_shot_simulation:ShotSimulation.CheckpointRestoreContinuesBitForBit
+  test_sim_guards:SimGuards.LongViolentRunStaysBoundedAndFinite  # 10^4+ steps
+  test_resources:Resources.ResidentMemoryDoesNotGrowOverThirtyFrames  # 30 frames
+)
+foreach(_entry IN LISTS _hp_slow_tests)
+  string(REPLACE ":" ";" _parts "${_entry}")
+  list(GET _parts 0 _exe)
+  list(GET _parts 1 _test)
+  set_tests_properties(${_test} PROPERTIES LABELS "${_exe};slow")
+endforeach()

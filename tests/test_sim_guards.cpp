@@ -1,0 +1,143 @@
+// Simulation guards (issue 12): a long run under violent head motion stays
+// finite and energy-bounded without help; the velocity clamp holds speeds to
+// GuideSettings::maxSpeed; a non-finite value is reported with the guide it
+// appeared in (ShotSimulation turns that into a FrameError naming the frame).
+#include "pipeline/scene.h"
+#include "pipeline/sim_settings.h"
+#include "sim/fibonacci.h"
+#include "sim/guides.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+using namespace hp;
+
+namespace {
+
+constexpr float kRadius = 0.1f;
+
+/// A sphere head shaken hard: ±5 cm at 6 Hz in x and y, ±1 rad at 3 Hz about
+/// Y. Peak root speed ≈ 3.8 m/s, peak head turn ≈ 22° per 20 ms step (below
+/// the 45° teleport limit, so the solver has to ride it out).
+HeadPose shaken(double t) {
+    HeadPose p;
+    p.time = t;
+    const double w6 = 2 * M_PI * 6 * t, w3 = 2 * M_PI * 3 * t;
+    p.transform = Eigen::Isometry3f::Identity();
+    p.transform.translation() = Vec3f(float(0.05 * std::sin(w6)), float(0.05 * std::cos(w6)), 0.f);
+    p.transform.linear() = Eigen::AngleAxisf(float(std::sin(w3)), Vec3f::UnitY()).toRotationMatrix();
+    p.collider = std::make_shared<SphereCollider>(p.transform.translation(), kRadius);
+    return p;
+}
+
+std::vector<SurfaceFrame> roots(const std::vector<Vec3f>& dirs, const HeadPose& pose) {
+    std::vector<SurfaceFrame> out(dirs.size());
+    for (size_t i = 0; i < dirs.size(); ++i) {
+        const Vec3f& n = dirs[i];
+        Vec3f t = Vec3f::UnitY().cross(n);
+        t = t.squaredNorm() > 1e-8f ? Vec3f(t.normalized()) : Vec3f(n.unitOrthogonal());
+        out[i].position = pose.transform * (kRadius * n);
+        out[i].normal = pose.transform.linear() * n;
+        out[i].tangent = pose.transform.linear() * t;
+    }
+    return out;
+}
+
+float maxSpeed(const StrandFrame& f) {
+    float m = 0.f;
+    for (const Vec3f& v : f.velocities) m = std::max(m, v.norm());
+    return m;
+}
+
+}  // namespace
+
+TEST(SimGuards, LongViolentRunStaysBoundedAndFinite) {
+    GuideSettings s;
+    s.maxSpeed = 0.f;  // the solver alone: no clamp to hide a blow-up
+    GuideSolver solver(s);
+    const std::vector<Vec3f> dirs = fibonacciCap(8);
+    HeadPose pose = shaken(0.0);
+    solver.initialize(roots(dirs, pose), pose);
+    // A strand swung rigidly with the head moves at most
+    // ω·(r + L) + v_head = 18.8·0.35 + 1.9 ≈ 8.5 m/s; allow 3× that.
+    const float speedBound = 3.f * 8.5f;
+    const double mass = double(dirs.size()) * s.massPerLength * s.length;
+    const double energyBound = 0.5 * mass * speedBound * speedBound;
+    double peakEnergy = 0;
+    float peakSpeed = 0;
+    StrandFrame f;
+    for (int k = 1; k <= 12000; ++k) {  // 240 s of shaking at 50 steps/s
+        pose = shaken(solver.nextTime());
+        const GuideStats& st = solver.step(roots(dirs, pose), pose);
+        ASSERT_EQ(st.nanCount, 0u) << "step " << k;
+        ASSERT_FALSE(st.reset) << "the motion stays below the teleport limits; step " << k;
+        ASSERT_TRUE(std::isfinite(st.kineticEnergy)) << "step " << k;
+        peakEnergy = std::max(peakEnergy, st.kineticEnergy);
+        if (k % 10 == 0) {
+            solver.write(f);
+            peakSpeed = std::max(peakSpeed, maxSpeed(f));
+            ASSERT_LE(st.maxLengthError, 1e-2) << "step " << k;
+        }
+    }
+    RecordProperty("peak_speed_mm_per_s", int(peakSpeed * 1000));
+    RecordProperty("peak_energy_uj", int(peakEnergy * 1e6));
+    EXPECT_LT(peakSpeed, speedBound);
+    EXPECT_LT(peakEnergy, energyBound);
+    EXPECT_GT(peakEnergy, 1e-4) << "the shaking moved the hair";
+}
+
+TEST(SimGuards, VelocityClampHoldsSpeedsToTheLimit) {
+    const std::vector<Vec3f> dirs = fibonacciCap(8);
+    auto run = [&](float limit, size_t& clamped) {
+        GuideSettings s;
+        s.maxSpeed = limit;
+        GuideSolver solver(s);
+        HeadPose pose = shaken(0.0);
+        solver.initialize(roots(dirs, pose), pose);
+        float peak = 0;
+        clamped = 0;
+        StrandFrame f;
+        for (int k = 1; k <= 200; ++k) {
+            pose = shaken(solver.nextTime());
+            clamped += solver.step(roots(dirs, pose), pose).clampedCount;
+            solver.write(f);
+            peak = std::max(peak, maxSpeed(f));
+        }
+        return peak;
+    };
+    size_t clamped = 0;
+    const float free = run(0.f, clamped);
+    EXPECT_EQ(clamped, 0u);
+    ASSERT_GT(free, 2.f) << "the shaking must exceed the limit for the test to mean anything";
+    EXPECT_LE(run(2.f, clamped), 2.f * (1.f + 1e-5f));
+    EXPECT_GT(clamped, 0u);
+}
+
+TEST(SimGuards, NonFiniteRootIsReportedWithItsGuide) {
+    GuideSettings s;
+    s.strandsPerWorld = 1;  // one world per guide: the NaN cannot spread to others
+    GuideSolver solver(s);
+    const std::vector<Vec3f> dirs = fibonacciCap(6);
+    HeadPose pose = shaken(0.0);
+    solver.initialize(roots(dirs, pose), pose);
+    pose = shaken(solver.nextTime());
+    EXPECT_EQ(solver.step(roots(dirs, pose), pose).firstNonFinite, -1);
+    pose = shaken(solver.nextTime());
+    std::vector<SurfaceFrame> r = roots(dirs, pose);
+    r[3].position.x() = std::numeric_limits<float>::quiet_NaN();
+    const GuideStats st = solver.step(r, pose);
+    EXPECT_GT(st.nanCount, 0u);
+    EXPECT_EQ(st.firstNonFinite, 3);
+    GuideStats total;
+    total.accumulate(st);
+    EXPECT_EQ(total.firstNonFinite, 3) << "kept when frames' steps are folded together";
+    EXPECT_NE(st.json(7, 0.1).find("\"nan\": "), std::string::npos);
+}
+
+TEST(SimGuards, MaxSpeedKeyMapsOntoTheSolver) {
+    const Scene scene = Scene::parse("simulation: {max_speed: 3.5}\n", "s.yaml", ".");
+    EXPECT_FLOAT_EQ(guideSettings(scene).maxSpeed, 3.5f);
+    EXPECT_THROW(Scene::parse("simulation: {max_speed: -1}\n", "s.yaml", "."), SceneError);
+}
