@@ -30,6 +30,22 @@ const std::string& hostName() {
     return name;
 }
 
+/// Whether `pid` is a live process on this machine. kill(pid, 0) fails with
+/// ESRCH only when no such process exists, but it succeeds for a zombie too:
+/// a killed writer's entry lingers until its parent (or init) reaps it, and
+/// its temporaries are as stale as a vanished writer's.
+bool processAlive(pid_t pid) {
+    if (::kill(pid, 0) != 0 && errno == ESRCH) return false;
+    std::ifstream stat(cat("/proc/", pid, "/stat"));
+    std::string line;
+    if (!std::getline(stat, line)) return true;  // no /proc: trust kill()
+    // "pid (comm) state ...": comm may hold spaces and parentheses.
+    const size_t close = line.rfind(')');
+    if (close == std::string::npos || close + 2 >= line.size()) return true;
+    const char state = line[close + 2];
+    return state != 'Z' && state != 'X';
+}
+
 }  // namespace
 
 fs::path temporaryPath(const fs::path& final) {
@@ -61,8 +77,7 @@ size_t removeStaleTemporaries(const std::set<fs::path>& folders) {
         char* end = nullptr;
         const long pid = std::strtol(name.c_str(), &end, 10);
         if (pid <= 0 || *end != '-') continue;
-        // kill(pid, 0) fails with ESRCH only when no such process exists.
-        if (pid == long(::getpid()) || ::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;
+        if (pid == long(::getpid()) || processAlive(pid_t(pid))) continue;
         std::error_code ec;
         if (fs::remove(tmp, ec)) ++removed;
     }

@@ -138,6 +138,20 @@ TEST(Batch, StaleTemporariesOfDeadWritersAreRemoved) {
     EXPECT_TRUE(fs::exists(dir / mine));
     EXPECT_TRUE(fs::exists(dir / "frame.0002.exr"));
     EXPECT_EQ(findTemporaries({dir.path()}).size(), 3u);
+
+    // A killed writer not yet reaped (a zombie) still answers kill(pid, 0);
+    // its temporaries are stale all the same.
+    pid_t zombie = ::fork();
+    if (zombie == 0) ::_exit(0);
+    for (int i = 0; i < 1000; ++i) {  // until it has exited (not reaped: waitid with WNOWAIT)
+        siginfo_t info{};
+        if (::waitid(P_PID, id_t(zombie), &info, WEXITED | WNOWAIT) == 0) break;
+    }
+    const fs::path ofZombie = dir / (std::string(kTemporaryPrefix) + std::to_string(zombie) + rest);
+    writeFile(ofZombie, "killed mid-write");
+    EXPECT_EQ(removeStaleTemporaries({dir.path()}), 1u);
+    EXPECT_FALSE(fs::exists(ofZombie));
+    ::waitpid(zombie, nullptr, 0);
 }
 
 TEST(Batch, SimKilledMidShotResumesFromItsCheckpointIdentically) {
