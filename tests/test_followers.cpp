@@ -112,9 +112,10 @@ TEST(FollowerNeighbours, GridEqualsBruteForce) {
             pts.push_back(p);
         }
         // Exact duplicates: ties by index. Copy first: push_back(pts[k]) reads a
-        // reference the reallocation may free (heap-buffer-overflow under ASan).
+        // reference the reallocation may free; the index wraps because the
+        // 50-point set is shorter than 20 × 7 (both found by ASan).
         for (int i = 0; i < 20; ++i) {
-            const Vec3f dup = pts[size_t(i) * 7];
+            const Vec3f dup = pts[(size_t(i) * 7) % size_t(n)];
             pts.push_back(dup);
         }
         const PointGrid grid(pts);
