@@ -3,6 +3,7 @@
 // the shadow map darken what they should, the voxel grid equals a CPU
 // voxelization along the same light rays, generated hair grows where asked,
 // and frames are bit-identical across runs.
+#include "gl_support.h"
 #include "test_support.h"
 
 #include "core/errors.h"
@@ -16,28 +17,6 @@
 
 namespace hp {
 namespace {
-
-/// One context per test process; tests skip (with EGL's reason) only when
-/// no headless OpenGL 4.5 can be created at all.
-GlContext* context(std::string* why) {
-    static std::unique_ptr<GlContext> ctx;
-    static std::string error;
-    static bool tried = false;
-    if (!tried) {
-        tried = true;
-        try {
-            ctx = GlContext::createHeadless();
-        } catch (const Error& e) {
-            error = e.what();
-        }
-    }
-    *why = error;
-    return ctx.get();
-}
-
-#define HP_REQUIRE_GL()                                                            \
-    std::string glWhy;                                                             \
-    if (!context(&glWhy)) GTEST_SKIP() << "no headless OpenGL 4.5 through EGL: " << glWhy
 
 /// A camera at (0, 0, 1) looking at the origin, small image.
 View testView(int w = 320, int h = 240) {
@@ -121,7 +100,7 @@ TEST(Preview, MissingGlIsAClearError) {
         unsetenv("HAIRPIPE_GL_PLATFORM");
         EXPECT_NE(std::string(e.what()).find("no usable headless OpenGL 4.5"), std::string::npos) << e.what();
     }
-    context(&glWhy)->makeCurrent();
+    test::glContext(&glWhy)->makeCurrent();
 }
 
 /// Hair coverage (sum of alpha) against the analytic projected area of

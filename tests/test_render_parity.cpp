@@ -4,6 +4,7 @@
 // as wide translucent lines), and hair behind the head must stay hidden.
 //
 // Set HAIRPIPE_TEST_DUMP=<folder> to write every rendered pair as EXR there.
+#include "gl_support.h"
 #include "test_support.h"
 
 #include "core/errors.h"
@@ -18,26 +19,6 @@
 
 namespace hp {
 namespace {
-
-GlContext* context(std::string* why) {
-    static std::unique_ptr<GlContext> ctx;
-    static std::string error;
-    static bool tried = false;
-    if (!tried) {
-        tried = true;
-        try {
-            ctx = GlContext::createHeadless();
-        } catch (const Error& e) {
-            error = e.what();
-        }
-    }
-    *why = error;
-    return ctx.get();
-}
-
-#define HP_REQUIRE_GL()                                                            \
-    std::string glWhy;                                                             \
-    if (!context(&glWhy)) GTEST_SKIP() << "no headless OpenGL 4.5 through EGL: " << glWhy
 
 void dump(const std::string& name, const Image& img) {
     const char* dir = std::getenv("HAIRPIPE_TEST_DUMP");
