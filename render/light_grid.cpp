@@ -7,20 +7,11 @@ namespace hp {
 
 namespace {
 
-Mat4f lookAt(const Vec3f& eye, const Vec3f& target) {
+/// The light's view of the grid; any up vector not parallel to the beam
+/// will do, the grid's roll does not matter.
+Mat4f lightView(const Vec3f& eye, const Vec3f& target) {
     const Vec3f f = (target - eye).normalized();
-    // Any up vector not parallel to the beam; the grid's roll does not matter.
-    const Vec3f up = std::abs(f.y()) < 0.9f ? Vec3f::UnitY() : Vec3f::UnitX();
-    const Vec3f s = f.cross(up).normalized();
-    const Vec3f u = s.cross(f);
-    Mat4f m = Mat4f::Identity();
-    m.block<1, 3>(0, 0) = s.transpose();
-    m.block<1, 3>(1, 0) = u.transpose();
-    m.block<1, 3>(2, 0) = -f.transpose();
-    m(0, 3) = -s.dot(eye);
-    m(1, 3) = -u.dot(eye);
-    m(2, 3) = f.dot(eye);
-    return m;
+    return lookAt(eye, target, std::abs(f.y()) < 0.9f ? Vec3f::UnitY() : Vec3f::UnitX());
 }
 
 }  // namespace
@@ -32,11 +23,11 @@ LightGrid LightGrid::fit(const Light& light, const Eigen::AlignedBox3f& bounds, 
     const float radius = std::max(0.5f * bounds.diagonal().norm(), 1e-4f);
     if (light.type == LightType::Directional) {
         const Vec3f dir = light.direction.normalized();
-        g.view = lookAt(centre - 2.f * radius * dir, centre);
+        g.view = lightView(centre - 2.f * radius * dir, centre);
     } else {
         if ((centre - light.position).norm() <= radius * 1.001f) return g;  // inside: no single frustum sees it all
         g.perspective = true;
-        g.view = lookAt(light.position, centre);
+        g.view = lightView(light.position, centre);
     }
     Vec2f qMin(1e30f, 1e30f), qMax(-1e30f, -1e30f);
     float dMin = 1e30f, dMax = -1e30f;

@@ -5,19 +5,21 @@
 
 namespace hp {
 
-Mat4f Camera::view() const {
-    const Vec3f f = (target - position).normalized();
+Mat4f lookAt(const Vec3f& eye, const Vec3f& target, const Vec3f& up) {
+    const Vec3f f = (target - eye).normalized();
     const Vec3f s = f.cross(up).normalized();
     const Vec3f u = s.cross(f);
     Mat4f m = Mat4f::Identity();
     m.block<1, 3>(0, 0) = s.transpose();
     m.block<1, 3>(1, 0) = u.transpose();
     m.block<1, 3>(2, 0) = -f.transpose();
-    m(0, 3) = -s.dot(position);
-    m(1, 3) = -u.dot(position);
-    m(2, 3) = f.dot(position);
+    m(0, 3) = -s.dot(eye);
+    m(1, 3) = -u.dot(eye);
+    m(2, 3) = f.dot(eye);
     return m;
 }
+
+Mat4f Camera::view() const { return lookAt(position, target, up); }
 
 Mat4f Camera::projection() const {
     const float t = 1.f / std::tan(0.5f * fovY * float(M_PI) / 180.f);

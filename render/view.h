@@ -14,6 +14,11 @@ namespace hp {
 using Vec4f = Eigen::Vector4f;
 using Mat4f = Eigen::Matrix4f;
 
+/// World-to-view matrix (OpenGL convention: looking down -Z, `up` roughly +Y
+/// on screen) of an eye at `eye` looking at `target`; `up` must not be
+/// parallel to the viewing direction.
+Mat4f lookAt(const Vec3f& eye, const Vec3f& target, const Vec3f& up);
+
 /// A pinhole perspective camera. Right-handed, Y up, looking down -Z in view space.
 struct Camera {
     Vec3f position{0.f, 0.05f, 0.9f};
