@@ -127,26 +127,6 @@ size_t limitRelativeVelocity(Vec3f* v, size_t n, float maxRelative) {
 
 float perStepFactor(float factor, float h, float hRef) { return std::pow(factor, h / hRef); }
 
-float ObstacleQuery::distance(const Vec3f& x, Vec3f* normal) const {
-    Vec3f n;
-    const float d = collider->signedDistance(toCollider * x, &n);
-    if (normal) *normal = normalToWorld * n;
-    return d;
-}
-
-Contact projectOut(const ObstacleQuery& head, float radius, Vec3f& x) {
-    Contact c;
-    if (!head.collider) return c;
-    Vec3f n;
-    const float d = head.distance(x, &n);
-    if (d >= radius) return c;
-    c.active = true;
-    c.normal = n;
-    c.push = radius - d;
-    x += c.push * n;
-    return c;
-}
-
 float strainLimited(float length, float restLength, float maxStrain) {
     return std::clamp(length, (1.f - maxStrain) * restLength, (1.f + maxStrain) * restLength);
 }
@@ -177,19 +157,6 @@ Contact placeParticle(const Vec3f& parent, Vec3f& child, float length, const Obs
         total.push = std::max(0.f, (child - start).dot(total.normal));
     }
     return total;
-}
-
-Vec3f contactFriction(const Vec3f& v, const Vec3f& vs, const Contact& contact, float mu, float h) {
-    if (!contact.active) return v;
-    const Vec3f& n = contact.normal;
-    const Vec3f rel = v - vs;
-    const float vnRaw = rel.dot(n) - contact.push / h;  // the approach the push stopped
-    const float vn = std::max(vnRaw, 0.f);
-    const float removed = vn - vnRaw;
-    Vec3f vt = rel - rel.dot(n) * n;
-    const float vtLen = vt.norm();
-    if (vtLen > 0.f) vt *= std::max(0.f, 1.f - mu * removed / vtLen);
-    return vs + vn * n + vt;
 }
 
 void helixPoints(float radius, float pitch, float segment, size_t n, Vec3f* out) {

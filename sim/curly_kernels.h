@@ -11,6 +11,7 @@
 #pragma once
 
 #include "sim/head.h"
+#include "sim/strand_constraints.h"
 
 #include <Eigen/Geometry>
 
@@ -106,34 +107,13 @@ float perStepFactor(float factor, float h, float hRef);
 
 // ---- The obstacle (head) -----------------------------------------------------
 
-/// The head during one Bullet step. The collider is posed at the end of the
-/// solver step; `toCollider` maps a world point at the end of this Bullet step
-/// onto that pose (identity without substeps), `normalToWorld` maps its
-/// normals back, `toPrevious` maps a point riding on the head back to where it
-/// was at the Bullet step's start (surface velocity for friction).
-struct ObstacleQuery {
-    const Collider* collider = nullptr;
-    Eigen::Isometry3f toCollider = Eigen::Isometry3f::Identity();
-    Mat3f normalToWorld = Mat3f::Identity();
-    Eigen::Isometry3f toPrevious = Eigen::Isometry3f::Identity();
-
-    /// Signed distance φ (negative inside) and outward world normal ∇φ at x.
-    float distance(const Vec3f& x, Vec3f* normal) const;
-    /// Velocity of the head surface at x over a step of length h.
-    Vec3f surfaceVelocity(const Vec3f& x, float h) const { return (x - toPrevious * x) / h; }
-};
-
-/// What a contact did to one particle.
-struct Contact {
-    bool active = false;
-    Vec3f normal = Vec3f::Zero();  ///< outward head normal
-    float push = 0.f;              ///< distance moved out along the normal, m
-};
-
-/// Projection out of the signed distance φ keeping `radius` clear
-/// (Bridson et al.'s collision handling, which the seed uses):
-///   if φ(x) < r:  x ← x + (r - φ(x))·∇φ(x).
-Contact projectOut(const ObstacleQuery& head, float radius, Vec3f& x);
+/// The head during one Bullet step and what a contact did to one particle:
+/// the same query, contact and projection out of the signed distance
+/// (Bridson et al.'s collision handling, which the seed uses) as the rope
+/// guides' (sim/strand_constraints.h).
+using ObstacleQuery = strand::HeadQuery;
+using strand::Contact;
+using strand::projectOut;
 
 /// The strain limit on one length: clamp(l, (1-s)|ē|, (1+s)|ē|).
 float strainLimited(float length, float restLength, float maxStrain);
@@ -149,12 +129,9 @@ float strainLimited(float length, float restLength, float maxStrain);
 /// the head carries its child instead of stretching the edge between them.
 Contact placeParticle(const Vec3f& parent, Vec3f& child, float length, const ObstacleQuery& head, float radius);
 
-/// Coulomb friction at velocity level for a particle the head pushed out by
-/// `push` in a step h, relative to the surface velocity vs: v_rel = v - vs;
-/// the push's velocity push/h along n is removed (no bounce), the normal part
-/// clamped to ≥ 0; the tangential part shrinks by at most μ times the normal
-/// velocity the contact removed (static friction when that stops it).
-Vec3f contactFriction(const Vec3f& v, const Vec3f& vs, const Contact& contact, float mu, float h);
+/// Friction after a contact: the same Coulomb update as the rope guides'
+/// (strand::contactFriction).
+using strand::contactFriction;
 
 // ---- Helices (seed eq. 6) and measuring them ----------------------------------
 
