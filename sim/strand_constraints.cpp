@@ -174,26 +174,46 @@ struct DriveState {
     explicit DriveState(const Mat3f& rootFrame) : Q(rootFrame) {}
 };
 
-/// Joint j of the Drive pass: the implicit spring on the segment's end,
-/// x ← x + f·(x* - x), renormalised onto the segment's length, carrying the
-/// subtree with the spring's turn and the length fix (a joint drive moves
-/// what hangs from it). driveLanes repeats these statements in SIMD lanes.
-inline void driveJoint(DriveState& s, Vec3f* x, int j, const JointParams& p) {
-    const Vec3f parent = x[j];
-    const Vec3f oldChild = s.C * x[j + 1] + s.c;
-    const float length = p.restLength[j];
-    const Vec3f rest = s.Q * p.restDir[j];
-    const Vec3f e = oldChild - parent;
+/// Joint j as the pass finds it: its parent vertex, its child as the turns
+/// above carry it, the rest direction in the transported frame, and the
+/// child's direction (the rest direction when the segment has collapsed).
+struct JointView {
+    Vec3f parent, oldChild, rest, d;
+    float length;
+};
+
+[[gnu::always_inline]] inline JointView viewJoint(const DriveState& s, const Vec3f* x, int j, const JointParams& p) {
+    JointView v;
+    v.parent = x[j];
+    v.oldChild = s.C * x[j + 1] + s.c;
+    v.length = p.restLength[j];
+    v.rest = s.Q * p.restDir[j];
+    const Vec3f e = v.oldChild - v.parent;
     const float len = e.norm();
-    const Vec3f d = len > 1e-12f ? Vec3f(e / len) : rest;
-    const float f = p.spring[j];
-    const Vec3f dir = ((1.f - f) * d + f * (s.Q * p.springDir[j])).normalized();
-    const Quatf q = minimalRotation(d, dir);
+    v.d = len > 1e-12f ? Vec3f(e / len) : v.rest;
+    return v;
+}
+
+/// Sets joint j's segment to direction `dir` at its rest length, carrying
+/// the subtree with the turn and the length fix (a joint drive moves what
+/// hangs from it), and turns the transported frame on.
+[[gnu::always_inline]] inline void turnJoint(DriveState& s, Vec3f* x, int j, const JointView& v, const Vec3f& dir) {
+    const Quatf q = minimalRotation(v.d, dir);
     s.C = q * s.C;
-    s.c = parent + length * dir + q * (s.c - oldChild);
-    x[j + 1] = parent + length * dir;
-    s.Q = minimalRotation(rest, dir) * s.Q;
+    s.c = v.parent + v.length * dir + q * (s.c - v.oldChild);
+    x[j + 1] = v.parent + v.length * dir;
+    s.Q = minimalRotation(v.rest, dir) * s.Q;
     s.Q.normalize();  // keep rounding from accumulating over the chain
+}
+
+/// Joint j of the Drive pass: the implicit spring on the segment's end,
+/// x ← x + f·(x* - x), renormalised onto the segment's length.
+/// driveLanes repeats these statements in SIMD lanes.
+inline void driveJoint(DriveState& s, Vec3f* x, int j, const JointParams& p) {
+    const JointView v = viewJoint(s, x, j, p);
+    const float f = p.spring[j];
+    const Vec3f dir = ((1.f - f) * v.d + f * (s.Q * p.springDir[j])).normalized();
+    turnJoint(s, x, j, v, dir);
 }
 
 /// The Drive pass of one strand.
@@ -211,13 +231,9 @@ void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFra
     // SolvePreload, with the Drive pass's frames and carries.
     DriveState s(rootFrame);
     for (int j = 0; j + 1 < vertexCount; ++j) {
-        const Vec3f parent = x[j];
-        const Vec3f oldChild = s.C * x[j + 1] + s.c;
-        const float length = p.restLength[j];
-        const Vec3f rest = s.Q * p.restDir[j];
-        const Vec3f e = oldChild - parent;
-        const float len = e.norm();
-        const Vec3f d = len > 1e-12f ? Vec3f(e / len) : rest;
+        const JointView v = viewJoint(s, x, j, p);
+        const Vec3f& rest = v.rest;
+        const Vec3f& d = v.d;
         const float f = p.spring[j];
         // Aim past the rest direction r so that the spring step lands on it:
         // normalize((1-f)·d + f·t) = r with |t| = 1 gives
@@ -234,13 +250,7 @@ void relaxJoints(JointPass pass, Vec3f* x, int vertexCount, const Mat3f& rootFra
         }
         p.springDir[j] = s.Q.conjugate() * target;
         // The vertex goes back onto the rest shape, what hangs below with it.
-        const Vec3f& dir = rest;
-        const Quatf q = transport(d, dir);
-        s.C = q * s.C;
-        s.c = parent + length * dir + q * (s.c - oldChild);
-        x[j + 1] = parent + length * dir;
-        s.Q = transport(rest, dir) * s.Q;
-        s.Q.normalize();
+        turnJoint(s, x, j, v, rest);
     }
 }
 
