@@ -5,7 +5,6 @@
 
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cstdlib>
 
 using namespace hp;
@@ -13,19 +12,6 @@ using namespace hp::test;
 namespace fs = std::filesystem;
 
 namespace {
-
-/// Runs a shell command; exit code and output (stdout + stderr).
-ProcessResult shell(const std::string& command) {
-    ProcessResult r;
-    FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-    if (!pipe) return r;
-    std::array<char, 4096> buf;
-    size_t n;
-    while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) r.output.append(buf.data(), n);
-    const int status = ::pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
 
 /// The status table's row of a stage, e.g. "preview    3      4      3".
 std::string stageRow(const std::string& status, const std::string& stage) {
@@ -39,7 +25,7 @@ std::string stageRow(const std::string& status, const std::string& stage) {
 std::string slurmUnavailable() {
     if (::geteuid() != 0) return "the Slurm daemons and the munge key need root";
     for (const char* tool : {"munged", "slurmctld", "slurmd", "sbatch", "squeue", "sinfo"})
-        if (shell(std::string("command -v ") + tool).exitCode != 0)
+        if (runShell(std::string("command -v ") + tool).exitCode != 0)
             return std::string(tool) + " not found (install slurm-wlm and munge, see tools/setup)";
     return "";
 }
@@ -48,7 +34,7 @@ std::string slurmUnavailable() {
 class LocalSlurm {
   public:
     explicit LocalSlurm(const fs::path& state) : state_(state) {
-        const ProcessResult r = shell("'" + sourcePath("tools/farm/slurm-local").string() + "' start '" + state.string() + "'");
+        const ProcessResult r = runShell("'" + sourcePath("tools/farm/slurm-local").string() + "' start '" + state.string() + "'");
         output_ = r.output;
         const std::string prefix = "export SLURM_CONF=";
         const size_t at = r.output.find(prefix);
@@ -59,7 +45,7 @@ class LocalSlurm {
         }
     }
     ~LocalSlurm() {
-        shell("'" + sourcePath("tools/farm/slurm-local").string() + "' stop '" + state_.string() + "'");
+        runShell("'" + sourcePath("tools/farm/slurm-local").string() + "' stop '" + state_.string() + "'");
         ::unsetenv("SLURM_CONF");
     }
     bool started() const { return !conf_.empty(); }

@@ -49,12 +49,9 @@ std::string assetsMissingMessage(const std::string& name) {
            " (../shared/assets exists only in the development workspace and CI; skipping)";
 }
 
-ProcessResult runHairpipe(const std::string& args, const fs::path& cwd) {
-    std::string command;
-    if (!cwd.empty()) command = "cd '" + cwd.string() + "' && ";
-    command += std::string("'") + HAIRPIPE_EXE + "' " + args + " 2>&1";
+ProcessResult runShell(const std::string& command) {
     ProcessResult r;
-    FILE* pipe = ::popen(command.c_str(), "r");
+    FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
     if (!pipe) return r;
     std::array<char, 4096> buf;
     size_t n;
@@ -62,6 +59,12 @@ ProcessResult runHairpipe(const std::string& args, const fs::path& cwd) {
     const int status = ::pclose(pipe);
     r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     return r;
+}
+
+ProcessResult runHairpipe(const std::string& args, const fs::path& cwd) {
+    std::string command;
+    if (!cwd.empty()) command = "cd '" + cwd.string() + "' && ";
+    return runShell(command + "'" + HAIRPIPE_EXE + "' " + args);
 }
 
 fs::path sourcePath(const std::string& relative) { return fs::path(HAIRPIPE_SOURCE_DIR) / relative; }

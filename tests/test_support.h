@@ -41,6 +41,10 @@ struct ProcessResult {
     std::string output;  ///< stdout and stderr together
 };
 
+/// Runs a shell command; its exit code (-1 if it did not exit) and its
+/// stdout and stderr together.
+ProcessResult runShell(const std::string& command);
+
 /// Runs the hairpipe executable with `args` (a shell-quoted string) in `cwd`.
 ProcessResult runHairpipe(const std::string& args, const std::filesystem::path& cwd = {});
 
