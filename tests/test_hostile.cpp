@@ -35,6 +35,17 @@ std::string loadError(const std::filesystem::path& file) {
     return "(loaded without error)";
 }
 
+/// Each case's YAML, written to `file`, fails to load with a message that
+/// contains the case's text.
+template <size_t N>
+void expectLoadErrors(const std::filesystem::path& file, const std::pair<const char*, const char*> (&cases)[N]) {
+    for (const auto& [yaml, message] : cases) {
+        writeFile(file, yaml);
+        const std::string error = loadError(file);
+        EXPECT_NE(error.find(message), std::string::npos) << error;
+    }
+}
+
 /// Number of files (of any kind) under `dir`; 0 if it does not exist.
 size_t filesUnder(const fs::path& dir) {
     std::error_code ec;
@@ -111,10 +122,7 @@ TEST(Hostile, NanAndInfinityInNumericKeys) {
         {"fps: 1e999\n", "n.yaml:1:6: 'fps': must be a finite number, got '1e999'"},
         {"render:\n  camera:\n    fov: NaN\n", "'render.camera.fov': must be a finite number"},
     };
-    for (const auto& [yaml, message] : cases) {
-        writeFile(dir / "n.yaml", yaml);
-        EXPECT_NE(loadError(dir / "n.yaml").find(message), std::string::npos) << loadError(dir / "n.yaml");
-    }
+    expectLoadErrors(dir / "n.yaml", cases);
     writeFile(dir / "n.yaml", cases[0].first);
     expectRejected(runHairpipe("validate n.yaml", dir.path()), {cases[0].second});
 }
@@ -129,10 +137,7 @@ TEST(Hostile, NegativeAndZeroCounts) {
         {"render:\n  camera:\n    width: 0\n", "z.yaml:3:12: 'render.camera.width': must be in [16, 16384] px"},
         {"frames: 5-1\n", "z.yaml:1:9: 'frames': bad frame range '5-1': '5-1' ends before it starts"},
     };
-    for (const auto& [yaml, message] : cases) {
-        writeFile(dir / "z.yaml", yaml);
-        EXPECT_NE(loadError(dir / "z.yaml").find(message), std::string::npos) << loadError(dir / "z.yaml");
-    }
+    expectLoadErrors(dir / "z.yaml", cases);
     writeFile(dir / "z.yaml", cases[0].first);
     expectRejected(runHairpipe("validate z.yaml", dir.path()), {cases[0].second});
 }
@@ -154,10 +159,7 @@ TEST(Hostile, AbsurdSizesAreRejectedAtLoad) {
         {"render:\n  camera: {width: 8192, height: 8192}\nreference: {samples: 4096}\n",
          "a.yaml:3:22: 'reference.samples': reference camera samples per frame"},
     };
-    for (const auto& [yaml, message] : cases) {
-        writeFile(dir / "a.yaml", yaml);
-        EXPECT_NE(loadError(dir / "a.yaml").find(message), std::string::npos) << loadError(dir / "a.yaml");
-    }
+    expectLoadErrors(dir / "a.yaml", cases);
     // Through the binary, with `run`: the scene is refused before an output
     // folder or any stage exists.
     for (size_t i : {size_t(0), size_t(3)}) {
