@@ -22,6 +22,6 @@ AssetError::AssetError(const std::string& file, const std::string& problem)
     : Error(file + ": " + problem), file_(file) {}
 
 IoError::IoError(const std::string& file, const std::string& problem)
-    : Error("cannot write " + file + ": " + problem), file_(file) {}
+    : Error("cannot write " + file + ": " + problem), file_(file), problem_(problem) {}
 
 }  // namespace hp

@@ -63,9 +63,11 @@ class IoError : public Error {
   public:
     IoError(const std::string& file, const std::string& problem);
     const std::string& file() const { return file_; }
+    const std::string& problem() const { return problem_; }
 
   private:
     std::string file_;
+    std::string problem_;
 };
 
 /// A stage could not produce a frame (NaN in the solver, GL failure, ...).

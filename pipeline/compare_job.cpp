@@ -22,15 +22,6 @@ fs::path perFrame(const CompareJob& job, const char* pattern, int frame) {
     return job.outputDir / expandFrame(pattern, frame);
 }
 
-void writeText(const fs::path& path, const std::string& text) {
-    writeAtomically(path, [&](const fs::path& tmp) {
-        std::ofstream out(tmp, std::ios::binary);
-        out << text;
-        out.close();
-        if (!out) throw IoError(path.string(), "cannot write");
-    });
-}
-
 std::set<int> framesOnDisk(const std::string& pattern) {
     std::set<int> frames;
     const fs::path p(pattern);
@@ -88,7 +79,7 @@ FrameRecord compareFrame(const CompareJob& job, int frame) {
                     [&](const fs::path& tmp) { writeImage(tmp.string(), flipHeatmap(c.flipMap), heat); });
     writeAtomically(diffImagePath(job, frame), [&](const fs::path& tmp) { writeImage(tmp.string(), c.absDiff); });
     // The metrics file last: its presence marks the frame as complete.
-    writeText(frameMetricsPath(job, frame), frameRecordJson(r) + "\n");
+    writeTextAtomically(frameMetricsPath(job, frame), frameRecordJson(r) + "\n");
     return r;
 }
 
@@ -137,10 +128,10 @@ std::vector<std::string> finishCompare(const CompareJob& job, std::vector<FrameR
         for (const std::string& f : r.failures) line += (line.empty() ? "" : ", ") + f;
         if (!line.empty()) failures.push_back(cat("frame ", r.frame, ": ", line));
     }
-    writeText(job.outputDir / "metrics.csv", metricsCsv(records));
-    writeText(job.outputDir / "metrics.json", metricsJson(job, records));
+    writeTextAtomically(job.outputDir / "metrics.csv", metricsCsv(records));
+    writeTextAtomically(job.outputDir / "metrics.json", metricsJson(job, records));
     if (!job.report.empty()) {
-        writeText(job.report, compareReportHtml(job, records));
+        writeTextAtomically(job.report, compareReportHtml(job, records));
         logInfo("compare: report ", job.report.string());
     }
     return failures;

@@ -98,18 +98,6 @@ std::string submitScript(const FarmPlan& p) {
     return s.str();
 }
 
-void writeText(const fs::path& path, const std::string& text, bool executable) {
-    writeAtomically(path, [&](const fs::path& tmp) {
-        std::ofstream out(tmp);
-        out << text;
-        out.close();
-        if (!out) throw IoError(path.string(), "write failed");
-        if (executable)
-            fs::permissions(tmp, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
-                            fs::perm_options::add);
-    });
-}
-
 }  // namespace
 
 FarmPlan makeFarmPlan(const Scene& scene, const RunOptions& options, const FarmOptions& farm) {
@@ -174,7 +162,7 @@ void writeFarmScripts(const FarmPlan& p) {
     if (!p.report) fs::remove(p.script("report"), ec);
 
     if (p.simulate)
-        writeText(p.script("sim"), taskScript(p, "sim", "sim", "sim.log", "", exe + " sim " + joinQuoted(common)), true);
+        writeTextAtomically(p.script("sim"), taskScript(p, "sim", "sim", "sim.log", "", exe + " sim " + joinQuoted(common)), true);
     if (!p.chunks.empty()) {
         std::ostringstream pre;
         pre << "task=\"${SLURM_ARRAY_TASK_ID:-${1:-}}\"\n"
@@ -190,7 +178,7 @@ void writeFarmScripts(const FarmPlan& p) {
         args.insert(args.end(), {"--stages", stages, "--no-report"});
         if (p.cacheOnly) args.push_back("--cache-only");
         if (p.options.force) args.push_back("--force");
-        writeText(p.script("frames"),
+        writeTextAtomically(p.script("frames"),
                   taskScript(p, "frames", "frames.$task", "frames.%a.log", pre.str(),
                              exe + " run " + joinQuoted(args) + " --frames \"$frames\""),
                   true);
@@ -198,10 +186,10 @@ void writeFarmScripts(const FarmPlan& p) {
     if (p.report) {
         std::vector<std::string> args = common;
         args.insert(args.end(), {"--stages", "compare"});
-        writeText(p.script("report"), taskScript(p, "report", "report", "report.log", "", exe + " run " + joinQuoted(args)),
+        writeTextAtomically(p.script("report"), taskScript(p, "report", "report", "report.log", "", exe + " run " + joinQuoted(args)),
                   true);
     }
-    writeText(p.folder() / "submit-slurm.sh", submitScript(p), true);
+    writeTextAtomically(p.folder() / "submit-slurm.sh", submitScript(p), true);
 
     std::ostringstream plan;
     plan << "# hairpipe farm plan (read by `hairpipe farm status`)\n"
@@ -212,7 +200,7 @@ void writeFarmScripts(const FarmPlan& p) {
          << "sim: " << (p.simulate ? "yes" : "no") << "\n"
          << "report: " << (p.report ? "yes" : "no") << "\n";
     for (size_t k = 0; k < p.chunks.size(); ++k) plan << "task " << k + 1 << ": " << formatFrameRange(p.chunks[k]) << "\n";
-    writeText(p.folder() / "plan.txt", plan.str(), false);
+    writeTextAtomically(p.folder() / "plan.txt", plan.str(), false);
     // Results of an earlier submission would be mistaken for this one's.
     for (fs::directory_iterator it(p.folder() / "status", ec), end; !ec && it != end; it.increment(ec))
         fs::remove(it->path(), ec);

@@ -65,7 +65,12 @@ class HairFrameSource final : public FrameSource {
         }
         if (shot_.writesCache && scene_.flag("cache.checkpoints") && sim_->canCheckpoint()) {
             const fs::path checkpoint = cachePath(scene_, shot_, "cache.checkpoint", frame);
-            writeAtomically(checkpoint, [&](const fs::path& tmp) { sim_->saveCheckpoint(tmp); });
+            try {
+                writeAtomically(checkpoint, [&](const fs::path& tmp) { sim_->saveCheckpoint(tmp); });
+            } catch (const IoError& e) {
+                // Only a resume needs it: the frame fails, its strands are still good.
+                data.failures.push_back(e.what());
+            }
         }
         return data;
     }

@@ -96,10 +96,28 @@ void writeAtomically(const fs::path& final, const std::function<void(const fs::p
         if (!fs::is_regular_file(tmp, ec)) throw IoError(final.string(), "the writer produced no file");
         fs::rename(tmp, final, ec);
         if (ec) throw IoError(final.string(), "cannot rename temporary file: " + ec.message());
+    } catch (const IoError& e) {
+        fs::remove(tmp, ec);
+        // The user knows the final name, never the temporary one.
+        if (e.file() == tmp.string()) throw IoError(final.string(), e.problem());
+        throw;
     } catch (...) {
         fs::remove(tmp, ec);
         throw;
     }
+}
+
+void writeTextAtomically(const fs::path& final, const std::string& text, bool executable) {
+    writeAtomically(final, [&](const fs::path& tmp) {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        out << text;
+        // close() flushes: a full disk shows only there, not at operator<<.
+        out.close();
+        if (!out) throw IoError(tmp.string(), "write failed (disk full?)");
+        if (executable)
+            fs::permissions(tmp, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
+                            fs::perm_options::add);
+    });
 }
 
 void checkOutputDirectory(const fs::path& dir) {

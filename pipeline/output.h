@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <functional>
 #include <set>
+#include <string>
 #include <vector>
 
 namespace hp {
@@ -26,9 +27,15 @@ std::filesystem::path temporaryPath(const std::filesystem::path& final);
 
 /// Creates the parent folder, calls `write(temporary)`, checks the file is
 /// there and renames it to `final`. On any failure the temporary is removed
-/// and the error re-thrown (IoError for filesystem failures).
+/// and the error re-thrown (IoError for filesystem failures; one that names
+/// the temporary is re-thrown naming `final`).
 void writeAtomically(const std::filesystem::path& final,
                      const std::function<void(const std::filesystem::path&)>& write);
+
+/// writeAtomically for a text file: writes `text` (and, with `executable`,
+/// adds the execute bits), checking the stream after it is closed, when
+/// buffered bytes reach the disk.
+void writeTextAtomically(const std::filesystem::path& final, const std::string& text, bool executable = false);
 
 /// @brief Creates `dir` (and its parents) and proves it writable by creating
 /// and removing a probe file; throws IoError naming the folder otherwise.

@@ -74,6 +74,10 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
         if (needsData) {
             try {
                 data = source.get(frame);
+                for (const std::string& failure : data.failures) {
+                    report.failures.push_back(cat("frame ", frame, ": ", failure));
+                    logError("frame ", frame, ": ", failure);
+                }
                 logVerbose("frame ", frame, " data (simulation or cache): peak RSS ", int(peakResidentMb()), " MB");
             } catch (const FrameError& e) {
                 // Without the frame's data no data stage can run; later frames may still work.

@@ -30,6 +30,10 @@ struct FrameData {
     /// Set when the strands were simulated for this frame (not read from the
     /// strand cache): what the simulation measured.
     const SimFrameStats* simulation = nullptr;
+    /// Side outputs of the source that could not be written (a checkpoint on
+    /// a full disk). The frame counts as failed, but its data is sound, so
+    /// the stages still run.
+    std::vector<std::string> failures;
 };
 
 /// Settings fixed for a whole run: resolved from the scene and the command line.

@@ -39,11 +39,7 @@ class SimStage final : public FrameStage {
         // the cache (e.g. only the stats file was lost) records that.
         const std::string json = data.simulation ? data.simulation->json()
                                                  : cat("{\"frame\": ", data.frame, ", \"from_cache\": true}");
-        writeAtomically(paths[1], [&](const fs::path& tmp) {
-            std::ofstream out(tmp);
-            out << json << "\n";
-            if (!out) throw IoError(paths[1].string(), "write failed");
-        });
+        writeTextAtomically(paths[1], json + "\n");
         if (paths.size() > 2) {
             UsdExportSettings usd;
             usd.fps = shot_.fps;

@@ -2,6 +2,7 @@
 
 #include "core/errors.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <fstream>
 
 namespace hp {
 
@@ -90,13 +92,27 @@ void writeImage(const std::string& path, const Image& image, const ImageWriteOpt
         }
         format = eightBit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
     }
-    if (channelFormats.empty()) buf.set_write_format(format);
-    else buf.set_write_format(channelFormats);
-    OIIO::ImageSpec& spec = buf.specmod();
+    OIIO::ImageSpec spec = buf.spec();
+    spec.set_format(format);
+    if (!channelFormats.empty()) spec.channelformats = channelFormats;
     if (exr) spec.attribute("compression", "zip");
     spec.attribute("Software", "hairpipe");
     for (const auto& [key, value] : options.metadata) spec.attribute(key, value);
-    if (!buf.write(path)) throw IoError(path, buf.geterror());
+    // Encoded in memory, then written and checked here. On a full disk OIIO
+    // 2.4's PNG writer reports nothing (a truncated frame would look finished,
+    // and a resumed batch would skip it), and its JPEG writer lets libjpeg
+    // call exit(), ending the whole batch.
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput proxy(bytes);
+    auto out = OIIO::ImageOutput::create(path, &proxy);
+    if (!out) throw IoError(path, "no image writer for this file type: " + OIIO::geterror());
+    if (!out->supports("ioproxy")) throw IoError(path, "unsupported image file type " + ext + " (use .exr or .png)");
+    if (!out->open(path, spec) || !buf.write(out.get()) || !out->close())
+        throw IoError(path, "image encoding failed: " + out->geterror());
+    std::ofstream file(path, std::ios::binary | std::ios::trunc);
+    file.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    file.close();
+    if (!file) throw IoError(path, "write failed (disk full?)");
 }
 
 Image readImage(const std::string& path, bool linearize) {

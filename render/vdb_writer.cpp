@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -89,6 +90,16 @@ void writeHeaderUuid(const std::filesystem::path& file, const std::string& uuid)
     io.flush();
     if (!io) throw IoError(file.string(), "cannot rewrite the VDB header");
 }
+
+/// OpenVDB's io::File::write opens its own std::ofstream and never looks at
+/// it again, so a full disk leaves a truncated file and no error (and the
+/// atomic rename would publish it). Archive's stream writer is protected:
+/// this subclass hands it a stream the caller owns and checks once closed.
+/// Same bytes as io::File (seekable stream, same header and compression).
+class CheckedVdbArchive final : public openvdb::io::Archive {
+  public:
+    void writeTo(std::ostream& os, const openvdb::GridPtrVec& grids) const { Archive::write(os, grids, true); }
+};
 
 /// OpenVDB's Mat4 is row-vector (p' = p · M, translation in the last row).
 openvdb::math::Mat4d toVdbMatrix(const GridTransform& t) {
@@ -220,16 +231,19 @@ void writeGrids(const std::filesystem::path& file, const DensityGrid& grid, cons
     digest.add(exact, sizeof exact, 3);
 
     try {
-        openvdb::io::File out(file.string());
+        CheckedVdbArchive archive;
         uint32_t flags = openvdb::io::COMPRESS_ACTIVE_MASK;
         if (settings.compression == VdbCompression::Blosc) {
             if (!openvdb::io::Archive::hasBloscCompression())
                 throw IoError(file.string(), "this OpenVDB library was built without Blosc; use compression: none");
             flags |= openvdb::io::COMPRESS_BLOSC;
         }
-        out.setCompression(flags);
-        out.write(grids);
-        out.close();
+        archive.setCompression(flags);
+        std::ofstream out(file, std::ios::binary | std::ios::trunc);
+        if (!out) throw IoError(file.string(), cat("cannot create the file: ", std::strerror(errno)));
+        archive.writeTo(out, grids);
+        out.close();  // flushes: a full disk may show only here
+        if (!out) throw IoError(file.string(), "write failed (disk full?)");
     } catch (const openvdb::Exception& e) {
         throw IoError(file.string(), std::string("OpenVDB: ") + e.what());
     }

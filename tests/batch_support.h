@@ -121,30 +121,57 @@ inline std::string replaceAll(std::string s, const std::string& from, const std:
     return s;
 }
 
-/// Asserts `b` holds the same outputs as `a`: caches, VDBs, PNGs, USD
-/// byte-identical; EXRs with identical channels and pixels (their headers
-/// carry the write time); compare tables identical once the output folder
-/// named in them is swapped; no temporaries left in `b`.
+/// Compare tables and the report: rewritten whole by every run that compares.
+inline bool isCompareTable(const std::string& f) {
+    return f.rfind("compare/", 0) == 0 && std::filesystem::path(f).extension() != ".png" &&
+           std::filesystem::path(f).extension() != ".exr";
+}
+
+/// Asserts output file `f` (relative) is the same in `a` and `b`: EXRs with
+/// identical channels and pixels (their headers carry the write time),
+/// compare tables identical once the output folder named in them is
+/// swapped, anything else byte for byte.
+inline void expectSameFile(const std::filesystem::path& a, const std::filesystem::path& b, const std::string& f) {
+    const std::string ext = std::filesystem::path(f).extension().string();
+    if (ext == ".exr") {
+        const Image ia = readImage((a / f).string()), ib = readImage((b / f).string());
+        EXPECT_EQ(ia.channels, ib.channels) << f;
+        ASSERT_EQ(ia.pixels.size(), ib.pixels.size()) << f;
+        EXPECT_EQ(0, std::memcmp(ia.pixels.data(), ib.pixels.data(), ia.pixels.size() * sizeof(float)))
+            << f << ": pixels differ";
+    } else if (isCompareTable(f)) {
+        EXPECT_EQ(replaceAll(readFile(a / f), a.string(), b.string()), readFile(b / f)) << f;
+    } else {
+        EXPECT_TRUE(readFile(a / f) == readFile(b / f)) << f << ": bytes differ";
+    }
+}
+
+inline void expectNoTemporaries(const std::vector<std::string>& files) {
+    for (const std::string& f : files)
+        EXPECT_EQ(std::filesystem::path(f).filename().string().rfind(".hairpipe-tmp-", 0), std::string::npos)
+            << "temporary file left: " << f;
+}
+
+/// Asserts `b` holds the same outputs as `a` (expectSameFile for each) and
+/// no temporaries.
 inline void expectSameOutputs(const std::filesystem::path& a, const std::filesystem::path& b) {
     const std::vector<std::string> fa = outputFiles(a), fb = outputFiles(b);
     EXPECT_EQ(fa, fb) << "different sets of output files";
-    for (const std::string& f : fb)
-        EXPECT_EQ(std::filesystem::path(f).filename().string().rfind(".hairpipe-tmp-", 0), std::string::npos)
-            << "temporary file left: " << f;
-    for (const std::string& f : fa) {
-        if (std::find(fb.begin(), fb.end(), f) == fb.end()) continue;
-        const std::string ext = std::filesystem::path(f).extension().string();
-        if (ext == ".exr") {
-            const Image ia = readImage((a / f).string()), ib = readImage((b / f).string());
-            EXPECT_EQ(ia.channels, ib.channels) << f;
-            ASSERT_EQ(ia.pixels.size(), ib.pixels.size()) << f;
-            EXPECT_EQ(0, std::memcmp(ia.pixels.data(), ib.pixels.data(), ia.pixels.size() * sizeof(float)))
-                << f << ": pixels differ";
-        } else if (f.rfind("compare/", 0) == 0 && ext != ".png") {
-            EXPECT_EQ(replaceAll(readFile(a / f), a.string(), b.string()), readFile(b / f)) << f;
-        } else {
-            EXPECT_TRUE(readFile(a / f) == readFile(b / f)) << f << ": bytes differ";
-        }
+    expectNoTemporaries(fb);
+    for (const std::string& f : fa)
+        if (std::find(fb.begin(), fb.end(), f) != fb.end()) expectSameFile(a, b, f);
+}
+
+/// Asserts every frame output `b` has is one `a` has too, and the same: a
+/// run that failed part way left only finished files. Compare tables are
+/// skipped (they list the failures).
+inline void expectOnlyFinishedOutputs(const std::filesystem::path& a, const std::filesystem::path& b) {
+    const std::vector<std::string> fa = outputFiles(a), fb = outputFiles(b);
+    expectNoTemporaries(fb);
+    for (const std::string& f : fb) {
+        if (isCompareTable(f)) continue;
+        if (std::find(fa.begin(), fa.end(), f) == fa.end()) ADD_FAILURE() << "unexpected output " << f;
+        else expectSameFile(a, b, f);
     }
 }
 

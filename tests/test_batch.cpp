@@ -2,6 +2,7 @@
 // frames, frame subsets from the cache, --jobs, chunks without the report,
 // whole-shot USD export, stale temporaries.
 #include "batch_support.h"
+#include "core/errors.h"
 #include "pipeline/output.h"
 
 #include <gtest/gtest.h>
@@ -200,6 +201,35 @@ TEST(Batch, RenderKilledMidShotCompletesIdenticallyWithoutPartialFiles) {
         << "the rerun should have skipped what the killed render finished:\n" << resumed.output;
     EXPECT_EQ(resumed.output.find("simulation:"), std::string::npos) << "frames come from the cache:\n" << resumed.output;
     // Cache, previews and references equal the uninterrupted render's.
+    expectSameOutputs(dir / "a", b);
+}
+
+TEST(Batch, FullDiskFailsFramesWithoutPartialFilesAndARerunCompletes) {
+    // A file-size limit with SIGXFSZ ignored: every write past it fails with
+    // EFBIG, as a full disk does with ENOSPC. Limits grow run by run (in the
+    // shell's ulimit blocks; all below one VDB frame, so every run fails), so
+    // each run gets further and must leave only finished files behind.
+    TempDir dir;
+    const fs::path scene = writeSmallScene(dir.path());
+    const ProcessResult full = runHairpipe("run -q " + q(scene) + " --out " + q(dir / "a"));
+    ASSERT_EQ(full.exitCode, 0) << full.output;
+    const fs::path b = dir / "b";
+    for (int blocks : {8, 32, 128, 256}) {
+        SCOPED_TRACE(cat("ulimit -f ", blocks));
+        const ProcessResult r = runShell(cat("cd ", q(dir.path()), " && trap '' XFSZ && ulimit -f ", blocks, " && '",
+                                             HAIRPIPE_EXE, "' run -q ", q(scene), " --out ", q(b), " 2>&1"));
+        EXPECT_EQ(r.exitCode, 2) << r.output;
+        EXPECT_NE(r.output.find("write failed (disk full?)"), std::string::npos) << r.output;
+        // Messages name the file the user asked for, never the temporary.
+        for (size_t at = r.output.find("cannot write "); at != std::string::npos;
+             at = r.output.find("cannot write ", at + 1)) {
+            const std::string path = r.output.substr(at + 13, r.output.find(": ", at) - at - 13);
+            EXPECT_EQ(fs::path(path).filename().string().rfind(kTemporaryPrefix, 0), std::string::npos) << path;
+        }
+        expectOnlyFinishedOutputs(dir / "a", b);
+    }
+    const ProcessResult rerun = runHairpipe("run -q " + q(scene) + " --out " + q(b));
+    ASSERT_EQ(rerun.exitCode, 0) << rerun.output;
     expectSameOutputs(dir / "a", b);
 }
 

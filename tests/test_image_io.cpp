@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <csignal>
+#include <sys/resource.h>
+
 using namespace hp;
 
 namespace {
@@ -77,4 +80,35 @@ TEST(ImageIo, MissingOrBrokenFileNamesTheFile) {
 
 TEST(ImageIo, UnwritablePathIsAnIoError) {
     EXPECT_THROW(writeImage("/nonexistent-dir/x.exr", gradient()), IoError);
+}
+
+TEST(ImageIo, FullDiskIsAnIoErrorForEveryFormat) {
+    // A file-size limit with SIGXFSZ ignored makes every write past it fail
+    // with EFBIG, as a full disk does with ENOSPC.
+    test::TempDir dir;
+    Image noise(96, 96, {"R", "G", "B", "A"});
+    uint32_t h = 1;
+    for (float& v : noise.pixels) v = float((h = h * 1664525u + 1013904223u) >> 8) / 16777216.f;  // incompressible
+    struct sigaction ignore = {}, oldAction = {};
+    ignore.sa_handler = SIG_IGN;
+    ASSERT_EQ(sigaction(SIGXFSZ, &ignore, &oldAction), 0);
+    rlimit oldLimit = {};
+    ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &oldLimit), 0);
+    rlimit tiny = oldLimit;
+    tiny.rlim_cur = 4096;
+    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &tiny), 0);
+    std::vector<std::string> missed;
+    for (const char* ext : {".png", ".exr", ".tif", ".jpg"}) {
+        const std::string path = (dir / (std::string("full") + ext)).string();
+        try {
+            writeImage(path, noise);
+            missed.push_back(ext);
+        } catch (const IoError& e) {
+            EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("disk full"), std::string::npos) << e.what();
+        }
+    }
+    setrlimit(RLIMIT_FSIZE, &oldLimit);
+    sigaction(SIGXFSZ, &oldAction, nullptr);
+    EXPECT_TRUE(missed.empty()) << "no error from a truncated write of " << ::testing::PrintToString(missed);
 }
