@@ -124,27 +124,51 @@ ScalpSettings scalpSettings(const Scene& scene) {
 
 namespace {
 
-/// Warns when the rest mesh has boundary edges (after welding seams), i.e. is
-/// open: a signed-distance collider's inside is only trustworthy for closed
-/// meshes (sim/level_set.h), so hair may be pushed the wrong way near holes.
-/// Scanned heads are often open at the neck, so this is a warning, not an
-/// error; the exact collider and `none` do not depend on a closed mesh.
-void warnIfOpen(const TriangleMesh& mesh, const std::string& colliderMethod, const std::string& file) {
-    if (colliderMethod != "rigid" && colliderMethod != "per_frame") return;
+/// Warns about defects of the rest mesh (after welding seams), counted per
+/// edge. Warnings, not errors: scanned heads are often open at the neck, and
+/// a defect far from the scalp does no harm.
+/// - open: boundary edges (one triangle), and non-manifold: edges shared by
+///   more than two triangles (fins, doubled faces). The level-set colliders'
+///   flood fill finds the inside only of a closed manifold mesh
+///   (sim/level_set.h), so hair may be pushed the wrong way there; the exact
+///   collider and `none` do not depend on it.
+/// - inconsistent winding: two triangles that run along their shared edge the
+///   same way, so one of them faces inward. Root normals come from the
+///   winding (hair rooted there grows into the head), and so does the exact
+///   collider's inside (angle-weighted pseudonormals).
+void warnIfNotClosed(const TriangleMesh& mesh, const std::string& colliderMethod, const std::string& file) {
+    const bool levelSet = colliderMethod == "rigid" || colliderMethod == "per_frame";
     const std::vector<uint32_t> weld = weldVertices(mesh.positions);
-    std::map<std::pair<uint32_t, uint32_t>, int> edges;
+    struct EdgeUse {
+        int uses = 0;
+        int direction = 0;  ///< +1 per use from the lower to the higher vertex, -1 the other way
+    };
+    std::map<std::pair<uint32_t, uint32_t>, EdgeUse> edges;
     for (const auto& t : mesh.triangles)
         for (int e = 0; e < 3; ++e) {
             uint32_t a = weld[t[e]], b = weld[t[(e + 1) % 3]];
             if (a == b) continue;  // a degenerate triangle's collapsed edge
-            if (a > b) std::swap(a, b);
-            ++edges[{a, b}];
+            EdgeUse& use = edges[{std::min(a, b), std::max(a, b)}];
+            ++use.uses;
+            use.direction += a < b ? 1 : -1;
         }
-    size_t boundary = 0;
-    for (const auto& [edge, uses] : edges) boundary += uses == 1;
-    if (boundary > 0)
+    size_t boundary = 0, nonManifold = 0, flipped = 0;
+    for (const auto& [edge, use] : edges) {
+        boundary += use.uses == 1;
+        nonManifold += use.uses > 2;
+        flipped += use.uses == 2 && use.direction != 0;
+    }
+    const char* advice = "; fix the mesh or use head.collider.method: exact";
+    if (levelSet && boundary > 0)
         logWarning("head: ", file, " is open (", boundary, " boundary edges): the collider's inside/outside is "
-                   "unreliable near the holes; close the mesh or use head.collider.method: exact");
+                   "unreliable near the holes", advice);
+    if (levelSet && nonManifold > 0)
+        logWarning("head: ", file, " is non-manifold (", nonManifold, " edges shared by more than two triangles): "
+                   "the collider's inside/outside is unreliable there", advice);
+    if (flipped > 0)
+        logWarning("head: ", file, " has inconsistently wound triangles (", flipped, " edges whose two triangles "
+                   "run the same way): hair rooted on inward-facing ones grows into the head, and the exact "
+                   "collider's inside/outside is wrong near them; make the winding consistent");
 }
 
 }  // namespace
@@ -176,7 +200,7 @@ HeadSetup loadHead(const Scene& scene) {
         scene.fail(scalp.method == ScalpMethod::All ? "head.file" : "head.scalp.method",
                    cat("the scalp (", scalpTriangles, scalpTriangles == 1 ? " triangle" : " triangles",
                        ") has zero area in ", h.rig->file, ": only degenerate triangles, no hair can grow"));
-    warnIfOpen(h.rest, scene.text("head.collider.method"), h.rig->file);
+    warnIfNotClosed(h.rest, scene.text("head.collider.method"), h.rig->file);
     logVerbose("head: ", h.rest.triangleCount(), " triangles, ", scalpTriangles, " on the scalp (",
                surfaceArea(h.rest, h.scalp) * 1e4, " cm²), set up in ", seconds(start), " s");
     return h;

@@ -224,6 +224,31 @@ TEST(Hostile, OpenHeadIsWarnedAbout) {
     const ProcessResult c = runHairpipe("sim c.yaml --out out2", dir.path());
     EXPECT_EQ(c.exitCode, 0) << c.output;
     EXPECT_EQ(c.output.find("boundary edges"), std::string::npos) << c.output;
+    EXPECT_EQ(c.output.find("non-manifold"), std::string::npos) << c.output;
+    EXPECT_EQ(c.output.find("inconsistently wound"), std::string::npos) << c.output;
+}
+
+TEST(Hostile, NonManifoldAndInconsistentlyWoundHeadsAreWarnedAbout) {
+    TempDir dir;
+    const std::string octahedron = "v 0.1 0 0\nv -0.1 0 0\nv 0 0.1 0\nv 0 -0.1 0\nv 0 0 0.1\nv 0 0 -0.1\n";
+    // A fin on edge 1-3 (a third triangle there, two new boundary edges).
+    writeFile(dir / "fin.obj", octahedron + "v 0.1 0.1 0.1\n"
+                               "f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\nf 1 7 3\n");
+    writeFile(dir / "f.yaml", shotWithHead("fin.obj"));
+    const ProcessResult f = runHairpipe("sim f.yaml --out out", dir.path());
+    EXPECT_EQ(f.exitCode, 0) << f.output;
+    EXPECT_NE(f.output.find("fin.obj is non-manifold (1 edges shared by more than two triangles)"), std::string::npos)
+        << f.output;
+    EXPECT_NE(f.output.find("fin.obj is open (2 boundary edges)"), std::string::npos) << f.output;
+    // One face turned over (f 3 1 5 instead of f 1 3 5): its three edges
+    // each run the same way as their neighbour's.
+    writeFile(dir / "flipped.obj", octahedron +
+                                   "f 3 1 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n");
+    writeFile(dir / "w.yaml", shotWithHead("flipped.obj"));
+    const ProcessResult w = runHairpipe("sim w.yaml --out out2", dir.path());
+    EXPECT_EQ(w.exitCode, 0) << w.output;
+    EXPECT_NE(w.output.find("flipped.obj has inconsistently wound triangles (3 edges"), std::string::npos) << w.output;
+    EXPECT_EQ(w.output.find("boundary edges"), std::string::npos) << w.output;
 }
 
 TEST(Hostile, ZeroLengthClip) {
