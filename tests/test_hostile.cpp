@@ -226,6 +226,7 @@ TEST(Hostile, OpenHeadIsWarnedAbout) {
     EXPECT_EQ(c.output.find("boundary edges"), std::string::npos) << c.output;
     EXPECT_EQ(c.output.find("non-manifold"), std::string::npos) << c.output;
     EXPECT_EQ(c.output.find("inconsistently wound"), std::string::npos) << c.output;
+    EXPECT_EQ(c.output.find("inside out"), std::string::npos) << c.output;
 }
 
 TEST(Hostile, NonManifoldAndInconsistentlyWoundHeadsAreWarnedAbout) {
@@ -249,6 +250,13 @@ TEST(Hostile, NonManifoldAndInconsistentlyWoundHeadsAreWarnedAbout) {
     EXPECT_EQ(w.exitCode, 0) << w.output;
     EXPECT_NE(w.output.find("flipped.obj has inconsistently wound triangles (3 edges"), std::string::npos) << w.output;
     EXPECT_EQ(w.output.find("boundary edges"), std::string::npos) << w.output;
+    // Every face turned over: consistent, closed, but inside out.
+    writeFile(dir / "inverted.obj", octahedron +
+                                    "f 3 1 5\nf 2 3 5\nf 4 2 5\nf 1 4 5\nf 1 3 6\nf 3 2 6\nf 2 4 6\nf 4 1 6\n");
+    writeFile(dir / "i.yaml", shotWithHead("inverted.obj"));
+    const ProcessResult i = runHairpipe("sim i.yaml --out out3", dir.path());
+    EXPECT_NE(i.output.find("inverted.obj is inside out"), std::string::npos) << i.output;
+    EXPECT_EQ(i.output.find("inconsistently wound"), std::string::npos) << i.output;
 }
 
 TEST(Hostile, ZeroLengthClip) {
