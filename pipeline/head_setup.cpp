@@ -168,12 +168,14 @@ void warnIfNotClosed(const TriangleMesh& mesh, const std::string& colliderMethod
     if (levelSet && nonManifold > 0)
         logWarning("head: ", file, " is non-manifold (", nonManifold, " edges shared by more than two triangles): "
                    "the collider's inside/outside is unreliable there", advice);
-    double volume = 0.0;
-    for (const auto& t : mesh.triangles)
-        volume += double(mesh.positions[t[0]].dot(mesh.positions[t[1]].cross(mesh.positions[t[2]]))) / 6.0;
-    if (boundary == 0 && nonManifold == 0 && flipped == 0 && volume < 0.0)
-        logWarning("head: ", file, " is inside out (every triangle faces inward, volume ", volume,
-                   " m³): hair grows into the head; reverse the winding");
+    if (boundary == 0 && nonManifold == 0 && flipped == 0) {  // a volume only for a closed, consistent mesh
+        double volume = 0.0;
+        for (const auto& t : mesh.triangles)
+            volume += double(mesh.positions[t[0]].dot(mesh.positions[t[1]].cross(mesh.positions[t[2]]))) / 6.0;
+        if (volume < 0.0)
+            logWarning("head: ", file, " is inside out (every triangle faces inward, volume ", volume,
+                       " m³): hair grows into the head; reverse the winding");
+    }
     if (flipped > 0)
         logWarning("head: ", file, " has inconsistently wound triangles (", flipped, " edges whose two triangles "
                    "run the same way): hair rooted on inward-facing ones grows into the head, and the exact "

@@ -1,6 +1,7 @@
 #include "pipeline/output.h"
 
 #include "core/errors.h"
+#include "core/files.h"
 
 #include <atomic>
 #include <cerrno>
@@ -109,11 +110,7 @@ void writeAtomically(const fs::path& final, const std::function<void(const fs::p
 
 void writeTextAtomically(const fs::path& final, const std::string& text, bool executable) {
     writeAtomically(final, [&](const fs::path& tmp) {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        out << text;
-        // close() flushes: a full disk shows only there, not at operator<<.
-        out.close();
-        if (!out) throw IoError(tmp.string(), "write failed (disk full?)");
+        writeFileChecked(tmp, text.data(), text.size());
         if (executable)
             fs::permissions(tmp, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
                             fs::perm_options::add);

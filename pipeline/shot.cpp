@@ -43,6 +43,12 @@ double peakResidentMb() {
     return double(u.ru_maxrss) / 1024.0;
 }
 
+/// A failure is logged when it happens and listed again at the end of the run.
+void recordFailure(RunReport& report, const std::string& what) {
+    report.failures.push_back(what);
+    logError(what);
+}
+
 }  // namespace
 
 RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const ShotSettings& shot) {
@@ -74,15 +80,11 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
         if (needsData) {
             try {
                 data = source.get(frame);
-                for (const std::string& failure : data.failures) {
-                    report.failures.push_back(cat("frame ", frame, ": ", failure));
-                    logError("frame ", frame, ": ", failure);
-                }
+                for (const std::string& failure : data.failures) recordFailure(report, cat("frame ", frame, ": ", failure));
                 logVerbose("frame ", frame, " data (simulation or cache): peak RSS ", int(peakResidentMb()), " MB");
             } catch (const FrameError& e) {
                 // Without the frame's data no data stage can run; later frames may still work.
-                report.failures.push_back(cat("frame ", frame, ": ", e.what()));
-                logError("frame ", frame, ": ", e.what());
+                recordFailure(report, cat("frame ", frame, ": ", e.what()));
                 sourceFailed = true;
             }
             // Any other error (a scene key, an unreadable head, a scalp that
@@ -95,8 +97,7 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
                 stage->run(data);
                 logVerbose("frame ", frame, " ", stage->name(), ": peak RSS ", int(peakResidentMb()), " MB");
             } catch (const Error& e) {
-                report.failures.push_back(cat("frame ", frame, " ", stage->name(), ": ", e.what()));
-                logError("frame ", frame, " ", stage->name(), ": ", e.what());
+                recordFailure(report, cat("frame ", frame, " ", stage->name(), ": ", e.what()));
             }
         }
         ++report.framesDone;
@@ -112,8 +113,7 @@ void finishStages(std::vector<StagePtr>& stages, const ShotSettings& shot, RunRe
         try {
             stage->finish(shot);
         } catch (const Error& e) {
-            report.failures.push_back(cat(stage->name(), ": ", e.what()));
-            logError(stage->name(), ": ", e.what());
+            recordFailure(report, cat(stage->name(), ": ", e.what()));
         }
     }
 }

@@ -1,6 +1,7 @@
 #include "pipeline/strand_cache.h"
 
 #include "core/errors.h"
+#include "core/files.h"
 
 #include <zlib.h>
 
@@ -93,11 +94,7 @@ void writeStrandCache(const std::filesystem::path& path, const StrandFrame& fram
     if (velocities) w.array(frame.velocities);
     w.put(crc(w.buffer.data(), w.buffer.size()));
 
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    if (!out) throw IoError(path.string(), std::strerror(errno));
-    out.write(w.buffer.data(), std::streamsize(w.buffer.size()));
-    out.close();
-    if (!out) throw IoError(path.string(), "write failed (disk full?)");
+    writeFileChecked(path, w.buffer.data(), w.buffer.size());
 }
 
 StrandFrame readStrandCache(const std::filesystem::path& path) {

@@ -1,6 +1,7 @@
 #include "render/image_io.h"
 
 #include "core/errors.h"
+#include "core/files.h"
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
@@ -10,7 +11,6 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
-#include <fstream>
 
 namespace hp {
 
@@ -109,10 +109,7 @@ void writeImage(const std::string& path, const Image& image, const ImageWriteOpt
     if (!out->supports("ioproxy")) throw IoError(path, "unsupported image file type " + ext + " (use .exr or .png)");
     if (!out->open(path, spec) || !buf.write(out.get()) || !out->close())
         throw IoError(path, "image encoding failed: " + out->geterror());
-    std::ofstream file(path, std::ios::binary | std::ios::trunc);
-    file.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-    file.close();
-    if (!file) throw IoError(path, "write failed (disk full?)");
+    writeFileChecked(path, bytes.data(), bytes.size());
 }
 
 Image readImage(const std::string& path, bool linearize) {

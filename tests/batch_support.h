@@ -146,10 +146,16 @@ inline void expectSameFile(const std::filesystem::path& a, const std::filesystem
     }
 }
 
-inline void expectNoTemporaries(const std::vector<std::string>& files) {
-    for (const std::string& f : files)
-        EXPECT_EQ(std::filesystem::path(f).filename().string().rfind(".hairpipe-tmp-", 0), std::string::npos)
-            << "temporary file left: " << f;
+/// Output files of `dir` whose names start with the temporary prefix.
+inline std::vector<std::string> temporaries(const std::filesystem::path& dir) {
+    std::vector<std::string> out;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(dir))
+        if (e.path().filename().string().rfind(".hairpipe-tmp-", 0) == 0) out.push_back(e.path().string());
+    return out;
+}
+
+inline void expectNoTemporaries(const std::filesystem::path& dir) {
+    for (const std::string& f : temporaries(dir)) ADD_FAILURE() << "temporary file left: " << f;
 }
 
 /// Asserts `b` holds the same outputs as `a` (expectSameFile for each) and
@@ -157,7 +163,7 @@ inline void expectNoTemporaries(const std::vector<std::string>& files) {
 inline void expectSameOutputs(const std::filesystem::path& a, const std::filesystem::path& b) {
     const std::vector<std::string> fa = outputFiles(a), fb = outputFiles(b);
     EXPECT_EQ(fa, fb) << "different sets of output files";
-    expectNoTemporaries(fb);
+    expectNoTemporaries(b);
     for (const std::string& f : fa)
         if (std::find(fb.begin(), fb.end(), f) != fb.end()) expectSameFile(a, b, f);
 }
@@ -167,20 +173,12 @@ inline void expectSameOutputs(const std::filesystem::path& a, const std::filesys
 /// skipped (they list the failures).
 inline void expectOnlyFinishedOutputs(const std::filesystem::path& a, const std::filesystem::path& b) {
     const std::vector<std::string> fa = outputFiles(a), fb = outputFiles(b);
-    expectNoTemporaries(fb);
+    expectNoTemporaries(b);
     for (const std::string& f : fb) {
         if (isCompareTable(f)) continue;
         if (std::find(fa.begin(), fa.end(), f) == fa.end()) ADD_FAILURE() << "unexpected output " << f;
         else expectSameFile(a, b, f);
     }
-}
-
-/// Output files of `dir` whose names start with the temporary prefix.
-inline std::vector<std::string> temporaries(const std::filesystem::path& dir) {
-    std::vector<std::string> out;
-    for (const auto& e : std::filesystem::recursive_directory_iterator(dir))
-        if (e.path().filename().string().rfind(".hairpipe-tmp-", 0) == 0) out.push_back(e.path().string());
-    return out;
 }
 
 }  // namespace hp::test
