@@ -1,6 +1,7 @@
 #include "pipeline/compare_report.h"
 
 #include "core/errors.h"
+#include "core/log.h"
 #include "pipeline/compare_table.h"
 #include "render/image_encode.h"
 
@@ -49,11 +50,16 @@ struct FrameImages {
     std::string a, b, flip, diff;
 };
 
+/// The image as an embedded PNG, or empty (the page then says the image is
+/// missing) when it cannot be read: a report of a partly failed shot must
+/// still be written, so this warns with the file and the reason instead of
+/// failing the report.
 std::string thumbnail(const std::string& path, bool linearize, bool srgbEncode, int width) {
     try {
         const Image image = readImage(path, linearize);
         return pngDataUri(resizeToWidth(displayImage(image), width), srgbEncode);
-    } catch (const Error&) {
+    } catch (const Error& e) {
+        logWarning("compare report: no thumbnail of ", path, ": ", e.what());
         return {};
     }
 }

@@ -107,6 +107,11 @@ class CurlyWetModel final : public GuideModel {
     GuideStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
         solver_.setSaturation(sceneSaturation(scene_, head.time));
         const CurlyWetStats& c = solver_.step(roots, head);
+        if (c.implicitFailures > 0)
+            logWarning("curly-wet: at t = ", head.time, " s the implicit spring step of ", c.implicitFailures,
+                       " strand-substep(s) was not finite; those strands skipped their curl, bending and core "
+                       "forces for it (try a smaller simulation.time_step, more substeps or softer hair.curly "
+                       "stiffnesses)");
         GuideStats g;
         g.maxLengthError = c.maxLengthError;
         g.meanLengthError = c.meanLengthError;

@@ -439,6 +439,8 @@ TEST(CompareCli, MissingOrMismatchedFramesFailOnlyThoseFrames) {
     EXPECT_TRUE(contains(r.output, "b/img.0002.exr: no such file")) << r.output;
     EXPECT_TRUE(contains(r.output, "a/img.0003.exr is 160x120")) << r.output;
     EXPECT_TRUE(contains(r.output, "b/img.0003.exr is 80x60")) << r.output;
+    // The report still gets written; the image it cannot show is named, not dropped silently.
+    EXPECT_TRUE(std::regex_search(r.output, std::regex("no thumbnail of [^\n]*b/img.0002.exr"))) << r.output;
     EXPECT_TRUE(fs::exists(dir / "out/metrics.0001.json")) << "frame 1 is still compared";
     const std::string csv = test::readFile(dir / "out/metrics.csv");
     EXPECT_TRUE(contains(csv, "\n1,")) << csv;

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <vector>
 
 namespace hp {
@@ -362,6 +363,32 @@ TEST(CurlyWet, WritesInterpolatedFramesAndResetsOnTeleport) {
     solver.write(mid, solver.time() - 0.5 * s.timeStep);
     EXPECT_EQ(mid.vertexCount(), f.vertexCount());
     EXPECT_THROW(solver.write(mid, solver.time() - 2.0 * s.timeStep), Error);
+}
+
+TEST(CurlyWet, NonFiniteImplicitStepIsCountedNotSilent) {
+    // A stretch stiffness at the float limit overflows the implicit system
+    // (h²·ks·|e| is not finite): the step must say so instead of quietly
+    // dropping the springs, and the strands must stay finite.
+    CurlyWetSettings s;
+    s.stretchStiffness = std::numeric_limits<float>::max();
+    CurlyWetSolver solver(s);
+    const MovingSphere head(0.1f, [](double) { return Vec3f::Zero(); });
+    const std::vector<Vec3f> dirs = fibonacciCap(4);
+    start(solver, head, dirs, 0.1f);
+    size_t failures = 0, nans = 0;
+    simulate(solver, head, dirs, 0.1f, 2, [&](const CurlyWetStats& st) {
+        failures += st.implicitFailures;
+        nans += st.nanCount;
+    });
+    EXPECT_GT(failures, 0u);
+    EXPECT_EQ(nans, 0u);
+
+    // Ordinary settings never fail.
+    CurlyWetSolver ordinary{CurlyWetSettings{}};
+    start(ordinary, head, dirs, 0.1f);
+    failures = 0;
+    simulate(ordinary, head, dirs, 0.1f, 2, [&](const CurlyWetStats& st) { failures += st.implicitFailures; });
+    EXPECT_EQ(failures, 0u);
 }
 
 TEST(CurlyWet, BadInputIsAClearError) {
