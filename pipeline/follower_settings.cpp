@@ -21,4 +21,18 @@ FollowerSettings followerSettings(const Scene& s) {
     return f;
 }
 
+GroomModifiers groomModifiers(const Scene& s) {
+    GroomModifiers m;
+    m.lengthVariation = float(s.number("hair.followers.length_variation"));
+    m.clump = float(s.number("hair.followers.clump"));
+    m.clumpProfile = float(s.number("hair.followers.clump_profile"));
+    m.clumps = uint32_t(s.integer("hair.followers.clumps"));
+    m.wave = float(s.number("hair.followers.wave"));
+    m.waveLength = float(s.number("hair.followers.wave_length"));
+    m.curl = float(s.number("hair.followers.curl"));
+    m.frizz = float(s.number("hair.followers.frizz"));
+    m.seed = uint32_t(s.integer("seed"));
+    return m;
+}
+
 }  // namespace hp

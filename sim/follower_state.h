@@ -134,6 +134,8 @@ struct StepContext {
 
 struct Counters {
     size_t projected = 0, queries = 0;
+    size_t inside = 0;      ///< projected vertices left inside (signed distance < 0)
+    float maxDepth = 0.f;   ///< deepest of those, m
 };
 
 /// Rebuilds the pair records [begin, end) of class `c` from its guide rows.

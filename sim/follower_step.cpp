@@ -32,6 +32,7 @@
 #include "sim/follower_simd.h"
 #include "sim/follower_state.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hp::follower {
@@ -126,7 +127,11 @@ void collideLane(const StepContext& ctx, const FollowerClass& c, const float* g1
             const float* r = ownRest + size_t(v) * 3 * kLanes + k;
             length = std::sqrt(r[0] * r[0] + r[kLanes] * r[kLanes] + r[2 * kLanes] * r[2 * kLanes]);
         }
-        projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p);
+        const float after = projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p);
+        if (after < 0.f) {
+            ++counters.inside;
+            counters.maxDepth = std::max(counters.maxDepth, -after);
+        }
         sx += p.x() - qx;
         sy += p.y() - qy;
         sz += p.z() - qz;

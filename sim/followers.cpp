@@ -34,14 +34,8 @@ RestShapes RestShapes::straight(size_t count, int vertices, float length) {
     return s;
 }
 
-namespace {
-
-using Mat3d = Eigen::Matrix3d;
-using Vec3d = Eigen::Vector3d;
-
-/// Orthonormal root frame [t, n, t × n] of a rest SurfaceFrame (Gram-Schmidt,
-/// so slightly inexact mesh frames are accepted).
-Mat3d restFrame(const SurfaceFrame& f, const char* what, size_t i) {
+Eigen::Matrix3d restRootFrame(const SurfaceFrame& f, const char* what, size_t i) {
+    using Vec3d = Eigen::Vector3d;
     Vec3d n = f.normal.cast<double>(), t = f.tangent.cast<double>();
     if (!n.allFinite() || !t.allFinite() || !f.position.allFinite() || n.norm() < 1e-6)
         throw Error(cat("followers: ", what, " ", i, " has a non-finite or zero root frame"));
@@ -49,10 +43,15 @@ Mat3d restFrame(const SurfaceFrame& f, const char* what, size_t i) {
     t -= n * n.dot(t);
     if (t.norm() < 1e-6) throw Error(cat("followers: ", what, " ", i, " has a tangent parallel to its normal"));
     t.normalize();
-    Mat3d m;
+    Eigen::Matrix3d m;
     m << t, n, t.cross(n);
     return m;
 }
+
+namespace {
+
+using Mat3d = Eigen::Matrix3d;
+using Vec3d = Eigen::Vector3d;
 
 /// Rotation taking coordinates in frame A to coordinates in frame B after
 /// carrying A over to B's normal by the minimal rotation: B⁻¹ swing(n_A → n_B) A.
@@ -132,6 +131,40 @@ void buildPackets(Followers::Impl& im, const std::vector<size_t>& ownStart, cons
 
 }  // namespace
 
+RestShapes followerBaseShapes(const FollowerGroom& groom) {
+    if (groom.followerShapes.count() > 0) return groom.followerShapes;
+    const size_t G = groom.guideRoots.size(), F = groom.followerRoots.size();
+    RestShapes out;
+    if (F == 0) return out;
+    if (G == 0 || groom.guideShapes.count() != G) throw Error("followers: base shapes need one rest shape per guide");
+    std::vector<Vec3f> guideRootPositions(G);
+    for (size_t g = 0; g < G; ++g) guideRootPositions[g] = groom.guideRoots[g].position;
+    const PointGrid grid(std::move(guideRootPositions));
+    for (size_t f = 0; f < F; ++f) {
+        uint32_t g1 = 0;
+        float d2 = 0.f;
+        grid.nearest(groom.followerRoots[f].position, 1, &g1, &d2);
+        const uint32_t n = perFollower(groom.followerVertices, f);
+        if (n < 2) throw Error(cat("followers: follower ", f, " has ", n, " vertices (2 or more needed)"));
+        const float segment = perFollower(groom.followerLengths, f) / float(n - 1);
+        // The kernel's effective frame is R_f R_y(φ): a rest direction r of
+        // guide 1 is R_y(φ) r in the follower's own root frame.
+        const double phi = twistAngle(restRootFrame(groom.guideRoots[g1], "guide", g1),
+                                      restRootFrame(groom.followerRoots[f], "follower", f));
+        const uint32_t a = groom.guideShapes.offsets[g1], gs = groom.guideShapes.offsets[g1 + 1] - a - 1;
+        Vec3f p = Vec3f::Zero();
+        out.points.push_back(p);
+        for (uint32_t y = 0; y + 1 < n; ++y) {
+            const uint32_t k = a + FollowerClass::guideSegment(y, n - 1, gs);
+            const Vec3d d = (groom.guideShapes.points[k + 1] - groom.guideShapes.points[k]).cast<double>().normalized();
+            p += (double(segment) * rotateY(phi, d)).cast<float>();
+            out.points.push_back(p);
+        }
+        out.offsets.push_back(uint32_t(out.points.size()));
+    }
+    return out;
+}
+
 Followers::Followers(const FollowerGroom& groom, const FollowerSettings& settings) : impl_(std::make_unique<Impl>()) {
     Impl& im = *impl_;
     im.settings = settings;
@@ -166,7 +199,7 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
     // --- Guides at rest: unit directions and inverse transported frames P_y⁻¹.
     std::vector<Mat3d> guideFrames(G);
     for (size_t g = 0; g < G; ++g) {
-        guideFrames[g] = restFrame(groom.guideRoots[g], "guide", g);
+        guideFrames[g] = restRootFrame(groom.guideRoots[g], "guide", g);
         const uint32_t a = groom.guideShapes.offsets[g], b = groom.guideShapes.offsets[g + 1];
         follower::Quat frame;
         Vec3f previous = Vec3f::UnitY();
@@ -269,7 +302,7 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
     // Frames and lengths are checked serially first, so the first bad follower is the one reported.
     std::vector<Mat3d> followerFrames(F);
     for (size_t f = 0; f < F; ++f) {
-        followerFrames[f] = restFrame(groom.followerRoots[f], "follower", f);
+        followerFrames[f] = restRootFrame(groom.followerRoots[f], "follower", f);
         if (!own) {
             const float length = perFollower(groom.followerLengths, f);
             if (!(length > 0.f) || !std::isfinite(length))
