@@ -7,6 +7,7 @@ FollowerSettings followerSettings(const Scene& s) {
     const std::string& mode = s.text("hair.followers.mode");
     f.mode = mode == "cluster" ? FollowerMode::Cluster
              : mode == "interpolate" ? FollowerMode::Interpolate
+             : mode == "barycentric" ? FollowerMode::Barycentric
                                      : FollowerMode::Varied;
     f.neighbours = s.text("hair.followers.neighbours") == "shape-similarity" ? NeighbourRule::ShapeSimilarity
                                                                              : NeighbourRule::Nearest;

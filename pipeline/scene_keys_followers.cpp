@@ -9,10 +9,13 @@ void addFollowerKeys(SchemaBuilder& b) {
               "Follower strands: strands without physics rebuilt every step from their own root on the "
               "deformed scalp, copying or interpolating the segment rotations of their two nearest guides "
               "(seed 000, Algorithm 1).")
-        .choice("hair.followers.mode", "varied", {"cluster", "interpolate", "varied"},
+        .choice("hair.followers.mode", "varied", {"cluster", "interpolate", "varied", "barycentric"},
                 "cluster: copy the nearest guide's segment rotations; interpolate: slerp between the two "
                 "nearest guides by relative root distance d1/(d1+d2); varied: slerp by "
-                "fixed_offset·d_f(y) + rand·min(|v1|, max_velocity) (the seed's recommended mode).")
+                "fixed_offset·d_f(y) + rand·min(|v1|, max_velocity) (the seed's recommended mode); "
+                "barycentric: blend the rotations of the three guides of the guide-root triangle over the "
+                "follower (Delaunay on the scalp) by barycentric weights, so followers fill the volume "
+                "between guides instead of sheets between two (neighbours is not used).")
         .choice("hair.followers.neighbours", "nearest", {"nearest", "shape-similarity"},
                 "nearest: the two nearest guide roots, ordered (the seed's rule); shape-similarity: among "
                 "the 8 nearest roots, the guides whose rest shapes are most alike (keeps followers from "

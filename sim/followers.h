@@ -65,6 +65,14 @@ enum class FollowerMode {
     Cluster,      ///< copy the nearest guide's segment rotations
     Interpolate,  ///< slerp between the two nearest guides by relative root distance
     Varied,       ///< seed 000's Algorithm 1 (recommended)
+    /// Three guides, the corners of the guide-root triangle over the
+    /// follower (sim/follower_triangles.h), rotations blended by the
+    /// barycentric weights b: q = normalize(b1 q1 + b2 ±K2 q2 K2⁻¹ + b3 ±K3 q3 K3⁻¹)
+    /// (signs toward q1, K the rest twist into guide 1's frame). Followers
+    /// fill the volume between guides instead of the ruled sheets between two.
+    /// Without followerShapes a follower's rest shape is the same blend of
+    /// its three guides' rest directions.
+    Barycentric,
 };
 
 enum class NeighbourRule {
@@ -133,6 +141,8 @@ Eigen::Matrix3d restRootFrame(const SurfaceFrame& frame, const char* what, size_
 struct FollowerNeighbours {
     uint32_t guide1 = 0, guide2 = 0;
     float distance1 = 0.f, distance2 = 0.f;  ///< rest root distances, m
+    uint32_t guide3 = 0;                     ///< Barycentric mode: the third corner
+    float weight[3] = {1.f, 0.f, 0.f};       ///< Barycentric mode: weights of guides 1, 2, 3
 };
 
 /// One step's inputs. `guides` may be the same object as update()'s `out`

@@ -11,7 +11,7 @@
 // steps the solver (or reads its frames) — only GuideSource::next changes.
 //
 // Usage: bench_followers [--quick] [--sizes 751,10000,...] [--steps N]
-//        [--modes varied,cluster,interpolate] [--threads 1,2] [--no-collide]
+//        [--modes varied,cluster,interpolate,barycentric] [--threads 1,2] [--no-collide]
 //        [--angle] [--length-variation X] [--clump X] [--clumps N]
 //        [--wave M] [--wave-length M] [--curl X] [--frizz M]
 // --angle adds a column: the median angle between mid-strand tangents of
@@ -83,7 +83,8 @@ struct Result {
 };
 
 const char* modeName(FollowerMode m) {
-    return m == FollowerMode::Varied ? "varied" : m == FollowerMode::Cluster ? "cluster" : "interpolate";
+    return m == FollowerMode::Varied ? "varied" : m == FollowerMode::Cluster ? "cluster"
+           : m == FollowerMode::Barycentric ? "barycentric" : "interpolate";
 }
 
 Result measure(const GuideSource& src, FollowerMode mode, int threads, int steps, bool collide) {
@@ -171,6 +172,7 @@ int main(int argc, char** argv) {
                 if (s == "varied") return FollowerMode::Varied;
                 if (s == "cluster") return FollowerMode::Cluster;
                 if (s == "interpolate") return FollowerMode::Interpolate;
+                if (s == "barycentric") return FollowerMode::Barycentric;
                 std::fprintf(stderr, "unknown mode %s\n", s.c_str());
                 std::exit(1);
             });
