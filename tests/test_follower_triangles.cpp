@@ -6,9 +6,11 @@
 #include "sim/synthetic_groom.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 using namespace hp;
@@ -121,4 +123,13 @@ TEST(Followers, BarycentricReproducesAGuideAtItsRootAndIsContinuous) {
     std::printf("arc tip steps: median %.2e m, largest %.2e m (root step 5e-4 m)\n", median, largest);
     EXPECT_LT(largest, 1e-2f);
     EXPECT_LT(largest, 6.f * median);
+
+    // The same bits on one and two threads (the triangulation, the blended
+    // rest shapes and the kernel are per follower).
+    StrandFrame one, two;
+    tbb::task_arena(1).execute([&] { Followers(groom, settings).update({guides, groom.guideRoots, groom.followerRoots}, one); });
+    tbb::task_arena(2).execute([&] { Followers(groom, settings).update({guides, groom.guideRoots, groom.followerRoots}, two); });
+    ASSERT_EQ(one.positions.size(), two.positions.size());
+    EXPECT_EQ(std::memcmp(one.positions.data(), two.positions.data(), one.positions.size() * sizeof(Vec3f)), 0);
+    EXPECT_EQ(std::memcmp(one.positions.data(), out.positions.data(), one.positions.size() * sizeof(Vec3f)), 0);
 }
