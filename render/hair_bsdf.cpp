@@ -111,16 +111,29 @@ Vec3f hairAbsorptionFromMelanin(float eumelanin, float pheomelanin) {
     return eumelanin * eu + pheomelanin * pheo;
 }
 
+namespace {
+/// Chiang 2016 eq. 9's denominator: σa = (ln c / D(β_n))².
+float colorFitScale(float b) {
+    return 5.969f - 0.215f * b + 2.532f * b * b - 10.73f * b * b * b + 5.574f * b * b * b * b +
+           0.245f * b * b * b * b * b;
+}
+}  // namespace
+
 Vec3f hairAbsorptionFromColor(const Vec3f& color, float betaN) {
-    const float b = betaN;
-    const float d = 5.969f - 0.215f * b + 2.532f * b * b - 10.73f * b * b * b + 5.574f * b * b * b * b +
-                    0.245f * b * b * b * b * b;
+    const float d = colorFitScale(betaN);
     Vec3f sigma;
     for (int c = 0; c < 3; ++c) {
         const float l = std::log(std::clamp(color[c], 1e-4f, 1.f)) / d;
         sigma[c] = l * l;
     }
     return sigma;
+}
+
+Vec3f hairColorFromAbsorption(const Vec3f& sigmaA, float betaN) {
+    const float d = colorFitScale(betaN);
+    Vec3f color;
+    for (int c = 0; c < 3; ++c) color[c] = std::exp(-std::sqrt(std::max(sigmaA[c], 0.f)) * d);
+    return color;
 }
 
 HairModel::HairModel(const HairFiberParams& params) : params_(params) {
