@@ -17,8 +17,8 @@ void addRenderKeys(SchemaBuilder& b) {
         .number("render.camera.far", 100, 1e-3, 1e6, "m", "Far clipping distance (preview depth range).");
     b.section("render.lights",
               "Lights, a list of maps. Unset: a three-point rig that follows the camera (render/view.cpp "
-              "threePointRig): a warm key from the upper left in front (intensity 2.2, the shadowed light), a cool "
-              "fill from the right (0.5) and a rim light from behind and above (1.2), the last two unshadowed.")
+              "threePointRig): a warm key from the upper left, from the side (intensity 1.6, the shadowed light), a cool "
+              "fill from the right (0.25) and a rim light from behind and above (1), the last two unshadowed.")
         .list("render.lights", "[]", 16, "Lights of the shot; unset = the three-point rig.")
         .choice("render.lights[].type", "directional", {"directional", "point"}, "Kind of light.")
         .choice("render.lights[].space", "world", {"world", "camera"},
@@ -76,7 +76,7 @@ void addRenderKeys(SchemaBuilder& b) {
                              "(render/view.h skinShade).")
         .vec3("render.head.color", 0.6, 0.42, 0.33, "", "Diffuse albedo (linear RGB).")
         .number("render.head.ambient", 0.05, 0, 1, "", "Ambient term.")
-        .number("render.head.wrap", 0.3, 0, 1, "",
+        .number("render.head.wrap", 0.2, 0, 1, "",
                 "Light wrapping past the terminator, (n·l + w)/(1 + w): skin's soft falloff (0 = Lambert).")
         .number("render.head.specular", 0.04, 0, 1, "", "Weight of the Blinn-Phong sheen.")
         .number("render.head.shininess", 30, 1, 10000, "", "Exponent of the sheen.");

@@ -80,9 +80,9 @@ std::vector<Light> threePointRig() {
         l.cameraRelative = true;
         return l;
     };
-    return {light({0.6f, -0.55f, -0.6f}, {1.f, 0.95f, 0.88f}, 2.2f, true),
-            light({-0.8f, -0.1f, -0.55f}, {0.85f, 0.9f, 1.f}, 0.5f, false),
-            light({-0.25f, -0.6f, 0.8f}, {1.f, 1.f, 1.f}, 1.2f, false)};
+    return {light({0.85f, -0.5f, -0.3f}, {1.f, 0.95f, 0.88f}, 1.6f, true),
+            light({-0.8f, -0.1f, -0.55f}, {0.85f, 0.9f, 1.f}, 0.25f, false),
+            light({-0.25f, -0.6f, 0.8f}, {1.f, 1.f, 1.f}, 1.f, false)};
 }
 
 Vec3f skinShade(const SurfaceMaterial& m, const Vec3f& n, const Vec3f& l, const Vec3f& v) {
