@@ -17,8 +17,7 @@ PreviewSettings makePreviewSettings(const Scene& s) {
 
     PreviewShadowSettings& sh = p.shadow;
     sh.light = int(s.integer("preview.shadow.light"));
-    // Unset render.lights is the three-point rig (3 lights, key first).
-    const size_t lights = s.given("render.lights") ? s.count("render.lights") : threePointRig().size();
+    const size_t lights = s.count("render.lights");
     if (sh.light >= 0 && size_t(sh.light) >= lights)
         s.fail("preview.shadow.light",
                cat("names light ", sh.light, " but render.lights has ", lights, " (use -1 for no shadows)"));

@@ -1,8 +1,34 @@
 // render.*: camera, lights and materials shared by the preview (GL) and the
 // reference (Embree), so both render the same shot (see render/view.h).
 #include "pipeline/scene_keys.h"
+#include "render/view.h"
+
+#include <sstream>
 
 namespace hp {
+
+namespace {
+
+/// render.lights' default: render/view.cpp's threePointRig() as a YAML list,
+/// so the rig is written down once.
+std::string rigYaml() {
+    std::ostringstream out;
+    auto vec = [&](const Vec3f& v) { out << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]"; };
+    out << "[";
+    const std::vector<Light> rig = threePointRig();
+    for (size_t i = 0; i < rig.size(); ++i) {
+        const Light& l = rig[i];
+        out << (i ? ", " : "") << "{type: directional, space: camera, direction: ";
+        vec(l.direction);
+        out << ", color: ";
+        vec(l.color);
+        out << ", intensity: " << l.intensity << (l.castsShadows ? "" : ", shadows: false") << "}";
+    }
+    out << "]";
+    return out.str();
+}
+
+}  // namespace
 
 void addRenderKeys(SchemaBuilder& b) {
     b.section("render", "The shot's look, shared by the preview and the reference renderer.");
@@ -16,10 +42,10 @@ void addRenderKeys(SchemaBuilder& b) {
         .number("render.camera.near", 0.01, 1e-5, 1e3, "m", "Near clipping distance (preview depth range).")
         .number("render.camera.far", 100, 1e-3, 1e6, "m", "Far clipping distance (preview depth range).");
     b.section("render.lights",
-              "Lights, a list of maps. Unset: a three-point rig that follows the camera (render/view.cpp "
+              "Lights, a list of maps. The default is a three-point rig that follows the camera (render/view.cpp "
               "threePointRig): a warm key from the upper left, from the side (intensity 1.6, the shadowed light), a cool "
               "fill from the right (0.25) and a rim light from behind and above (1), the last two unshadowed.")
-        .list("render.lights", "[]", 16, "Lights of the shot; unset = the three-point rig.")
+        .list("render.lights", rigYaml(), 16, "Lights of the shot; the default is the three-point rig.")
         .choice("render.lights[].type", "directional", {"directional", "point"}, "Kind of light.")
         .choice("render.lights[].space", "world", {"world", "camera"},
                 "Frame of direction and position: world, or the camera's (x right, y up, z toward the viewer; "

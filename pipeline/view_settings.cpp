@@ -22,7 +22,6 @@ View makeView(const Scene& s) {
     if (c.farClip <= c.nearClip) s.fail("render.camera.far", "must be greater than render.camera.near");
 
     v.lights.clear();
-    if (!s.given("render.lights")) v.lights = threePointRig();
     for (size_t i = 0; i < s.count("render.lights"); ++i) {
         const std::string k = cat("render.lights[", i, "].");
         Light l;

@@ -13,6 +13,9 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 
 /// Offset off the head's surface for rays leaving it: far above float error
 /// at head scale, far below a hair radius.
+/// Shadow rays from the head see hair only (RayStart::throughHead says why).
+const RayStart kFromHead{kNoStrand, 0, true};
+
 float surfaceOffset(const Vec3f& p) { return 4e-6f * (1.f + p.cwiseAbs().maxCoeff()); }
 
 /// Local frame of a fibre hit: x along the tangent, z the viewer's direction
@@ -121,7 +124,7 @@ SampleResult shadeKajiyaKay(const ShadingContext& ctx, const Vec3f& o, const Vec
             l = light.toLight(q, &radiance, nullptr);
             const Vec3f f = skinShade(view.head, n, l, v);
             if (f.maxCoeff() <= 0.f) continue;  // no shadow ray where the light cannot reach
-            r.diffuse += f.cwiseProduct(incident(ctx, light, q, T, RayStart{}, &l, &r.rays));
+            r.diffuse += f.cwiseProduct(incident(ctx, light, q, T, kFromHead, &l, &r.rays));
         }
     }
     r.radiance = r.diffuse + r.specular;
@@ -192,7 +195,7 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
                 if (f.maxCoeff() <= 0.f) continue;
                 const float weight = shadowRoulette(beta.cwiseProduct(f), ctx.settings.shadowRouletteThreshold, u);
                 if (weight <= 0.f) continue;
-                if (light.castsShadows) radiance *= visibility(ctx, nextOrigin, l, distance, 0.f, RayStart{}, &r.rays);
+                if (light.castsShadows) radiance *= visibility(ctx, nextOrigin, l, distance, 0.f, kFromHead, &r.rays);
                 radiance *= weight;
                 r.radiance += beta.cwiseProduct(f).cwiseProduct(radiance);
             }

@@ -1,4 +1,5 @@
-// The opaque head: albedo * ambient + sum of skinShade * radiance * visibility.
+// The opaque head: albedo * ambient + sum of skinShade * radiance * hair's
+// shadow (the head does not shadow itself; shaders/shadow.glsl says why).
 // With DEPTH_ONLY it is the shadow map's (empty) fragment stage.
 #include "common.glsl"
 #include "shadow.glsl"
@@ -26,7 +27,7 @@ void main() {
         // skinShade (render/view.cpp): wrapped diffuse plus a Blinn-Phong sheen.
         vec3 f = uHeadColor.rgb * max(0.0, (c + w) / (1.0 + w));
         if (c > 0.0 && uHeadSkin.y > 0.0) f += vec3(uHeadSkin.y * pow(max(0.0, dot(n, normalize(l + v))), uHeadSkin.z));
-        if (max(f.r, max(f.g, f.b)) > 0.0) color += f * radiance * lightVisibility(i, vWorld);
+        if (max(f.r, max(f.g, f.b)) > 0.0) color += f * radiance * hairOnlyVisibility(i, vWorld);
     }
     oColor = vec4(color, 1.0);
     oDepth = vec4(1.0 / gl_FragCoord.w);

@@ -163,9 +163,21 @@ TEST(Schema, ReferencePageIsUpToDate) {
 
 TEST(SceneLists, DefaultListAndItemDefaults) {
     const Scene s = Scene::parse("", "shot.yaml", ".");
-    ASSERT_EQ(s.count("render.lights"), 1u);
+    // The default list is the three-point rig of render/view.cpp.
+    ASSERT_EQ(s.count("render.lights"), 3u);
     EXPECT_EQ(s.text("render.lights[0].type"), "directional");
-    EXPECT_EQ(s.number("render.lights[0].intensity"), 3.0);
+    EXPECT_EQ(s.text("render.lights[0].space"), "camera");
+    EXPECT_TRUE(s.flag("render.lights[0].shadows"));
+    EXPECT_FALSE(s.flag("render.lights[2].shadows"));
+    const View v = makeView(s);
+    const std::vector<Light> rig = threePointRig();
+    ASSERT_EQ(v.lights.size(), rig.size());
+    for (size_t i = 0; i < rig.size(); ++i) {
+        EXPECT_TRUE(v.lights[i].direction.isApprox(rig[i].direction, 1e-5f)) << i;
+        EXPECT_NEAR(v.lights[i].intensity, rig[i].intensity, 1e-6f) << i;
+        EXPECT_EQ(v.lights[i].castsShadows, rig[i].castsShadows) << i;
+        EXPECT_TRUE(v.lights[i].cameraRelative) << i;
+    }
 }
 
 TEST(SceneLists, ItemsFromFileGetDefaultsAndLocations) {
@@ -194,7 +206,7 @@ TEST(SceneLists, SetOverridesItemsAndWholeLists) {
     EXPECT_EQ(b.count("render.lights"), 2u);
     EXPECT_EQ(b.text("render.lights[1].type"), "point");
     const SceneError e = parseError("", {"render.lights[3].intensity=1"});
-    EXPECT_NE(e.detail().find("has only 1 items"), std::string::npos) << e.what();
+    EXPECT_NE(e.detail().find("has only 3 items"), std::string::npos) << e.what();
 }
 
 TEST(SceneLists, TooManyItems) {
@@ -209,8 +221,13 @@ TEST(ViewSettings, MapsKeysAndChecksAcrossThem) {
     const View v = makeView(s);
     EXPECT_EQ(v.camera.width, 320);
     EXPECT_EQ(v.camera.fovY, 30.f);
-    ASSERT_EQ(v.lights.size(), 1u);
-    EXPECT_TRUE(v.lights[0].direction.isApprox(Vec3f(-1, -1, -1)));
+    ASSERT_EQ(v.lights.size(), 3u);
+    // Camera-relative: the key comes from the camera's upper left.
+    const std::vector<Light> world = v.worldLights();
+    const Vec3f toKey = -world[0].direction.normalized();
+    const Vec3f right = (v.camera.target - v.camera.position).cross(v.camera.up).normalized();
+    EXPECT_LT(toKey.dot(right), 0.f);
+    EXPECT_GT(toKey.dot(v.camera.up), 0.f);
     const Scene bad = Scene::parse("render:\n  camera: {position: [0, 0, 0]}\n", "shot.yaml", ".");
     try {
         makeView(bad);
