@@ -267,3 +267,32 @@ TEST(HairBsdf, ColorInversionOrdersAbsorption) {
     EXPECT_LT(s.y(), s.z());
     EXPECT_NEAR(hairAbsorptionFromColor(Vec3f(1.f, 1.f, 1.f), 0.3f).norm(), 0.f, 1e-6f);
 }
+
+TEST(HairBsdf, MelaninColourFitInvertsChiangsFitAndIsMonotone) {
+    // The Kajiya-Kay colour of render.hair.melanin is Chiang's eq. 9 solved
+    // for the colour: feeding it back through the forward fit must return
+    // the melanin's σa, for any roughness.
+    for (float betaN : {0.2f, 0.3f, 0.6f})
+        for (float eu : {0.05f, 0.3f, 1.3f})
+            for (float pheo : {0.f, 0.5f}) {
+                const Vec3f sigma = hairAbsorptionFromMelanin(eu, pheo);
+                const Vec3f back = hairAbsorptionFromColor(hairColorFromAbsorption(sigma, betaN), betaN);
+                EXPECT_LT((back - sigma).cwiseAbs().maxCoeff(), 1e-3f * sigma.maxCoeff() + 1e-6f)
+                    << "eumelanin " << eu << " pheomelanin " << pheo << " beta_n " << betaN;
+            }
+    // More eumelanin darkens every channel; melanin absorbs blue most, so
+    // the colour is warm; pheomelanin reddens it (red over green rises).
+    Vec3f last = Vec3f::Ones();
+    for (float eu = 0.f; eu <= 8.f; eu += 0.25f) {
+        const Vec3f c = hairColorFromAbsorption(hairAbsorptionFromMelanin(eu, 0.f), 0.3f);
+        for (int k = 0; k < 3; ++k) EXPECT_LE(c[k], last[k]) << eu;
+        if (eu > 0.f) EXPECT_GT(c.x(), c.z()) << eu;
+        last = c;
+    }
+    const Vec3f plain = hairColorFromAbsorption(hairAbsorptionFromMelanin(0.3f, 0.f), 0.3f);
+    const Vec3f red = hairColorFromAbsorption(hairAbsorptionFromMelanin(0.3f, 0.8f), 0.3f);
+    EXPECT_GT(red.x() / red.y(), plain.x() / plain.y());
+    // The values render/hair_bsdf.h and the README document (β_n = 0.3).
+    EXPECT_LT((plain - Vec3f(0.124f, 0.068f, 0.023f)).cwiseAbs().maxCoeff(), 1e-3f) << plain.transpose();
+    EXPECT_LT((red - Vec3f(0.046f, 0.014f, 0.001f)).cwiseAbs().maxCoeff(), 1e-3f) << red.transpose();
+}

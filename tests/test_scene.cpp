@@ -160,6 +160,7 @@ TEST(Schema, ReferencePageIsUpToDate) {
 }
 
 #include "pipeline/view_settings.h"
+#include "render/hair_bsdf.h"
 
 TEST(SceneLists, DefaultListAndItemDefaults) {
     const Scene s = Scene::parse("", "shot.yaml", ".");
@@ -214,6 +215,31 @@ TEST(SceneLists, TooManyItems) {
     for (int i = 0; i < 17; ++i) yaml += "    - {type: point}\n";
     const SceneError e = parseError(yaml);
     EXPECT_NE(e.detail().find("at most 16"), std::string::npos) << e.what();
+}
+
+TEST(ViewSettings, DisplayAndMelaninKeys) {
+    const Scene s = Scene::parse(
+        "render:\n  exposure: 1.5\n  background: {type: gradient, color: [0.2, 0.2, 0.2]}\n"
+        "  hair: {melanin: 0.3}\n",
+        "shot.yaml", ".");
+    const DisplaySettings d = makeDisplaySettings(s);
+    EXPECT_EQ(d.exposure, 1.5f);
+    EXPECT_EQ(d.backdrop.kind, Backdrop::Kind::Gradient);
+    EXPECT_TRUE(d.backdrop.top.isApprox(Vec3f(0.2f, 0.2f, 0.2f)));
+    // One key drives both renderers: the physical σa and the Kajiya-Kay colour.
+    const View v = makeView(s);
+    EXPECT_TRUE(hairAbsorption(s).isApprox(hairAbsorptionFromMelanin(0.3f, 0.f)));
+    EXPECT_TRUE(v.hair.color.isApprox(hairColorFromAbsorption(hairAbsorptionFromMelanin(0.3f, 0.f), 0.3f)));
+    // A view the built-in transform does not know names the key and its line.
+    const Scene bad = Scene::parse("render:\n  ocio:\n    view: nope\n", "shot.yaml", ".");
+    try {
+        makeDisplaySettings(bad);
+        FAIL() << "an unknown view must be a scene error";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(e.key(), "render.ocio.view");
+        EXPECT_EQ(e.where().line, 3);
+        EXPECT_NE(std::string(e.what()).find("nope"), std::string::npos) << e.what();
+    }
 }
 
 TEST(ViewSettings, MapsKeysAndChecksAcrossThem) {
