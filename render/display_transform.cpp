@@ -21,7 +21,7 @@ namespace {
 // Narkowicz 2015, "ACES Filmic Tone Mapping Curve": f(x) = x(a x + b) / (x(c x + d) + e).
 constexpr float kA = 2.51f, kB = 0.03f, kC = 2.43f, kD = 0.59f, kE = 0.14f;
 
-/// One channel (index `c`) of `image` as a float buffer; 1 where it is missing.
+/// The channel `name` of `image` as a one-channel float buffer; `missing` where the image lacks it.
 OIIO::ImageBuf channelBuffer(const Image& image, const char* name, float missing) {
     OIIO::ImageBuf buf(OIIO::ImageSpec(image.width, image.height, 1, OIIO::TypeDesc::FLOAT));
     const int c = image.channelIndex(name);
