@@ -64,10 +64,20 @@ std::string thumbnail(const std::string& path, bool linearize, bool srgbEncode, 
     }
 }
 
+/// A render (linear EXR, or an 8-bit file linearised) through the job's
+/// display transform, as the stages' PNGs show it.
+std::string renderThumbnail(const std::string& path, const DisplaySettings& display, int width) {
+    try {
+        return pngDataUri(toDisplay(resizeToWidth(readImage(path, true), width), display), false);
+    } catch (const Error&) {
+        return {};
+    }
+}
+
 FrameImages loadImages(const CompareJob& job, const FrameRecord& r) {
     FrameImages f;
-    f.a = thumbnail(r.a, true, true, job.reportWidth);
-    f.b = thumbnail(r.b, true, true, job.reportWidth);
+    f.a = renderThumbnail(r.a, job.display, job.reportWidth);
+    f.b = renderThumbnail(r.b, job.display, job.reportWidth);
     if (r.compared) {
         // The heat map PNG holds display values already: read and write it as stored.
         f.flip = thumbnail(flipImagePath(job, r.frame).string(), false, false, job.reportWidth);
