@@ -69,7 +69,8 @@ std::string thumbnail(const std::string& path, bool linearize, bool srgbEncode, 
 std::string renderThumbnail(const std::string& path, const DisplaySettings& display, int width) {
     try {
         return pngDataUri(toDisplay(resizeToWidth(readImage(path, true), width), display), false);
-    } catch (const Error&) {
+    } catch (const Error& e) {
+        logWarning("compare report: no thumbnail of ", path, ": ", e.what());
         return {};
     }
 }
