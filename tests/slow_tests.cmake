@@ -16,6 +16,8 @@ set(_hp_slow_tests
   test_shot_simulation:ShotSimulation.CheckpointRestoreContinuesBitForBit
   test_sim_guards:SimGuards.LongViolentRunStaysBoundedAndFinite  # 10^4+ steps
   test_resources:Resources.ResidentMemoryDoesNotGrowOverThirtyFrames  # 30 frames
+  test_scene_cut:SceneCut.NoVertexInsideAnyColliderOnTheCutFrameAndAfter  # 60 solver steps, two formulations
+  test_scene_cut:SceneCut.InfoListsTheCutsOfTheClip             # three head imports
 )
 foreach(_entry IN LISTS _hp_slow_tests)
   string(REPLACE ":" ";" _parts "${_entry}")
