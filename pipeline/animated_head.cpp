@@ -130,9 +130,14 @@ HeadPose AnimatedHead::sample(double time) const {
     }
     if (world_) {
         std::vector<Eigen::Isometry3f> poses;
-        for (const ExtraCollider& c : settings_.colliders)
+        std::vector<std::vector<Vec3f>> skins(settings_.colliders.size());
+        for (size_t i = 0; i < settings_.colliders.size(); ++i) {
+            const ExtraCollider& c = settings_.colliders[i];
             poses.push_back(c.followsHead ? pose.transform * c.place(time) : c.place(time));
-        pose.collider = std::make_shared<CompositeCollider>(std::move(pose.collider), world_->posed(poses));
+            if (c.skin) skins[i] = c.skin->sample(time).mesh.positions;
+        }
+        pose.collider =
+            std::make_shared<CompositeCollider>(std::move(pose.collider), world_->posed(poses, 0.05f, std::move(skins)));
     }
     return pose;
 }

@@ -22,6 +22,8 @@ enum class ColliderMethod {
     None,      ///< no collider
 };
 
+class AnimatedHead;
+
 /// One collider beside the head (scene key head.colliders[]): a Bullet
 /// shape placed at each time by `place` (local -> world, or local -> the
 /// head's rest frame when it follows the head's rigid motion).
@@ -29,6 +31,9 @@ struct ExtraCollider {
     ColliderShape shape;
     bool followsHead = false;
     std::function<Eigen::Isometry3f(double)> place;
+    /// Skinned mesh: its own file's animation, sampled at the shot time
+    /// for the vertices of each pose (shape.kind SkinnedMesh).
+    std::shared_ptr<const AnimatedHead> skin;
 };
 
 struct HeadAnimationSettings {

@@ -52,7 +52,7 @@ HeadImportSettings headImportSettings(const Scene& scene) {
     return s;
 }
 
-std::vector<ExtraCollider> extraColliders(const Scene& scene) {
+std::vector<ExtraCollider> extraColliders(const Scene& scene, const HeadAnimationSettings& head) {
     std::vector<ExtraCollider> out;
     const double fps = scene.number("fps");
     for (size_t i = 0; i < scene.count("head.colliders"); ++i) {
@@ -62,18 +62,35 @@ std::vector<ExtraCollider> extraColliders(const Scene& scene) {
         c.shape.kind = type == "sphere"    ? ColliderShape::Kind::Sphere
                        : type == "capsule" ? ColliderShape::Kind::Capsule
                        : type == "mesh"    ? ColliderShape::Kind::ConvexMesh
+                       : type == "skinned" ? ColliderShape::Kind::SkinnedMesh
                                            : ColliderShape::Kind::Box;
         c.shape.radius = float(scene.number(k + "radius"));
         c.shape.length = float(scene.number(k + "length"));
         c.shape.halfExtents = 0.5f * scene.vec3f(k + "size");
         if (c.shape.kind == ColliderShape::Kind::Box && !(c.shape.halfExtents.minCoeff() > 0.f))
             scene.fail(k + "size", "a box needs positive extents");
-        if (c.shape.kind == ColliderShape::Kind::ConvexMesh) {
+        if (c.shape.kind == ColliderShape::Kind::ConvexMesh || c.shape.kind == ColliderShape::Kind::SkinnedMesh) {
             HeadImportSettings mesh;
             mesh.file = scene.file(k + "file");
-            if (mesh.file.empty()) scene.fail(k + "file", "a mesh collider needs its file");
+            if (mesh.file.empty()) scene.fail(k + "file", cat("a ", type, " collider needs its file"));
             mesh.unitScale = scene.number(k + "unit_scale");
-            c.shape.points = importHead(mesh).restMesh().positions;
+            auto rig = std::make_shared<const HeadRig>(importHead(mesh));
+            c.shape.points = rig->restMesh().positions;
+            if (c.shape.kind == ColliderShape::Kind::SkinnedMesh) {
+                // The file's clip on the head's timing (clip_offset, clip_speed, loop).
+                HeadAnimationSettings body = head;
+                body.motion = nullptr;
+                body.collider = ColliderMethod::None;
+                body.colliders.clear();
+                try {
+                    body.clip = findClip(*rig, scene.text(k + "clip"));
+                } catch (const RigSelectionError& e) {
+                    scene.fail(k + "clip", e.what());
+                }
+                auto skin = std::make_shared<const AnimatedHead>(rig, body);
+                c.shape.triangles = skin->rest().triangles;
+                c.skin = std::move(skin);
+            }
             if (c.shape.points.size() < 4)
                 scene.fail(k + "file", cat(mesh.file.string(), " has ", c.shape.points.size(),
                                            " vertices; a collider needs at least 4"));
@@ -141,7 +158,7 @@ HeadAnimationSettings headAnimationSettings(const Scene& scene, const HeadRig& r
         scene.fail("head.collider.exterior_band", "must be at least head.collider.voxel_size");
     if (s.levelSet.interiorBand < s.levelSet.voxelSize)
         scene.fail("head.collider.interior_band", "must be at least head.collider.voxel_size");
-    s.colliders = extraColliders(scene);
+    s.colliders = extraColliders(scene, s);
     return s;
 }
 

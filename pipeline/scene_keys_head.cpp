@@ -41,14 +41,18 @@ void addHeadKeys(SchemaBuilder& b) {
               "collision world that every hair vertex queries (sim/collision_world.h); the head keeps its own "
               "collider (head.collider) as the fast path.")
         .list("head.colliders", "[]", 64, "The colliders, a list of maps.")
-        .choice("head.colliders[].type", "box", {"sphere", "capsule", "box", "mesh"},
+        .choice("head.colliders[].type", "box", {"sphere", "capsule", "box", "mesh", "skinned"},
                 "sphere, capsule, box: Bullet's primitives; mesh: the convex hull of a mesh file's vertices "
-                "(a rigid prop; split a concave prop into convex parts, one entry each).")
+                "(a rigid prop; split a concave prop into convex parts, one entry each); skinned: a mesh file "
+                "played by its own clip (a body), a triangle mesh rebuilt on each pose's vertices.")
         .number("head.colliders[].radius", 0.05, 1e-5, 100, "m", "sphere, capsule: radius.")
         .number("head.colliders[].length", 0.1, 0, 100, "m", "capsule: distance between the cap centres (along local Y).")
         .vec3("head.colliders[].size", 0.1, 0.1, 0.1, "m", "box: full extents along local X, Y, Z.")
-        .file("head.colliders[].file", "", "mesh: the mesh file (any format assimp reads; every mesh in it).")
-        .number("head.colliders[].unit_scale", 1, 1e-9, 1e9, "", "mesh: metres per file unit.")
+        .file("head.colliders[].file", "", "mesh, skinned: the mesh file (any format assimp reads; every mesh in it).")
+        .text("head.colliders[].clip", "",
+              "skinned: the file's clip by name or index, on the head's timing (head.clip_offset, clip_speed, loop); "
+              "empty: the first; 'none': the rest pose.")
+        .number("head.colliders[].unit_scale", 1, 1e-9, 1e9, "", "mesh, skinned: metres per file unit.")
         .choice("head.colliders[].parent", "world", {"world", "head"},
                 "world: placed in the world; head: carried by the head's rigid motion (placement in the rest "
                 "pose's world frame).")

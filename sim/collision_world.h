@@ -2,11 +2,18 @@
 //
 // Each is a Bullet collision object in one btCollisionWorld (the Bullet side
 // stays in sim/collision_world.cpp): Bullet's primitives for analytic shapes
-// (btSphereShape, btCapsuleShape, btBoxShape) and a btConvexHullShape for a
-// rigid mesh prop. A hair vertex asks the world for its signed distance:
-// the broadphase (btDbvtBroadphase::aabbTest) finds the objects near it and
-// Bullet's GJK/EPA (btGjkEpaSolver2::SignedDistance) gives the distance,
-// negative inside, with the normal to push along. The result is a Collider
+// (btSphereShape, btCapsuleShape, btBoxShape), a btConvexHullShape for a
+// rigid mesh prop, and a btBvhTriangleMeshShape for a skinned mesh (a body),
+// built on each pose's deformed vertices. A hair vertex asks the world for
+// its signed distance: the broadphase (btDbvtBroadphase::aabbTest) finds the
+// objects near it; Bullet's GJK/EPA (btGjkEpaSolver2::SignedDistance) gives
+// the distance to a convex shape, negative inside, with the normal to push
+// along; for a triangle mesh the mesh's BVH lists the triangles near the
+// vertex and Bullet's Voronoi-region closest point
+// (btVoronoiSimplexSolver::closestPtPointTriangle) picks the nearest, whose face (by its winding) says
+// inside or outside. A vertex farther than the query range from every
+// triangle is taken as clear: a mesh collider sees only hair near its skin,
+// which is where projection keeps hair. The result is a Collider
 // (sim/head.h), and CompositeCollider joins it to the head's own collider
 // (the distance-grid fast path), so every solver (rope, rigid, rod,
 // followers) collides with all of them unchanged; a head without extra
@@ -24,12 +31,13 @@ namespace hp {
 
 /// @brief One collider's shape, in its own local frame.
 struct ColliderShape {
-    enum class Kind { Sphere, Capsule, Box, ConvexMesh };
+    enum class Kind { Sphere, Capsule, Box, ConvexMesh, SkinnedMesh };
     Kind kind = Kind::Sphere;
     float radius = 0.05f;                  ///< sphere, capsule: m
     float length = 0.1f;                   ///< capsule: distance between the cap centres, along local Y, m
     Vec3f halfExtents = Vec3f::Constant(0.05f);  ///< box: m
     std::vector<Vec3f> points;             ///< convex mesh: the mesh's vertices (their convex hull collides)
+    std::vector<Tri> triangles;            ///< skinned mesh: the triangles (outward by winding) over each pose's vertices
 };
 
 /// @brief The colliders of a shot: shapes built once, posed per time.
@@ -46,7 +54,10 @@ class CollisionWorld {
     /// as a Collider: the smallest signed distance to any of them. Points
     /// farther than `range` from every collider get `range` (a lower bound
     /// of the true distance, enough to tell a hair vertex it is clear).
-    std::shared_ptr<const Collider> posed(const std::vector<Eigen::Isometry3f>& poses, float range = 0.05f) const;
+    /// `skins[i]` holds the deformed vertices of skinned collider i (local
+    /// coordinates, one per vertex of its triangles); other entries empty.
+    std::shared_ptr<const Collider> posed(const std::vector<Eigen::Isometry3f>& poses, float range = 0.05f,
+                                          std::vector<std::vector<Vec3f>> skins = {}) const;
     size_t size() const;
 
     struct Impl;

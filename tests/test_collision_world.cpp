@@ -1,11 +1,13 @@
 // Colliders beside the head (sim/collision_world.h): Bullet primitives and a
 // mesh prop in one collision world, joined to the head's collider; hair
 // lies on them. Distances are checked against the geometry computed here.
+#include "pipeline/head_import.h"
 #include "pipeline/head_setup.h"
 #include "pipeline/scene.h"
 #include "sim/collision_world.h"
 #include "sim/fibonacci.h"
 #include "sim/guides.h"
+#include "sim/mesh_collider.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -155,4 +157,51 @@ TEST(CollisionWorld, PropColliderFromASecondFile) {
     EXPECT_NEAR(later.collider->signedDistance({0.5f, 0.2f, 0.f}), -0.05f, 1e-4f);
     EXPECT_NEAR(later.collider->signedDistance({0.5f, 0.28f, 0.f}), 0.03f, 1e-4f);
     EXPECT_LT(later.collider->signedDistance({0.f, 0.f, 0.f}), 0.f) << "the head's own collider is still there";
+}
+
+// A skinned body from a file, played by its own clip: at a nodding pose the
+// collider's surface is the deformed mesh (posed here independently through
+// the same file), not the rest mesh.
+TEST(CollisionWorld, SkinnedBodyColliderFollowsItsSkin) {
+    TempDir dir;
+    const std::string glb = sourcePath("scenes/assets/head.glb").string();
+    writeFile(dir / "s.yaml", "fps: 25\nhead:\n  file: " + glb +
+                                  "\n  clip: none\n  collider: {method: none}\n  colliders:\n"
+                                  "    - {type: skinned, file: " + glb + ", clip: nod_shake_turn}\n");
+    const Scene scene = Scene::load(dir / "s.yaml");
+    const HeadSetup head = loadHead(scene);
+    HeadImportSettings import;
+    import.file = glb;
+    auto rig = std::make_shared<const HeadRig>(importHead(import));
+    HeadAnimationSettings play;
+    play.clip = 0;
+    play.collider = ColliderMethod::None;
+    const AnimatedHead body(rig, play);
+    const double t = 0.375;  // the first nod at its deepest: 20° down
+    TriangleMesh skin = body.sample(t).mesh;
+    skin.computeNormals();
+    TriangleMesh rest = body.rest();
+    rest.computeNormals();
+    const auto collider = head.motion->sample(t).collider;
+    // Reference: the exact closest-triangle distance of the deformed mesh
+    // (Embree BVH, angle-weighted pseudonormals; sim/mesh_collider.h).
+    const MeshCollider exact(skin);
+    float worst = 0.f;
+    size_t moved = 0, checked = 0;
+    for (size_t v = 0; v < skin.positions.size(); v += 23) {
+        const Vec3f& p = skin.positions[v];
+        const Vec3f& n = skin.normals[v];
+        for (float offset : {0.003f, 0.001f, -0.001f, -0.002f}) {
+            const Vec3f q = p + offset * n;
+            worst = std::max(worst, std::abs(collider->signedDistance(q) - exact.signedDistance(q)));
+        }
+        // The same offset from the rest pose is off the skin where the nod moved it.
+        const Vec3f r = rest.positions[v] + 0.003f * rest.normals[v];
+        if (std::abs(collider->signedDistance(r) - exact.signedDistance(r)) < 1e-4f &&
+            std::abs(exact.signedDistance(r) - 0.003f) > 0.002f)
+            ++moved;
+        ++checked;
+    }
+    EXPECT_LE(worst, 1e-4f) << "within 3 mm of the deformed skin, inside and out, Bullet's distance is the exact one";
+    EXPECT_GT(moved, checked / 4) << "the collider is the deformed mesh, not the rest mesh";
 }
