@@ -18,6 +18,7 @@ set(_hp_slow_tests
   test_resources:Resources.ResidentMemoryDoesNotGrowOverThirtyFrames  # 30 frames
   test_scene_cut:SceneCut.NoVertexInsideAnyColliderOnTheCutFrameAndAfter  # 60 solver steps, two formulations
   test_scene_cut:SceneCut.InfoListsTheCutsOfTheClip             # three head imports
+  test_scene_cut:SceneCut.StressClipCutFrameHasNoVertexInsideAnyCollider  # exact collider per step
   test_collision_world:CollisionWorld.HairOnAShoulderBoxStaysOnIt  # 300 solver steps
   test_collision_world:CollisionWorld.PropColliderFromASecondFile  # head import + grid
   test_stress_clip:StressClip.DISABLED_NoStretchNoPenetrationAfterAnyFrameOnOneAndTwoThreads  # two 62-frame shots

@@ -3,6 +3,8 @@
 // on the new pose, placed outside every collider before the frame is
 // written; `hairpipe info` lists the cuts of a clip.
 #include "batch_support.h"
+#include "pipeline/scene.h"
+#include "pipeline/shot_simulation.h"
 #include "sim/fibonacci.h"
 #include "sim/guides.h"
 #include "sim/scene_cut.h"
@@ -126,4 +128,27 @@ TEST(SceneCut, InfoListsTheCutsOfTheClip) {
     const ProcessResult looser =
         runHairpipe("info " + q(scene) + " --set 'head.animate.yaw=[[1, 0], [6, 0], [6.2, 120]]' --set simulation.cut_angle=150 --set simulation.cut_distance=0.2");
     EXPECT_NE(looser.output.find("cuts:    0 "), std::string::npos) << looser.output;
+}
+
+// The stress clip's cut at 2 s (frame 50 at 25 fps), hair everywhere, the
+// shoulders as a Bullet capsule: the shot restarts at rest on the new pose
+// with no guide vertex inside the head or the shoulders on the cut frame,
+// and no strand (followers included) more than 1 mm inside.
+TEST(SceneCut, StressClipCutFrameHasNoVertexInsideAnyCollider) {
+    const Scene scene = Scene::load(sourcePath("scenes/stress.yaml"),
+                                    {"frames=48-52", "hair.guides.count=60", "hair.followers.count=600"});
+    ShotSimulation sim(scene, scene.number("fps"), 48);
+    for (int frame = 49; frame <= 52; ++frame) {
+        const StrandFrame& f = sim.advanceTo(frame);
+        const GuideStats& g = sim.stats().guides;
+        EXPECT_EQ(g.reset, frame == 50) << "frame " << frame;
+        if (frame == 50) {
+            EXPECT_EQ(g.penetrationCount, 0u) << "guide vertices inside a collider on the cut frame";
+        }
+        float depth = 0.f;
+        for (size_t s = 0; s < f.strandCount(); ++s)
+            for (uint32_t i = f.first(s) + 1; i < f.offsets[s + 1]; ++i)
+                depth = std::max(depth, -sim.pose().collider->signedDistance(f.positions[i]));
+        EXPECT_LE(depth, 1e-3f) << "frame " << frame;
+    }
 }
