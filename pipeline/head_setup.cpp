@@ -70,11 +70,21 @@ std::vector<ExtraCollider> extraColliders(const Scene& scene, const HeadAnimatio
         if (c.shape.kind == ColliderShape::Kind::Box && !(c.shape.halfExtents.minCoeff() > 0.f))
             scene.fail(k + "size", "a box needs positive extents");
         if (c.shape.kind == ColliderShape::Kind::ConvexMesh || c.shape.kind == ColliderShape::Kind::SkinnedMesh) {
-            HeadImportSettings mesh;
-            mesh.file = scene.file(k + "file");
-            if (mesh.file.empty()) scene.fail(k + "file", cat("a ", type, " collider needs its file"));
-            mesh.unitScale = scene.number(k + "unit_scale");
-            auto rig = std::make_shared<const HeadRig>(importHead(mesh));
+            // Another file, or (no file) meshes of the head's own file, placed as the head is.
+            HeadImportSettings mesh = headImportSettings(scene);
+            if (!scene.file(k + "file").empty()) {
+                mesh = HeadImportSettings{};
+                mesh.file = scene.file(k + "file");
+                mesh.unitScale = scene.number(k + "unit_scale");
+            }
+            if (mesh.file.empty()) scene.fail(k + "file", cat("a ", type, " collider needs a file (or head.file)"));
+            mesh.meshes = splitList(scene.text(k + "meshes"));
+            std::shared_ptr<const HeadRig> rig;
+            try {
+                rig = std::make_shared<const HeadRig>(importHead(mesh));
+            } catch (const RigSelectionError& e) {
+                scene.fail(k + "meshes", e.what());
+            }
             c.shape.points = rig->restMesh().positions;
             if (c.shape.kind == ColliderShape::Kind::SkinnedMesh) {
                 // The file's clip on the head's timing (clip_offset, clip_speed, loop).
@@ -83,7 +93,8 @@ std::vector<ExtraCollider> extraColliders(const Scene& scene, const HeadAnimatio
                 body.collider = ColliderMethod::None;
                 body.colliders.clear();
                 try {
-                    body.clip = findClip(*rig, scene.text(k + "clip"));
+                    const std::string clip = scene.text(k + "clip");
+                    body.clip = findClip(*rig, clip.empty() ? scene.text("head.clip") : clip);
                 } catch (const RigSelectionError& e) {
                     scene.fail(k + "clip", e.what());
                 }

@@ -48,10 +48,15 @@ void addHeadKeys(SchemaBuilder& b) {
         .number("head.colliders[].radius", 0.05, 1e-5, 100, "m", "sphere, capsule: radius.")
         .number("head.colliders[].length", 0.1, 0, 100, "m", "capsule: distance between the cap centres (along local Y).")
         .vec3("head.colliders[].size", 0.1, 0.1, 0.1, "m", "box: full extents along local X, Y, Z.")
-        .file("head.colliders[].file", "", "mesh, skinned: the mesh file (any format assimp reads; every mesh in it).")
+        .file("head.colliders[].file", "",
+              "mesh, skinned: the mesh file (any format assimp reads). Empty: the head's own file, imported and "
+              "placed as the head (head.unit_scale, up_axis, translate, rotate).")
+        .text("head.colliders[].meshes", "",
+              "mesh, skinned: comma-separated meshes of the file (names or indices as `hairpipe info` lists them); "
+              "empty: every mesh.")
         .text("head.colliders[].clip", "",
               "skinned: the file's clip by name or index, on the head's timing (head.clip_offset, clip_speed, loop); "
-              "empty: the first; 'none': the rest pose.")
+              "empty: the clip head.clip names; 'none': the rest pose.")
         .number("head.colliders[].unit_scale", 1, 1e-9, 1e9, "", "mesh, skinned: metres per file unit.")
         .choice("head.colliders[].parent", "world", {"world", "head"},
                 "world: placed in the world; head: carried by the head's rigid motion (placement in the rest "

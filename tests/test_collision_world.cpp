@@ -159,7 +159,7 @@ TEST(CollisionWorld, PropColliderFromASecondFile) {
     EXPECT_LT(later.collider->signedDistance({0.f, 0.f, 0.f}), 0.f) << "the head's own collider is still there";
 }
 
-// A skinned body from a file, played by its own clip: at a nodding pose the
+// A skinned body (here the head file's own meshes), played by its own clip: at a nodding pose the
 // collider's surface is the deformed mesh (posed here independently through
 // the same file), not the rest mesh.
 TEST(CollisionWorld, SkinnedBodyColliderFollowsItsSkin) {
@@ -167,7 +167,13 @@ TEST(CollisionWorld, SkinnedBodyColliderFollowsItsSkin) {
     const std::string glb = sourcePath("scenes/assets/head.glb").string();
     writeFile(dir / "s.yaml", "fps: 25\nhead:\n  file: " + glb +
                                   "\n  clip: none\n  collider: {method: none}\n  colliders:\n"
-                                  "    - {type: skinned, file: " + glb + ", clip: nod_shake_turn}\n");
+                                  "    - {type: skinned, clip: nod_shake_turn}\n");  // the head's own file
+    try {
+        loadHead(Scene::load(dir / "s.yaml", {"head.colliders[0].meshes=Tail"}));
+        ADD_FAILURE() << "a mesh the file does not have is an error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("head.colliders[0].meshes"), std::string::npos) << e.what();
+    }
     const Scene scene = Scene::load(dir / "s.yaml");
     const HeadSetup head = loadHead(scene);
     HeadImportSettings import;
