@@ -46,7 +46,7 @@ void evaluateRoots(const TriangleMesh& mesh, const std::vector<SurfacePoint>& ro
 }  // namespace
 
 /// The two strand models behind one interface: the rigid chain
-/// (sim/guides.h: rope or rigid formulation) and curly-wet (sim/curly_wet.h).
+/// (sim/guides.h: rod, rope or rigid formulation) and curly-wet (sim/curly_wet.h).
 class GuideModel {
   public:
     virtual ~GuideModel() = default;
@@ -84,7 +84,7 @@ class RigidChainModel final : public GuideModel {
     }
     void write(StrandFrame& frame, double time) const override { solver_.write(frame, time); }
     size_t guideCount() const override { return solver_.guideCount(); }
-    bool canCheckpoint() const override { return solver_.settings().formulation == GuideFormulation::Rope; }
+    bool canCheckpoint() const override { return solver_.settings().formulation != GuideFormulation::Rigid; }
     std::vector<char> saveState() const override { return solver_.saveState(); }
     void restoreState(const std::vector<char>& state) override { solver_.restoreState(state); }
     const char* name() const override { return formulationName(solver_.settings().formulation); }
