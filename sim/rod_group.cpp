@@ -48,12 +48,13 @@ class RodGroup final : public GuideGroup {
             const float m = set.mass[set.vertex(begin, 0) + k];
             invMass_[k] = m > 0.f ? 1.f / m : 0.f;
         }
-        for (size_t g = begin; g < end; ++g) computeCurvature(g, false);
+        for (size_t g = begin; g < end; ++g) computeCurvature(g, 0.f);
     }
 
     void reset() override { set_.resetGuides(begin_, end_); }
-    void preload(const SubstepContext&) override {
-        for (size_t g = begin_; g < end_; ++g) computeCurvature(g, set_.settings.preload);
+    void preload(const SubstepContext& ctx) override {
+        const float h = ctx.h / float(std::max(1, set_.settings.rodSubsteps));
+        for (size_t g = begin_; g < end_; ++g) computeCurvature(g, set_.settings.preload ? h : 0.f);
     }
     void substep(const SubstepContext& ctx) override;
     double kineticEnergy() const override { return set_.kineticEnergy(begin_, end_); }
@@ -75,16 +76,16 @@ class RodGroup final : public GuideGroup {
         return s;
     }
     /// Rest curvatures of guide g from its rest shape at the end-of-step
-    /// root; with `preload`, the rest shape is made a static equilibrium
-    /// under gravity (rod::restCurvature).
-    void computeCurvature(size_t g, bool preload) {
+    /// root; with a pre-load step h > 0, the rest shape is made a static
+    /// equilibrium of steps of h under gravity (rod::preload).
+    void computeCurvature(size_t g, float preloadStep) {
         const Mat3f R = set_.rootRot1[g].toRotationMatrix();
-        std::vector<Vec3f> x(size_t(set_.vertices)), f(size_t(set_.vertices));
+        std::vector<Vec3f> x(size_t(set_.vertices));
         set_.restShape(g, set_.rootPos1[g], R, x.data());
-        for (int i = 0; i < set_.vertices; ++i) f[size_t(i)] = set_.mass[set_.vertex(g, i)] * set_.settings.gravity;
         const rod::RodStrand s = strand(g);
-        rod::restCurvature(s, x.data(), R, preload ? f.data() : nullptr,
-                           &curvature_[(g - begin_) * size_t(set_.segments)]);
+        rod::Vec2f* c = &curvature_[(g - begin_) * size_t(set_.segments)];
+        rod::restCurvature(s, x.data(), R, c);
+        if (preloadStep > 0.f) rod::preload(s, x.data(), R, set_.settings.gravity, preloadStep, c, scratch_);
     }
 
     std::vector<float> invMass_;

@@ -139,27 +139,25 @@ Vec2f bendConstraint(const Vec3f& u, float parentLen, const Vec3f& e, const Vec3
     return C;
 }
 
-void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f* force, Vec2f* c) {
+void preloadOffset(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f* force, Vec2f* c) {
     const int S = s.vertices - 1;
-    Eigen::MatrixXd Jt;
-    if (force) Jt = Eigen::MatrixXd::Zero(3 * S, 3 * S);
+    if (s.bendStiffness <= 0) return;
+    Eigen::MatrixXd Jt = Eigen::MatrixXd::Zero(3 * S, 3 * S);
     forJoints(s, x, R, [&](int j, const Vec3f& u, float ulen, const Vec3f& e, const Vec3f& a, bool ghost) {
         Vec3f g[2][3];
-        c[j] = bendConstraint(u, ulen, e, a, Vec2f::Zero(), ghost, g);  // C_j(x) = 0
-        if (!force) return;
+        bendConstraint(u, ulen, e, a, Vec2f::Zero(), ghost, g);
         const Vec3f d = e.normalized();
         for (int slot = 0; slot < 3; ++slot) {
-            const int v = j - 1 + slot;  // vertex; free vertex v has unknowns 3(v-1)..
+            const int v = j - 1 + slot;  // free vertex v has unknowns 3(v-1)..3(v-1)+2
             if (v < 1) continue;
+            const Vec3f gs = slot == 2 ? d : slot == 1 ? Vec3f(-d) : Vec3f::Zero();
             for (int k = 0; k < 3; ++k) {
                 Jt(3 * (v - 1) + k, 3 * j) = g[0][slot][k];
                 Jt(3 * (v - 1) + k, 3 * j + 1) = g[1][slot][k];
+                Jt(3 * (v - 1) + k, 3 * j + 2) = gs[k];
             }
-            const Vec3f gs = slot == 2 ? d : slot == 1 ? Vec3f(-d) : Vec3f::Zero();
-            for (int k = 0; k < 3; ++k) Jt(3 * (v - 1) + k, 3 * j + 2) = gs[k];
         }
     });
-    if (!force || s.bendStiffness <= 0) return;
     Eigen::VectorXd f(3 * S);
     for (int v = 1; v <= S; ++v)
         for (int k = 0; k < 3; ++k) f[3 * (v - 1) + k] = -double(force[v][k]);
@@ -169,6 +167,34 @@ void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec
     for (int j = 0; j < S; ++j) {
         const double alpha = voronoi(s, j) / s.bendStiffness;
         c[j] += Vec2f(float(alpha * lambda[3 * j]), float(alpha * lambda[3 * j + 1]));
+    }
+}
+
+void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec2f* c) {
+    forJoints(s, x, R, [&](int j, const Vec3f& u, float ulen, const Vec3f& e, const Vec3f& a, bool ghost) {
+        Vec3f g[2][3];
+        c[j] = bendConstraint(u, ulen, e, a, Vec2f::Zero(), ghost, g);  // C_j(x) = 0
+    });
+}
+
+void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gravity, float h, Vec2f* c,
+             RodScratch& sc) {
+    const int n = s.vertices;
+    std::vector<Vec3f> f(size_t(n), Vec3f::Zero()), xt(size_t(n), Vec3f::Zero()), vt(size_t(n), Vec3f::Zero());
+    for (int i = 1; i < n; ++i) f[size_t(i)] = gravity / s.invMass[i];
+    preloadOffset(s, x, R, f.data(), c);
+    // The analytic pre-load balances the forces at x; rodStep linearises at
+    // its prediction y = x + h²g, about a millimetre away. Each probe step
+    // from rest measures the drift δ that remains and cancels its force
+    // M·δ/h² the same way (measured: the error shrinks ~10× per probe).
+    for (int probe = 0; probe < 3; ++probe) {
+        for (int i = 0; i < n; ++i) {
+            xt[size_t(i)] = x[i];
+            vt[size_t(i)] = Vec3f::Zero();
+        }
+        rodStep(s, xt.data(), vt.data(), x[0], R, gravity, h, 0.f, 0.f, nullptr, 0.f, sc);
+        for (int i = 1; i < n; ++i) f[size_t(i)] = (xt[size_t(i)] - x[i]) / (s.invMass[i] * h * h);
+        preloadOffset(s, x, R, f.data(), c);
     }
 }
 

@@ -82,12 +82,20 @@ inline Vec3f transportVector(const Vec3f& a, const Vec3f& d, const Vec3f& dNext)
 Vec3f frameStart(const Mat3f& R, const Vec3f& d);
 
 /// Writes the rest curvatures c_j (vertices - 1 entries) of the shape x with
-/// root frame R: C_j(x) = 0, so x is the stress-free shape. With `weight`
-/// (per-vertex forces f_i, may be null), adds the pre-load that makes x an
-/// exact static equilibrium of rodStep's discrete forces:
+/// root frame R: C_j(x) = 0, so x is the stress-free shape.
+void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec2f* c);
+
+/// Adds to c the pre-load that balances per-vertex forces f at x:
 ///   Σ_r ∇C_r Λ_r = -f  (the free vertices: 3(n-1) equations, 2(n-1) bend
-///   and n-1 stretch multipliers),  c_j += (l̄_j/EI)·Λ_bend,j.
-void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f* force, Vec2f* c);
+///   and n-1 stretch multipliers),  c_j += (l̄_j/EI)·Λ_bend,j,
+/// since a bend row's force multiplier is Λ = -C/α = (c - κ)/α.
+void preloadOffset(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f* force, Vec2f* c);
+
+/// Pre-loads c (holding the rest curvatures) so that x is an exact static
+/// equilibrium of rodStep with step h under gravity: preloadOffset for the
+/// weights, then three probe steps from rest, each cancelling the drift left.
+void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gravity, float h, Vec2f* c,
+             RodScratch& scratch);
 
 /// One XPBD step of length h for one strand (x: positions at the step's
 /// start, v: velocities; root at rootPos with frame rootFrame at the end):
