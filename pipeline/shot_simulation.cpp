@@ -156,6 +156,7 @@ std::string SimFrameStats::json() const {
       << ", \"max_length_error\": " << guides.maxLengthError << ", \"mean_length_error\": " << guides.meanLengthError
       << ", \"penetration_count\": " << guides.penetrationCount << ", \"max_penetration\": " << guides.maxPenetration
       << ", \"kinetic_energy\": " << guides.kineticEnergy << ", \"nan_count\": " << guides.nanCount
+      << ", \"pinned\": " << guides.pinnedCount
       << ", \"strand_contacts\": " << guides.strandContacts << ", \"reset\": " << (guides.reset ? "true" : "false")
       << ", \"ms_per_step\": " << guides.msPerStep << ", \"head_ms\": " << headMs
       << ", \"follower_ms\": " << followerMs << ", \"follower_projected\": " << followerProjected

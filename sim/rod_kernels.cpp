@@ -271,8 +271,10 @@ int rodStep(const RodStrand& s, Vec3f* x, Vec3f* v, const Vec3f& rootPos, const 
             const bool outside = !contact.active || head->distance(y[i], nullptr) > -0.1f * radius;
             if (!lengthOk || !outside) {
                 // No place at its length outside the head: held at its length
-                // toward where it was (its last valid place).
-                y[i] = strand::followTheLeader(y[i - 1], old[i], l);
+                // toward its last valid place, where it was at the step's
+                // start, carried along with the head's motion.
+                const Vec3f last = head ? Vec3f(head->toPrevious.inverse() * old[i]) : old[i];
+                y[i] = strand::followTheLeader(y[i - 1], last, l);
                 contact = strand::Contact{};
                 ++pinned;
             }
