@@ -273,8 +273,16 @@ int rodStep(const RodStrand& s, Vec3f* x, Vec3f* v, const Vec3f& rootPos, const 
                 // No place at its length outside the head: held at its length
                 // toward its last valid place, where it was at the step's
                 // start, carried along with the head's motion.
+                // If the head took that place too, straight out from the
+                // surface under the parent (outside whenever the head is
+                // locally convex there).
                 const Vec3f last = head ? Vec3f(head->toPrevious.inverse() * old[i]) : old[i];
                 y[i] = strand::followTheLeader(y[i - 1], last, l);
+                Vec3f normal;
+                if (head && head->distance(y[i], nullptr) < 0.f) {
+                    head->distance(y[i - 1], &normal);
+                    y[i] = y[i - 1] + l * normal.normalized();
+                }
                 contact = strand::Contact{};
                 ++pinned;
             }
