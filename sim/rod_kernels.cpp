@@ -234,17 +234,27 @@ int rodStep(const RodStrand& s, Vec3f* x, Vec3f* v, const Vec3f& rootPos, const 
         g[6 + 2] = d;
         sc.rhs[3 * j + 2] = -(len - s.restLength[j]);
     });
-    // A = J W Jᵀ (+ α̃ already on the diagonal), lower band.
-    for (int r = 0; r < N; ++r) {
-        const int jr = r / 3;
-        for (int q = std::max(0, r - kBand); q <= r; ++q) {
-            const int jq = q / 3;
-            if (jr - jq > 2) continue;
-            double sum = 0;
-            for (int vtx = std::max(1, jr - 1); vtx <= jq + 1; ++vtx)
-                sum += double(s.invMass[vtx]) *
-                       double(sc.grad[size_t(r) * 3 + size_t(vtx - jr + 1)].dot(sc.grad[size_t(q) * 3 + size_t(vtx - jq + 1)]));
-            sc.band[size_t(r) * W + size_t(r - q)] += sum;
+    // A = J W Jᵀ (+ α̃ already on the diagonal), lower band, vertex by
+    // vertex: the rows touching free vertex v are the bend rows of joints
+    // v-1, v, v+1 and the stretch rows of joints v-1, v (at most 8, rows
+    // within 7 of each other); each pair adds w_v·g_a·g_b.
+    for (int vtx = 1; vtx < n; ++vtx) {
+        int rows[8];
+        const Vec3f* grads[8];
+        int count = 0;
+        for (int j = vtx - 1; j <= std::min(vtx + 1, S - 1); ++j) {
+            const int slot = vtx - j + 1;
+            const int kinds = j <= vtx ? 3 : 2;  // joint v+1's stretch row does not touch v
+            for (int k = 0; k < kinds; ++k) {
+                rows[count] = 3 * j + k;
+                grads[count++] = &sc.grad[size_t(3 * j + k) * 3 + size_t(slot)];
+            }
+        }
+        const float w = s.invMass[vtx];
+        for (int a = 0; a < count; ++a) {
+            double* row = &sc.band[size_t(rows[a]) * W];
+            const Vec3f ga = w * *grads[a];
+            for (int b = 0; b <= a; ++b) row[rows[a] - rows[b]] += double(ga.dot(*grads[b]));
         }
     }
     bandedSolve(sc.band.data(), sc.invD.data(), sc.rhs.data(), N);
