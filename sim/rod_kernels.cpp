@@ -277,7 +277,7 @@ int rodStep(const RodStrand& s, Vec3f* x, Vec3f* v, const Vec3f& rootPos, const 
         if (i > 0) {
             const float l = s.restLength[i - 1];
             contact = strand::placeSegment(y[i - 1], y[i], l, head, radius);
-            const bool lengthOk = std::abs((y[i] - y[i - 1]).norm() / l - 1.f) < 1e-3f;
+            const bool lengthOk = std::abs((y[i] - y[i - 1]).norm() / l - 1.f) < 1e-4f;
             const bool outside = !contact.active || head->distance(y[i], nullptr) > -0.1f * radius;
             if (!lengthOk || !outside) {
                 // No place at its length outside the head: held at its length
