@@ -15,10 +15,13 @@
 // and the bending energy alone drives the dynamics. That is the model's
 // twist assumption; anisotropic (elliptic) fibres would need twist.
 //
-// Why this solver (measured; see README "Physics of the guides"): Gauss-
-// Seidel XPBD needs many iterations to carry the weight of a stiff strand to
-// its root (under-converged sweeps make it softer than its EI); the direct
-// solve is exact per linearisation at a cost linear in the segment count.
+// Why this solver (measured on the 2-core machine, loaded; README "Physics
+// of the guides"): the direct banded solve is exact per linearisation, so
+// the static elastica comes out within 0.3% of L at 0.01 s steps; one XPBD
+// step per 0.02 s is unstable (a hanging chain's tip oscillation grows), two
+// are the default; a 23-segment strand costs ~10 µs of CPU per XPBD step,
+// about 3× the rope's step. Gauss-Seidel XPBD (cheaper per sweep, softer than
+// its EI when under-converged) was not measured.
 #include "sim/guide_group.h"
 #include "sim/rod_kernels.h"
 
