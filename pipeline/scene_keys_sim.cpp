@@ -57,7 +57,7 @@ void addSimKeys(SchemaBuilder& b) {
                  "Guides per Bullet world; worlds run in parallel. A fixed partition: results do not depend on "
                  "the thread count.")
         .number("simulation.max_speed", 50, 0, 1e4, "m/s",
-                "Guard (rope formulation): a guide vertex faster than this after a step is slowed to it; the "
+                "Guard (rod and rope formulations): a guide vertex faster than this after a step is slowed to it; the "
                 "frame's statistics count the clamped vertices. 0: no clamp.");
     b.section("simulation.limits", "Joint limits (seed: ±30° bend, ±10° twist, soft, with a projection limit).")
         .number("simulation.limits.bend", 30, 0.1, 179, "deg", "Bend limit about the two bending axes.")

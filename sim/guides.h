@@ -93,7 +93,7 @@ struct GuideSettings {
     // Guard: a vertex faster than this after a step is numerical, not
     // physical (a violent head turn moves tips a few m/s); its velocity is
     // scaled back to it so one bad step cannot pump energy into the next.
-    // Rope formulation only; 0 disables the clamp.
+    // Rod and rope formulations; 0 disables the clamp.
     float maxSpeed = 50.f;          ///< m/s
 
     // Parallelism. Guides are partitioned into Bullet worlds of this many
