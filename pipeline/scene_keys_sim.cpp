@@ -15,24 +15,40 @@ void addSimKeys(SchemaBuilder& b) {
         .number("hair.radius.root", 0.00004, 0, 0.01, "m", "Radius at the root.")
         .number("hair.radius.tip", 0.00001, 0, 0.01, "m", "Radius at the tip.");
 
+    b.section("hair.material",
+              "Rod formulation: the fibre and the wisp a guide stands for (SI units). Mass per length "
+              "N·ρ·πr², bending stiffness N·E·πr⁴/4, twist stiffness N·G·πr⁴/2, r = hair.radius.root.")
+        .number("hair.material.youngs_modulus", 3.8e9, 0, 1e12, "Pa", "Young's modulus E of one hair (human: 3.5–4 GPa).")
+        .number("hair.material.shear_modulus", 1.3e9, 0, 1e12, "Pa",
+                "Shear modulus G of one hair (twist stiffness; an isotropic fibre with a free tip carries no "
+                "twist moment, see README).")
+        .number("hair.material.density", 1300, 1, 1e5, "kg/m³", "Density ρ of hair.")
+        .number("hair.material.hairs_per_guide", 100, 1e-3, 1e7, "",
+                "Hairs N of the wisp a guide stands for: its mass and bending stiffness are N times one hair's.");
     b.section("simulation",
-              "Guide dynamics with Bullet. `rope` (default): Bullet soft-body ropes with joint springs, limits, "
-              "exact lengths and head projection after each Bullet step; `rigid`: the seed's capsule rigid bodies "
-              "and 6-DoF spring joints, kept for comparison.")
-        .choice("simulation.formulation", "rope", {"rope", "rigid"}, "Which Bullet arrangement simulates the guides.")
+              "Guide dynamics. `rod` (default): inextensible elastic rods from hair.material, XPBD with a direct "
+              "banded solve per strand; `rope`: Bullet soft-body ropes with joint springs, limits, exact lengths "
+              "and head projection after each Bullet step; `rigid`: the seed's capsule rigid bodies and 6-DoF "
+              "spring joints, kept for comparison.")
+        .choice("simulation.formulation", "rod", {"rod", "rope", "rigid"}, "Which model simulates the guides.")
         .number("simulation.time_step", 0.02, 1e-4, 1, "s", "Fixed simulation step (seed: 0.02 s).")
         .integer("simulation.substeps", 1, 1, 64, "", "Bullet steps per simulation step.")
         .integer("simulation.iterations", 20, 1, 1000, "", "Bullet solver iterations per Bullet step (seed: 20).")
+        .integer("simulation.rod_substeps", 2, 1, 64, "", "Rod: XPBD steps per simulation substep.")
         .number("simulation.friction", 0.2, 0, 10, "", "Coulomb friction against the head and between strands.")
         .number("simulation.damping", 1, 0, 1000, "1/s",
-                "Velocity decay rate: v·exp(-damping·t), the same whatever the time step.")
+                "Velocity decay rate: v·exp(-damping·t), the same whatever the time step (rod: air drag, a force "
+                "-damping·μ·v per length).")
         .vec3("simulation.gravity", 0, -9.81, 0, "m/s²", "Gravity.")
-        .number("simulation.mass_per_length", 0.005, 1e-9, 100, "kg/m", "Mass of a guide per metre.")
+        .number("simulation.mass_per_length", 0.005, 1e-9, 100, "kg/m", "Rope, rigid: mass of a guide per metre.")
         .number("simulation.bend_stiffness", 5e-5, 0, 1e3, "N·m/rad",
-                "Joint spring toward the rest shape (both formulations; rigid: Bullet caps it for stability).")
+                "Rope, rigid: joint spring toward the rest shape (rigid: Bullet caps it for stability).")
         .number("simulation.bend_damping", 0, 0, 1e3, "N·m·s/rad", "Rigid only: damping of the joint springs.")
         .flag("simulation.preload", true,
               "Pre-load the joint springs so the rest shape is an equilibrium under gravity at the first frame.")
+        .number("simulation.settle", 0, 0, 60, "s",
+                "Rod: the guides first fall onto the still head for this long (drag ≥ 10/s); the settled shape "
+                "becomes the groom (pre-loaded with simulation.preload). 0: start from the groom as combed.")
         .flag("simulation.head_collision", true,
               "Project vertices out of the head's signed distance (with friction) after every Bullet step.")
         .flag("simulation.strand_collision", false,
@@ -41,7 +57,7 @@ void addSimKeys(SchemaBuilder& b) {
                  "Guides per Bullet world; worlds run in parallel. A fixed partition: results do not depend on "
                  "the thread count.")
         .number("simulation.max_speed", 50, 0, 1e4, "m/s",
-                "Guard (rope formulation): a guide vertex faster than this after a step is slowed to it; the "
+                "Guard (rod and rope formulations): a guide vertex faster than this after a step is slowed to it; the "
                 "frame's statistics count the clamped vertices. 0: no clamp.")
         // Scene cuts (sim/scene_cut.h); `hairpipe info` lists the cuts of the clip.
         .number("simulation.cut_distance", 0.1, 0, 1e6, "m",

@@ -43,7 +43,7 @@ float frameAlignedStep(double fps, double maxStep) {
 }
 
 /// The two strand models behind one interface: the rigid chain
-/// (sim/guides.h: rope or rigid formulation) and curly-wet (sim/curly_wet.h).
+/// (sim/guides.h: rod, rope or rigid formulation) and curly-wet (sim/curly_wet.h).
 class GuideModel {
   public:
     virtual ~GuideModel() = default;
@@ -81,7 +81,7 @@ class RigidChainModel final : public GuideModel {
     }
     void write(StrandFrame& frame, double time) const override { solver_.write(frame, time); }
     size_t guideCount() const override { return solver_.guideCount(); }
-    bool canCheckpoint() const override { return solver_.settings().formulation == GuideFormulation::Rope; }
+    bool canCheckpoint() const override { return solver_.settings().formulation != GuideFormulation::Rigid; }
     std::vector<char> saveState() const override { return solver_.saveState(); }
     void restoreState(const std::vector<char>& state) override { solver_.restoreState(state); }
     const char* name() const override { return formulationName(solver_.settings().formulation); }
@@ -158,6 +158,7 @@ std::string SimFrameStats::json() const {
       << ", \"max_length_error\": " << guides.maxLengthError << ", \"mean_length_error\": " << guides.meanLengthError
       << ", \"penetration_count\": " << guides.penetrationCount << ", \"max_penetration\": " << guides.maxPenetration
       << ", \"kinetic_energy\": " << guides.kineticEnergy << ", \"nan_count\": " << guides.nanCount
+      << ", \"pinned\": " << guides.pinnedCount
       << ", \"strand_contacts\": " << guides.strandContacts << ", \"reset\": " << (guides.reset ? "true" : "false")
       << ", \"ms_per_step\": " << guides.msPerStep << ", \"head_ms\": " << headMs
       << ", \"follower_ms\": " << followerMs << ", \"follower_projected\": " << followerProjected

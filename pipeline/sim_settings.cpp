@@ -21,6 +21,12 @@ GuideSettings guideSettings(const Scene& scene) {
     s.massPerLength = float(scene.number("simulation.mass_per_length"));
     s.bendStiffness = float(scene.number("simulation.bend_stiffness"));
     s.bendDamping = float(scene.number("simulation.bend_damping"));
+    s.youngsModulus = float(scene.number("hair.material.youngs_modulus"));
+    s.shearModulus = float(scene.number("hair.material.shear_modulus"));
+    s.density = float(scene.number("hair.material.density"));
+    s.hairsPerGuide = float(scene.number("hair.material.hairs_per_guide"));
+    s.rodSubsteps = int(scene.integer("simulation.rod_substeps"));
+    s.settleTime = float(scene.number("simulation.settle"));
     s.preload = scene.flag("simulation.preload");
     s.headCollision = scene.flag("simulation.head_collision");
     s.strandCollision = scene.flag("simulation.strand_collision");
@@ -42,6 +48,8 @@ GuideSettings guideSettings(const Scene& scene) {
     if (s.tipRadius > s.rootRadius)
         scene.fail("hair.radius.tip", cat("the tip radius ", s.tipRadius, " m is larger than the root radius ",
                                           s.rootRadius, " m"));
+    if (s.formulation == GuideFormulation::Rod && !(s.rootRadius > 0.f))
+        scene.fail("hair.radius.root", "the rod formulation takes its fibre radius from hair.radius.root, which must be > 0");
     s.validate();  // the ranges above already hold; this catches what a future key adds
     return s;
 }

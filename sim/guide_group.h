@@ -81,6 +81,12 @@ struct GuideSet {
     }
     /// Writes guide g's rest shape rooted at (p, R) into out[0..vertices).
     void restShape(size_t g, const Vec3f& p, const Mat3f& R, Vec3f* out) const;
+    /// Puts guides [begin, end) in their rest shape at the end-of-step roots, at rest.
+    void resetGuides(size_t begin, size_t end);
+    /// Kinetic energy of guides [begin, end), J.
+    double kineticEnergy(size_t begin, size_t end) const;
+    /// Largest bend of guides [begin, end) relative to the rest shape (maxBendAngle), radians.
+    float maxBend(size_t begin, size_t end) const;
 };
 
 /// What one Bullet step (a substep of the solver's step) needs.
@@ -110,6 +116,9 @@ class GuideGroup {
     virtual double kineticEnergy() const = 0;
     /// Largest bend (and twist) angle relative to the rest shape, radians.
     virtual void jointAngles(float& bend, float& twist) const = 0;
+    /// Vertices pinned in the last substeps (no place outside the head at
+    /// their length), then cleared. Only the rod formulation pins.
+    virtual size_t takePinned() { return 0; }
 
     size_t begin() const { return begin_; }
     size_t end() const { return end_; }
@@ -129,6 +138,9 @@ class Formulation {
 };
 
 std::unique_ptr<Formulation> makeRopeFormulation(const GuideSet& set);
+std::unique_ptr<Formulation> makeRodFormulation();
+/// The rod formulation's mass per length, kg/m (rod::Material::massPerLength).
+double rodMassPerLength(const GuideSettings& s);
 std::unique_ptr<Formulation> makeRigidFormulation(const GuideSet& set, const HeadPose& head);
 
 /// Strand-strand contacts for the rope formulation: Bullet's broadphase and

@@ -23,12 +23,15 @@ using guides::GuideSet;
 using strand::Mat3f;
 using strand::Quatf;
 
-const char* formulationName(GuideFormulation f) { return f == GuideFormulation::Rigid ? "rigid" : "rope"; }
+const char* formulationName(GuideFormulation f) {
+    return f == GuideFormulation::Rigid ? "rigid" : f == GuideFormulation::Rod ? "rod" : "rope";
+}
 
 GuideFormulation parseFormulation(const std::string& name) {
     if (name == "rope") return GuideFormulation::Rope;
     if (name == "rigid") return GuideFormulation::Rigid;
-    throw Error(cat("unknown guide formulation '", name, "' (choices: rope, rigid)"));
+    if (name == "rod") return GuideFormulation::Rod;
+    throw Error(cat("unknown guide formulation '", name, "' (choices: rod, rope, rigid)"));
 }
 
 void GuideSettings::validate() const {
@@ -44,6 +47,11 @@ void GuideSettings::validate() const {
     check(massPerLength > 0.f, "mass per length must be positive");
     check(bendStiffness >= 0.f && limitStiffness >= 0.f && bendDamping >= 0.f, "stiffness and damping must be ≥ 0");
     check(damping >= 0.f, "damping must be ≥ 0");
+    check(youngsModulus >= 0.f && shearModulus >= 0.f, "Young's and shear moduli must be ≥ 0");
+    check(density > 0.f && hairsPerGuide > 0.f, "density and hairs per guide must be positive");
+    check(formulation != GuideFormulation::Rod || rootRadius > 0.f, "the rod needs a fibre radius (root radius) > 0");
+    check(rodSubsteps >= 1, "rod substeps must be ≥ 1");
+    check(settleTime >= 0.f, "settle time must be ≥ 0");
     check(friction >= 0.f, "friction must be ≥ 0");
     check(bendLimit > 0.f && bendLimit < 180.f, "bend limit must be in (0, 180) degrees");
     check(twistLimit > 0.f && twistLimit < 90.f, "twist limit must be in (0, 90) degrees");
@@ -63,6 +71,7 @@ void GuideStats::accumulate(const GuideStats& s) {
     nanCount += s.nanCount;
     if (firstNonFinite < 0) firstNonFinite = s.firstNonFinite;
     clampedCount += s.clampedCount;
+    pinnedCount = std::max(pinnedCount, s.pinnedCount);
     strandContacts = std::max(strandContacts, s.strandContacts);
     msPerStep = (msPerStep * double(steps) + s.msPerStep * double(s.steps)) / double(steps + s.steps);
     steps += s.steps;
@@ -74,10 +83,10 @@ std::string GuideStats::json(int frame, double time) const {
     std::snprintf(buf, sizeof buf,
                   "{\"frame\": %d, \"time\": %.6f, \"max_length_error\": %.3e, \"mean_length_error\": %.3e, "
                   "\"penetrations\": %zu, \"max_penetration_m\": %.3e, \"kinetic_energy_j\": %.6e, "
-                  "\"nan\": %zu, \"clamped\": %zu, \"strand_contacts\": %zu, \"ms_per_step\": %.3f, "
+                  "\"nan\": %zu, \"clamped\": %zu, \"pinned\": %zu, \"strand_contacts\": %zu, \"ms_per_step\": %.3f, "
                   "\"steps\": %zu, \"reset\": %s}",
                   frame, time, maxLengthError, meanLengthError, penetrationCount, maxPenetration, kineticEnergy,
-                  nanCount, clampedCount, strandContacts, msPerStep, steps, reset ? "true" : "false");
+                  nanCount, clampedCount, pinnedCount, strandContacts, msPerStep, steps, reset ? "true" : "false");
     return buf;
 }
 
@@ -87,6 +96,29 @@ void GuideSet::restShape(size_t g, const Vec3f& p, const Mat3f& R, Vec3f* out) c
     out[0] = p;
     for (int j = 0; j < segments; ++j)
         out[j + 1] = out[j] + R * (restLength[segment(g, j)] * groomDir[segment(g, j)]);
+}
+
+void GuideSet::resetGuides(size_t begin, size_t end) {
+    for (size_t g = begin; g < end; ++g) {
+        restShape(g, rootPos1[g], rootRot1[g].toRotationMatrix(), &x[vertex(g, 0)]);
+        for (int i = 0; i < vertices; ++i) v[vertex(g, i)] = Vec3f::Zero();
+    }
+}
+
+double GuideSet::kineticEnergy(size_t begin, size_t end) const {
+    double e = 0;
+    for (size_t g = begin; g < end; ++g)
+        for (int i = 1; i < vertices; ++i) {
+            const size_t k = vertex(g, i);
+            e += 0.5 * mass[k] * v[k].squaredNorm();
+        }
+    return e;
+}
+
+float GuideSet::maxBend(size_t begin, size_t end) const {
+    float bend = 0.f;
+    for (size_t g = begin; g < end; ++g) bend = std::max(bend, maxBendAngle(*this, g, &x[vertex(g, 0)], rootRot1[g]));
+    return bend;
 }
 
 float maxBendAngle(const GuideSet& set, size_t g, const Vec3f* x, const Quatf& rootRot) {
@@ -150,6 +182,32 @@ struct GuideSolver::Impl {
     }
 
     GuideStats measure(const Collider* collider) const;
+
+    /// Lets the guides fall onto the still head at its start pose for
+    /// settings.settleTime (with drag of at least 10/s so they come to
+    /// rest), then makes the settled shape the rest shape (the groom): rod
+    /// formulation only, whose rest data are the directions and lengths.
+    void settle(const HeadPose& head) {
+        GuideSettings& s = set.settings;
+        const float drag = s.damping;
+        s.damping = std::max(drag, 10.f);
+        guides::SubstepContext ctx;
+        ctx.h = s.timeStep / float(s.substeps);
+        ctx.head.collider = head.collider.get();
+        ctx.headTransform = head.transform;
+        ctx.headCollision = s.headCollision;
+        const int steps = int(std::ceil(s.settleTime / ctx.h));
+        for (int k = 0; k < steps; ++k) forGroups([&](guides::GuideGroup& grp) { grp.substep(ctx); });
+        s.damping = drag;
+        for (size_t g = 0; g < set.count; ++g) {
+            const Mat3f Rt = set.rootRot1[g].toRotationMatrix().transpose();
+            for (int j = 0; j < set.segments; ++j)
+                set.groomDir[set.segment(g, j)] =
+                    (Rt * (set.x[set.vertex(g, j + 1)] - set.x[set.vertex(g, j)])).normalized();
+            set.resetGuides(g, g + 1);  // exactly the settled shape (lengths restored), at rest
+        }
+        ++set.version;
+    }
 };
 
 GuideSolver::GuideSolver(const GuideSettings& settings) : impl_(std::make_unique<Impl>()) {
@@ -208,8 +266,10 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
             }
         }
         // Lumped masses: each vertex carries half of its two segments.
+        const float mu =
+            s.formulation == GuideFormulation::Rod ? float(guides::rodMassPerLength(s)) : s.massPerLength;
         for (int j = 0; j < set.segments; ++j) {
-            const float half = 0.5f * s.massPerLength * set.restLength[set.segment(g, j)];
+            const float half = 0.5f * mu * set.restLength[set.segment(g, j)];
             if (j > 0) set.mass[set.vertex(g, j)] += half;
             set.mass[set.vertex(g, j + 1)] += half;
         }
@@ -240,18 +300,21 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
 
     set.headTransform = head.transform;
     m.formulation = s.formulation == GuideFormulation::Rigid ? guides::makeRigidFormulation(set, head)
-                                                               : guides::makeRopeFormulation(set);
+                    : s.formulation == GuideFormulation::Rod ? guides::makeRodFormulation()
+                                                             : guides::makeRopeFormulation(set);
     const size_t perWorld =
         s.formulation == GuideFormulation::Rigid && s.strandCollision ? set.count : size_t(s.strandsPerWorld);
     m.groups.clear();
     for (size_t b = 0; b < set.count; b += perWorld)
         m.groups.push_back(m.formulation->makeGroup(set, b, std::min(set.count, b + perWorld)));
     m.contacts.reset();
-    if (s.strandCollision && s.formulation == GuideFormulation::Rope)
+    if (s.strandCollision && s.formulation != GuideFormulation::Rigid)
         m.contacts = std::make_unique<guides::StrandContacts>(set);
 
     ++set.version;
-    if (s.preload) {
+    const bool settled = s.settleTime > 0.f && s.formulation == GuideFormulation::Rod;
+    if (settled) m.settle(head);
+    if (s.preload || settled) {  // a rod group also re-derives its rest curvatures here
         guides::SubstepContext ctx;
         ctx.h = s.timeStep / float(s.substeps);
         ctx.headTransform = head.transform;
@@ -334,11 +397,11 @@ const GuideStats& GuideSolver::step(const std::vector<SurfaceFrame>& roots, cons
         }
     }
     // Velocity guard (GuideSettings::maxSpeed). A NaN speed fails the
-    // comparison and is left for measure() to report. Rope only: its groups
+    // comparison and is left for measure() to report. Rod and rope only: their groups
     // reload x / v from the set when the version moves, while the rigid
     // formulation's bodies keep their own state (set.v is a read-back).
     size_t clamped = 0;
-    if (s.maxSpeed > 0.f && !teleport && s.formulation == GuideFormulation::Rope) {
+    if (s.maxSpeed > 0.f && !teleport && s.formulation != GuideFormulation::Rigid) {
         for (Vec3f& v : set.v) {
             const float speed = v.norm();
             if (speed > s.maxSpeed) {
@@ -361,6 +424,7 @@ const GuideStats& GuideSolver::step(const std::vector<SurfaceFrame>& roots, cons
     m.last.reset = teleport;
     m.last.strandContacts = strandContacts;
     m.last.clampedCount = clamped;
+    for (auto& grp : m.groups) m.last.pinnedCount += grp->takePinned();
     m.last.msPerStep =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - clock0).count();
     return m.last;
@@ -456,8 +520,8 @@ void GuideSolver::write(StrandFrame& frame, double time) const {
 std::vector<char> GuideSolver::saveState() const {
     const Impl& m = *impl_;
     const GuideSet& set = m.set;
-    if (set.settings.formulation != GuideFormulation::Rope)
-        throw Error("guide solver: checkpoints need the rope formulation (the rigid one keeps state inside Bullet)");
+    if (set.settings.formulation == GuideFormulation::Rigid)
+        throw Error("guide solver: checkpoints need the rod or rope formulation (the rigid one keeps state inside Bullet)");
     BlobWriter w;
     w.put(m.time);
     w.put(m.prevTime);
@@ -480,8 +544,8 @@ void GuideSolver::restoreState(const std::vector<char>& state) {
     Impl& m = *impl_;
     GuideSet& set = m.set;
     if (!m.initialized) throw Error("guide solver: restoreState() before initialize()");
-    if (set.settings.formulation != GuideFormulation::Rope)
-        throw Error("guide solver: checkpoints need the rope formulation");
+    if (set.settings.formulation == GuideFormulation::Rigid)
+        throw Error("guide solver: checkpoints need the rod or rope formulation");
     BlobReader r(state, "guide solver");
     m.time = r.get<double>();
     m.prevTime = r.get<double>();

@@ -6,7 +6,11 @@
 // real velocities) and the head's collider. Two formulations share this
 // interface (see sim/guide_group.h for how each one maps onto Bullet):
 //
-// - `Rope` (default, production): each guide is a Bullet btSoftBody rope;
+// - `Rod` (default): each guide is an inextensible elastic rod with physical
+//   parameters (E, G, ρ, fibre radius, hairs per guide), advanced by XPBD
+//   with a direct banded solve per strand (sim/rod_kernels.h,
+//   sim/rod_group.cpp); no Bullet world, Bullet only for strand-strand pairs.
+// - `Rope` (the previous production formulation): each guide is a Bullet btSoftBody rope;
 //   Bullet integrates gravity and solves the stretch links, interleaved with
 //   the bend limits; the kernels of sim/strand_constraints.h turn the joints
 //   toward the (gravity pre-loaded) rest shape on Bullet's prediction and,
@@ -31,9 +35,9 @@
 
 namespace hp {
 
-enum class GuideFormulation { Rope, Rigid };
+enum class GuideFormulation { Rope, Rigid, Rod };
 
-/// "rope" / "rigid".
+/// "rope" / "rigid" / "rod".
 const char* formulationName(GuideFormulation f);
 /// Inverse of formulationName; throws hp::Error naming the valid choices.
 GuideFormulation parseFormulation(const std::string& name);
@@ -41,7 +45,7 @@ GuideFormulation parseFormulation(const std::string& name);
 /// Everything the guide solver needs to know. Units: metres, seconds, kg,
 /// degrees for angles. Defaults are seed 000's values where the seed gives one.
 struct GuideSettings {
-    GuideFormulation formulation = GuideFormulation::Rope;
+    GuideFormulation formulation = GuideFormulation::Rod;
 
     // Shape of a guide.
     int segments = 23;              ///< segments per guide (vertices = segments + 1)
@@ -56,13 +60,20 @@ struct GuideSettings {
     int iterations = 20;            ///< Bullet solver iterations per Bullet step
 
     // Material.
-    float massPerLength = 0.005f;   ///< kg/m (a guide stands for a clump of hairs)
-    float bendStiffness = 5e-5f;    ///< joint spring toward the rest pose, N·m/rad
+    float massPerLength = 0.005f;   ///< rope, rigid: kg/m (a guide stands for a clump of hairs)
+    float bendStiffness = 5e-5f;    ///< rope, rigid: joint spring toward the rest pose, N·m/rad
+    // Rod material (SI): μ = N·ρ·πr², EI = N·E·πr⁴/4, GJ = N·G·πr⁴/2, r = rootRadius (sim/rod_kernels.h).
+    float youngsModulus = 3.8e9f;   ///< rod: E, Pa
+    float shearModulus = 1.3e9f;    ///< rod: G, Pa (GJ is reported; see sim/rod_group.cpp for why it enters nothing)
+    float density = 1300.f;         ///< rod: ρ, kg/m³
+    float hairsPerGuide = 100.f;    ///< rod: N, the hairs of the wisp a guide stands for
+    int rodSubsteps = 2;            ///< rod: XPBD steps per solver substep
     float bendDamping = 0.f;        ///< rigid only: joint spring damping, N·m·s/rad
-    float damping = 1.0f;           ///< velocity decay rate, 1/s: v *= exp(-damping·t), any step size
+    float damping = 1.0f;           ///< velocity decay rate, 1/s: v *= exp(-damping·t), any step size (rod: air drag)
     float friction = 0.2f;          ///< Coulomb friction against the head and between strands
     Vec3f gravity = Vec3f(0.f, -9.81f, 0.f);  ///< m/s²
     bool preload = true;            ///< pre-load the springs so the rest shape holds under gravity at t0
+    float settleTime = 0.f;         ///< rod: s of falling onto the still head before t0; the result is the groom
 
     // Joint limits (seed: ±30° about the bending axes, ±10° twist, soft).
     float bendLimit = 30.f;         ///< deg
@@ -82,7 +93,7 @@ struct GuideSettings {
     // Guard: a vertex faster than this after a step is numerical, not
     // physical (a violent head turn moves tips a few m/s); its velocity is
     // scaled back to it so one bad step cannot pump energy into the next.
-    // Rope formulation only; 0 disables the clamp.
+    // Rod and rope formulations; 0 disables the clamp.
     float maxSpeed = 50.f;          ///< m/s
 
     // Parallelism. Guides are partitioned into Bullet worlds of this many
@@ -105,6 +116,7 @@ struct GuideStats {
     long firstNonFinite = -1;       ///< lowest guide index with a non-finite value (-1: none)
     size_t clampedCount = 0;        ///< vertex velocities scaled back to maxSpeed
     size_t strandContacts = 0;      ///< strand-strand contacts resolved in the step
+    size_t pinnedCount = 0;         ///< rod: vertices pinned (no place outside the head at their length)
     double msPerStep = 0;           ///< wall-clock milliseconds of step()
     bool reset = false;             ///< a teleport / scene cut reset the guides this step
 

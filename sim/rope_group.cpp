@@ -279,12 +279,7 @@ RopeGroup::RopeGroup(GuideSet& set, size_t begin, size_t end) : GuideGroup(set, 
 
 RopeGroup::~RopeGroup() { world_.removeSoftBody(body_.get()); }
 
-void RopeGroup::reset() {
-    for (size_t g = begin_; g < end_; ++g) {
-        set_.restShape(g, set_.rootPos1[g], set_.rootRot1[g].toRotationMatrix(), &set_.x[set_.vertex(g, 0)]);
-        for (int i = 0; i < set_.vertices; ++i) set_.v[set_.vertex(g, i)] = Vec3f::Zero();
-    }
-}
+void RopeGroup::reset() { set_.resetGuides(begin_, end_); }
 
 void RopeGroup::load(size_t g, float h, float alpha) {
     const size_t b = g - begin_;
@@ -358,21 +353,11 @@ void RopeGroup::relax(size_t g, const SubstepContext& ctx) {
     }
 }
 
-double RopeGroup::kineticEnergy() const {
-    double e = 0;
-    for (size_t g = begin_; g < end_; ++g)
-        for (int i = 1; i < set_.vertices; ++i) {
-            const size_t k = set_.vertex(g, i);
-            e += 0.5 * set_.mass[k] * set_.v[k].squaredNorm();
-        }
-    return e;
-}
+double RopeGroup::kineticEnergy() const { return set_.kineticEnergy(begin_, end_); }
 
 void RopeGroup::jointAngles(float& bend, float& twist) const {
-    bend = 0.f;
+    bend = set_.maxBend(begin_, end_);
     twist = 0.f;
-    for (size_t g = begin_; g < end_; ++g)
-        bend = std::max(bend, maxBendAngle(set_, g, &set_.x[set_.vertex(g, 0)], set_.rootRot1[g]));
 }
 
 class RopeFormulation final : public Formulation {

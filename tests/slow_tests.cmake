@@ -15,6 +15,7 @@ set(_hp_slow_tests
   test_shot_simulation:ShotSimulation.DefaultClipKeepsLengthsRootsAndClearance
   test_shot_simulation:ShotSimulation.CheckpointRestoreContinuesBitForBit
   test_sim_guards:SimGuards.LongViolentRunStaysBoundedAndFinite  # 10^4+ steps
+  test_rod:Rod.HeavyElasticaTipMatchesShootingWithinTwoPercentOfLength  # 10 runs of 6 s settling
   test_resources:Resources.ResidentMemoryDoesNotGrowOverThirtyFrames  # 30 frames
   test_render_parity:RenderParity.ThreePointRigAndSkinMatch    # 5 reference renders
   test_scene_cut:SceneCut.NoVertexInsideAnyColliderOnTheCutFrameAndAfter  # 60 solver steps, two formulations

@@ -103,7 +103,12 @@ TEST(Guides, StrandUnderGravitySettlesAndHangsDown) {
 }
 
 TEST(Guides, PreloadHoldsTheRestShapeUnderGravity) {
+    // The rope's pre-load holds upright strands. A rod of hair's stiffness
+    // cannot: a 0.25 m column under its own weight has β = wL³/EI ≈ 130, far
+    // beyond Greenhill's buckling load (β ≈ 7.84), so upright rods fall, as
+    // hair does. The rod's pre-load is tested on a stable groom (test_rod).
     GuideSettings s;  // preload on by default
+    s.formulation = GuideFormulation::Rope;
     GuideSolver solver(s);
     const std::vector<Vec3f> dirs = fibonacciCap(16);
     SpinningSphere head(0.1f, 0.f);  // still head: nothing should move
@@ -133,6 +138,7 @@ TEST(Guides, PreloadHoldsTheRestShapeUnderGravity) {
 
 TEST(Guides, RopeBendingStaysWithinLimits) {
     GuideSettings s;
+    s.formulation = GuideFormulation::Rope;  // the rod has no bend limits: its stiffness is physical
     s.preload = false;
     s.bendStiffness = 1e-7f;  // soft: gravity and the spin push joints onto their limits
     s.headCollision = false;  // the head would force its own bends
@@ -188,7 +194,7 @@ TEST(Guides, StableOverTenThousandStepsWithATeleport) {
         const GuideStats& st = solver.step(sphereRoots(dirs, 0.1f, pose), pose);
         ASSERT_EQ(st.nanCount, 0u) << "step " << k;
         ASSERT_LE(st.maxLengthError, 1e-3) << "step " << k;
-        ASSERT_LE(st.maxPenetration, 1e-3) << "step " << k;
+        ASSERT_LE(st.maxPenetration, 1e-3) << "step " << k << " pinned " << st.pinnedCount;
         if (st.reset) {
             ++resets;
             EXPECT_EQ(k, 5000);
@@ -206,10 +212,17 @@ TEST(Guides, StableOverTenThousandStepsWithATeleport) {
         << "the guides followed the head to its new place";
 }
 
-TEST(Guides, NoVertexSinksIntoAFastTurningHead) {
+class GuidesInEveryFormulation : public ::testing::TestWithParam<GuideFormulation> {};
+INSTANTIATE_TEST_SUITE_P(RodAndRope, GuidesInEveryFormulation,
+                         ::testing::Values(GuideFormulation::Rod, GuideFormulation::Rope),
+                         [](const auto& param) { return std::string(formulationName(param.param)); });
+
+TEST_P(GuidesInEveryFormulation, NoVertexSinksIntoAFastTurningHead) {
     GuideSettings s;
+    s.formulation = GetParam();
     s.preload = false;
     s.bendStiffness = 0;  // limp hair lies on the head and is dragged over it
+    s.youngsModulus = 0;  // (rod)
     GuideSolver solver(s);
     const SphereCollider sphere(Vec3f::Zero(), 0.1f);
     size_t touching = 0;
@@ -223,7 +236,9 @@ TEST(Guides, NoVertexSinksIntoAFastTurningHead) {
             for (const Vec3f& p : f.positions) touching += sphere.signedDistance(p) < 2.f * s.collisionRadius;
         }
     });
-    EXPECT_GT(touching, 100u) << "the hair does lie on the head, so the test exercises the contacts";
+    // Measured: rope > 100, rod 75 (at 720°/s a limp rod is flung farther
+    // out: nothing but the head holds it in).
+    EXPECT_GT(touching, 50u) << "the hair does lie on the head, so the test exercises the contacts";
     EXPECT_LE(deepest, 1e-3) << "goal: no vertex deeper than 1 mm";
     EXPECT_EQ(deepest, 0.0) << "measured: none inside the head at all";
 }

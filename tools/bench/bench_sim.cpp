@@ -6,12 +6,13 @@
 // radius 1 mm; gravity -9.81; one step = 0.02 s. 20 warm-up steps, then 250
 // timed steps. Reports steps/s (median of --runs runs, with min-max), the
 // largest segment stretch |len/rest - 1| and the deepest vertex penetration
-// over the timed steps, NaN count, threads — for both formulations, with and
-// without strand-strand collision, on 1 and 2 threads.
+// over the timed steps, NaN count, threads — for every formulation (rod,
+// rope, rigid), with and without strand-strand collision, on 1 and 2 threads.
 //
-//   bench_sim [--guides 94,845] [--formulation rope,rigid] [--strand-collision off,on]
+//   bench_sim [--guides 94,845] [--formulation rod,rope,rigid] [--strand-collision off,on]
 //             [--threads 1,2] [--runs 3] [--warmup 20] [--steps 250]
-//             [--substeps 1] [--iterations 20] [--per-world 16] [--rate 90] [--preload on|off]
+//             [--substeps 1] [--iterations 20] [--rod-substeps 2] [--per-world 16] [--rate 90]
+//             [--preload on|off]
 #include "sim/fibonacci.h"
 #include "sim/guides.h"
 
@@ -98,9 +99,9 @@ RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int 
 }  // namespace
 
 int main(int argc, char** argv) {
-    std::vector<std::string> guideList{"94", "845"}, formList{"rope", "rigid"}, collList{"off", "on"},
+    std::vector<std::string> guideList{"94", "845"}, formList{"rod", "rope", "rigid"}, collList{"off", "on"},
         threadList{"1", "2"};
-    int runs = 3, warmup = 20, steps = 250, substeps = 1, iterations = 20, perWorld = 16;
+    int runs = 3, warmup = 20, steps = 250, substeps = 1, iterations = 20, perWorld = 16, rodSubsteps = 2;
     float rate = 90.f;
     bool preload = true;
     for (int i = 1; i < argc; ++i) {
@@ -122,6 +123,7 @@ int main(int argc, char** argv) {
         else if (a == "--substeps") substeps = std::stoi(next());
         else if (a == "--iterations") iterations = std::stoi(next());
         else if (a == "--per-world") perWorld = std::stoi(next());
+        else if (a == "--rod-substeps") rodSubsteps = std::stoi(next());
         else if (a == "--rate") rate = std::stof(next());
         else if (a == "--preload") preload = next() != "off";
         else {
@@ -147,6 +149,7 @@ int main(int argc, char** argv) {
                     s.substeps = substeps;
                     s.iterations = iterations;
                     s.strandsPerWorld = perWorld;
+                    s.rodSubsteps = rodSubsteps;
                     s.preload = preload;
                     std::vector<RunResult> results;
                     for (int r = 0; r < runs; ++r) results.push_back(runOnce(s, std::stoul(gs), rate, warmup, steps));

@@ -1,0 +1,48 @@
+// The rod formulation's validation cases at benchmark resolution (the
+// default 23 segments, 0.25 m, 0.02 s steps): the same cases tests/test_rod.cpp
+// asserts (tests/rod_cases.h), reported as one JSON object:
+//   cantilever: [{beta, tip_error}]   tip error as a fraction of L vs the heavy elastica
+//   pendulum_period_error             hanging chain, first mode vs T1 = 4π/2.4048·sqrt(L/g)
+//   energy_drift                      (max E - E0)/(μgL²/2), released from horizontal, no drag, 10 s
+//   damped_kinetic_energy_j           after 5 s with drag 1/s
+//   max_stretch                       max |l/l0 - 1| over every case
+//
+//   bench_rod --json
+#include "tests/rod_cases.h"
+
+#include <cstdio>
+#include <cstring>
+
+int main(int argc, char** argv) {
+    using namespace hp::rodcases;
+    bool json = false;
+    for (int i = 1; i < argc; ++i) {
+        if (std::strcmp(argv[i], "--json") == 0) json = true;
+        else {
+            std::fprintf(stderr, "usage: bench_rod [--json]\n");
+            return 1;
+        }
+    }
+    double maxStretch = 0;
+    std::string cases;
+    for (double beta : {0.5, 2.0, 8.0, 32.0, 128.0}) {
+        const Cantilever c = cantilever(beta, 2);
+        maxStretch = std::max(maxStretch, c.maxStretch);
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "%s{\"beta\": %g, \"tip_error\": %.5f}", cases.empty() ? "" : ", ", beta,
+                      double(c.error));
+        cases += buf;
+    }
+    const Pendulum p = pendulum();
+    const Energy e = energy();
+    maxStretch = std::max({maxStretch, p.maxStretch, e.maxStretch});
+    if (json)
+        std::printf("{\"cantilever\": [%s], \"pendulum_period_error\": %.5f, \"energy_drift\": %.6f, "
+                    "\"damped_kinetic_energy_j\": %.3e, \"max_stretch\": %.3e}\n",
+                    cases.c_str(), p.error, e.drift, e.dampedKinetic, maxStretch);
+    else
+        std::printf("cantilever %s\npendulum period %.4f s vs %.4f s (error %.4f)\nenergy drift %.6f, damped KE "
+                    "%.3e J\nmax stretch %.3e\n",
+                    cases.c_str(), p.period, p.reference, p.error, e.drift, e.dampedKinetic, maxStretch);
+    return 0;
+}
