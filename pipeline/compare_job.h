@@ -34,15 +34,15 @@ struct CompareThresholds {
 struct CompareJob {
     std::string a;  ///< template of sequence A (the reference for FLIP), with #### or %04d
     std::string b;  ///< template of sequence B (the test)
-    /// What A and B are ("preview (OpenGL)", "reference (Embree, physical, 8 spp)"); empty: "A", "B".
-    std::string aLabel, bLabel;
-    /// A third sequence the report shows beside A and B without measuring it; empty: none.
-    std::string beside, besideLabel;
     std::filesystem::path outputDir;  ///< per-frame images and the tables
     std::filesystem::path report;     ///< HTML report; empty: none
     CompareSettings settings;
     CompareThresholds thresholds;
     int reportWidth = 512;  ///< width of the images embedded in the report, pixels
+    /// What A and B are ("preview (OpenGL)", "reference (Embree, physical, 8 spp)"); empty: "A", "B".
+    std::string aLabel, bLabel;
+    /// A third sequence the report shows beside A and B without measuring it; empty: none.
+    std::string beside, besideLabel;
 };
 
 /// The job the scene's compare.* keys describe, with templates and folders

@@ -140,7 +140,7 @@ class ReferenceStage final : public FrameStage {
 
     ShotSettings shot_;
     View view_;
-    const Scene& scene_;
+    Scene scene_;  ///< a copy: callers may pass a temporary scene
     std::optional<CameraTrack> track_;  ///< made on the first frame: it may read the strand cache
 
     /// The camera of `frame` (camera auto reads the clip once, on first use).
