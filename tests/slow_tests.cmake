@@ -19,6 +19,7 @@ set(_hp_slow_tests
   test_camera:CameraAuto.ProjectHeadAndHairStayInFrame         # 2 x 84 frames projected
   test_camera:CameraAuto.FoxStaysInFrame
   test_camera:CameraAuto.RenderedBorderHasNoCoverage            # 3 Embree frames
+  test_camera:CameraAuto.RunSimulatesTheClipFirstAndChunksFrameAlike  # 3 hairpipe runs
 )
 foreach(_entry IN LISTS _hp_slow_tests)
   string(REPLACE ":" ";" _parts "${_entry}")

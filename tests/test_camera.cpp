@@ -8,6 +8,7 @@
 // A rendered check (Embree reference, small frames, strands standing at
 // full reach) finds alpha 0 on the whole frame border.
 #include "test_support.h"
+#include "batch_support.h"
 
 #include "pipeline/camera_track.h"
 #include "pipeline/head_setup.h"
@@ -270,6 +271,31 @@ TEST(CameraAuto, RenderedBorderHasNoCoverage) {
         EXPECT_EQ(border, 0.0) << "frame " << frame << ": coverage on the border";
         EXPECT_GT(total, 0.1 * image.width * image.height) << "frame " << frame << ": the head and hair are framed";
     }
+}
+
+TEST(CameraAuto, RunSimulatesTheClipFirstAndChunksFrameAlike) {
+    // Camera auto from the cached hair: rendering frame 2 alone needs the
+    // whole clip's strands, and --jobs chunks must all get the same camera.
+    TempDir dir;
+    const std::filesystem::path scene = dir / "auto.yaml";
+    test::writeFile(scene, "frames: 1-6\nseed: 3\n"
+                           "head: {file: " + test::sourcePath("scenes/assets/head.glb").string() +
+                               ", clip: nod_shake_turn}\n"
+                               "hair: {guides: {count: 16, length: 0.15, segments: 8}, followers: {count: 300}}\n"
+                               "render: {camera: {mode: auto, hair: cache, width: 64, height: 36}}\n"
+                               "reference: {enabled: true, samples: 1, png: ''}\n");
+    const test::ProcessResult one = test::runHairpipe("run -v " + test::q(scene) + " --out " + test::q(dir / "one") +
+                                                      " --frames 2 --stages reference");
+    ASSERT_EQ(one.exitCode, 0) << one.output;
+    EXPECT_NE(one.output.find("of the whole clip"), std::string::npos) << one.output;
+    EXPECT_TRUE(std::filesystem::exists(dir / "one/cache/strands.0006.hpc")) << "the clip's last frame is cached";
+    const test::ProcessResult jobs = test::runHairpipe("run -q " + test::q(scene) + " --out " + test::q(dir / "jobs") +
+                                                       " --frames 1-6 --stages reference --jobs 2 --chunk 1");
+    ASSERT_EQ(jobs.exitCode, 0) << jobs.output;
+    // The same pixels (the files differ only in their capture date).
+    const Image a = readImage((dir / "one/reference/reference.0002.exr").string());
+    const Image b = readImage((dir / "jobs/reference/reference.0002.exr").string());
+    EXPECT_EQ(a.pixels, b.pixels);
 }
 
 }  // namespace
