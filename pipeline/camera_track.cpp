@@ -10,6 +10,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <mutex>
+#include <optional>
 
 namespace hp {
 
@@ -103,9 +105,10 @@ void addCachedHair(FramingSample& sample, const StrandFrame& hair, const std::ar
 
 }  // namespace
 
-CameraTrack makeCameraTrack(const Scene& scene, const Camera& lens, const std::filesystem::path& outputDir,
-                            bool allowCache) {
-    checkCameraKeys(scene);
+namespace {
+
+CameraTrack computeCameraTrack(const Scene& scene, const Camera& lens, const std::filesystem::path& outputDir,
+                               bool allowCache) {
     const std::string mode = cameraMode(scene);
     if (mode == "fixed") return CameraTrack(lens);
     FramingSettings settings = framingSettings(scene);
@@ -161,6 +164,27 @@ CameraTrack makeCameraTrack(const Scene& scene, const Camera& lens, const std::f
                ", ", first.target.z(), "), framed in ",
                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), " s");
     return CameraTrack(std::move(perFrame), lens);
+}
+
+}  // namespace
+
+CameraTrack makeCameraTrack(const Scene& scene, const Camera& lens, const std::filesystem::path& outputDir,
+                            bool allowCache) {
+    checkCameraKeys(scene);
+    // The preview and reference stages of one process ask for the same track;
+    // framing the cached hair reads every clip frame, so the last track is
+    // kept, keyed by everything it depends on (a pure function of these).
+    static std::mutex mutex;
+    static std::string lastKey;
+    static std::optional<CameraTrack> last;
+    const std::string key = cat(scene.dump(), "\n", outputDir.string(), "\n", allowCache, " ", lens.fovY, " ",
+                                lens.width, " ", lens.height, " ", lens.nearClip, " ", lens.farClip);
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (!last || key != lastKey) {
+        last = computeCameraTrack(scene, lens, outputDir, allowCache);
+        lastKey = key;
+    }
+    return *last;
 }
 
 }  // namespace hp
