@@ -277,10 +277,10 @@ std::string compareReportHtml(const CompareJob& job, const std::vector<FrameReco
         out << "<div class=\"frame\" data-frame=\"" << r.frame << "\"" << (i ? " hidden" : "") << "><div class=\"panels"
             << (job.beside.empty() ? "" : " five") << "\">"
             << panel(images[i].a, a + " (toggle: space)", "a swap",
-                     " data-a=\"" + html(a + " (toggle: space)") + "\" data-b=\"" + html(b + " (toggled: space)") + "\"")
-            << panel(images[i].b, b, "b");
+                     " data-a=\"" + html(a + " (toggle: space)") + "\" data-b=\"" + html(b + " (toggled: space)") + "\"");
+        // The unmeasured sequence (the physical reference) right beside A (the preview).
         if (!job.beside.empty()) out << panel(images[i].beside, sideName("beside", job.besideLabel), "beside");
-        out
+        out << panel(images[i].b, b, "b")
             << panel(images[i].flip, "FLIP error (magma, 0 black → 1 yellow)", "flip")
             << panel(images[i].diff, "|A − B|", "diff") << "</div><p>frame " << r.frame << ": " << metricsLine(r)
             << "</p></div>\n";
