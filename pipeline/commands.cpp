@@ -199,7 +199,8 @@ CommandSpec validateCommandSpec() {
     c.run = [](const CommandLine& cl) {
         CommandContext ctx(cl);
         resolveShot(ctx.scene, ctx.options);
-        makeView(ctx.scene);  // checks across render keys
+        makeView(ctx.scene);             // checks across render keys
+        makeDisplaySettings(ctx.scene);  // the OCIO config loads; its display and view exist
         checkCameraKeys(ctx.scene);
         if (sceneHasHead(ctx.scene)) loadHead(ctx.scene);  // mesh, clip and scalp selections
         if (usesCurlyWetModel(ctx.scene)) curlyWetSettings(ctx.scene).validate();  // across hair.curly/wet keys

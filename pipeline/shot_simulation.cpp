@@ -107,6 +107,11 @@ class CurlyWetModel final : public GuideModel {
     GuideStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
         solver_.setSaturation(sceneSaturation(scene_, head.time));
         const CurlyWetStats& c = solver_.step(roots, head);
+        if (c.implicitFailures > 0)
+            logWarning("curly-wet: at t = ", head.time, " s the implicit spring step of ", c.implicitFailures,
+                       " strand-substep(s) was not finite; those strands skipped their curl, bending and core "
+                       "forces for it (try a smaller simulation.time_step, more substeps or softer hair.curly "
+                       "stiffnesses)");
         GuideStats g;
         g.maxLengthError = c.maxLengthError;
         g.meanLengthError = c.meanLengthError;
@@ -161,6 +166,13 @@ std::string SimFrameStats::json() const {
       << ", \"follower_ms\": " << followerMs << ", \"follower_projected\": " << followerProjected
       << ", \"frame_ms\": " << totalMs << ", \"strands\": " << strands << ", \"vertices\": " << vertices;
     if (saturation >= 0) o << ", \"saturation\": " << saturation;
+    o << ", \"guides\": {\"max_length_error\": " << guides.maxLengthError
+      << ", \"mean_length_error\": " << guides.meanLengthError << ", \"penetration_count\": " << guides.penetrationCount
+      << ", \"max_penetration\": " << guides.maxPenetration << "}";
+    o << ", \"followers\": {\"max_length_error\": " << followers.maxLengthError
+      << ", \"mean_length_error\": " << followers.meanLengthError
+      << ", \"penetration_count\": " << followers.penetrationCount
+      << ", \"max_penetration\": " << followers.maxPenetration << ", \"projected\": " << followerProjected << "}";
     o << "}";
     return o.str();
 }
@@ -211,6 +223,7 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame)
     float length = 0.f;
     for (uint32_t v = 1; v < rest.vertexCount(0); ++v) length += (rest.positions[v] - rest.positions[v - 1]).norm();
     groom.followerLengths = {length};
+    applyGroomModifiers(groom, groomModifiers(scene));  // rest shapes of clumped, wavy, frizzy followers
     FollowerSettings followerOptions = followerSettings(scene);
     if (usesCurlyWetModel(scene)) {
         const CurlyWetSettings curly = curlyWetSettings(scene);
@@ -281,6 +294,8 @@ void ShotSimulation::produceFrame(double time) {
     stats_.guides = pendingSteps_ ? pending_ : GuideStats{};
     stats_.guides.steps = pendingSteps_;
     stats_.followerProjected = fs.projected;
+    const Followers::LengthError lengthError = followers_->lengthError(strands_);
+    stats_.followers = {lengthError.max, lengthError.mean, fs.penetrationCount, fs.maxPenetration};
     stats_.followerMs = msSince(followerStart);
     stats_.headMs = headMs;
     stats_.strands = strands_.strandCount();

@@ -29,12 +29,20 @@ struct SimFrameStats {
     double time = 0.0;
     GuideStats guides;             ///< folded over the guide steps since the previous frame
     size_t followerProjected = 0;  ///< follower vertices pushed out of the head
+    /// Followers at the output frame (they are rebuilt per frame, not per step).
+    struct FollowerFigures {
+        double maxLengthError = 0, meanLengthError = 0;  ///< |segment length / rest - 1|
+        size_t penetrationCount = 0;  ///< vertices left inside the head (signed distance < 0)
+        double maxPenetration = 0;    ///< m
+    } followers;
     double headMs = 0;             ///< sampling the head animation (all steps)
     double followerMs = 0;         ///< rebuilding the followers
     double totalMs = 0;            ///< the whole frame
     size_t strands = 0, vertices = 0;
     double saturation = -1;        ///< curly-wet: mean saturation; -1 otherwise
-    /// One JSON object (a line of the run's statistics).
+    /// One JSON object (a line of the run's statistics): the guides' figures
+    /// at the top level (as before) and again under "guides", the followers'
+    /// under "followers".
     std::string json() const;
 };
 

@@ -22,8 +22,8 @@ namespace {
 class PreviewStage final : public FrameStage {
   public:
     PreviewStage(const Scene& scene, const ShotSettings& shot)
-        : view_(makeView(scene)), scene_(scene), settings_(makePreviewSettings(scene)),
-          outputDir_(shot.outputDir) {
+        : view_(makeView(scene)), scene_(scene), display_(makeDisplaySettings(scene)),
+          settings_(makePreviewSettings(scene)), outputDir_(shot.outputDir) {
         checkCameraKeys(scene);
         for (const char* key : {"preview.exr", "preview.png"}) {
             const std::string& t = scene.text(key);
@@ -68,7 +68,7 @@ class PreviewStage final : public FrameStage {
                             {"hairpipe:stage", "preview"},
                             {"hairpipe:renderer", renderer_->stats().renderer}};
         for (const fs::path& path : outputs(data.frame))
-            writeAtomically(path, [&](const fs::path& tmp) { writeImage(tmp.string(), image, options); });
+            writeAtomically(path, [&](const fs::path& tmp) { writeImageWithDisplay(tmp.string(), image, display_, options); });
     }
 
   private:
@@ -98,6 +98,7 @@ class PreviewStage final : public FrameStage {
         if (!track_) track_ = makeCameraTrack(scene_, view_.camera, outputDir_);
         return track_->at(frame);
     }
+    DisplaySettings display_;  // PNG frames only; EXRs stay linear
     PreviewSettings settings_;
     fs::path outputDir_;
     std::string exr_, png_, sceneName_;

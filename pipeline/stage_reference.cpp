@@ -19,7 +19,7 @@ namespace hp {
 
 namespace {
 
-ReferenceSettings referenceSettings(const Scene& s, const View& view, const ShotSettings& shot) {
+ReferenceSettings referenceSettings(const Scene& s, const ShotSettings& shot) {
     ReferenceSettings r;
     r.mode = s.text("reference.mode") == "physical" ? ReferenceMode::Physical : ReferenceMode::KajiyaKay;
     r.samplesPerPixel = int(s.integer("reference.samples"));
@@ -34,10 +34,7 @@ ReferenceSettings referenceSettings(const Scene& s, const View& view, const Shot
     f.azimuthalRoughness = float(s.number("reference.physical.azimuthal_roughness"));
     f.cuticleTiltDegrees = float(s.number("reference.physical.cuticle_tilt"));
     f.ior = float(s.number("reference.physical.ior"));
-    f.sigmaA = s.flag("reference.physical.use_hair_color")
-                   ? hairAbsorptionFromColor(view.hair.color, f.azimuthalRoughness)
-                   : hairAbsorptionFromMelanin(float(s.number("reference.physical.melanin")),
-                                               float(s.number("reference.physical.pheomelanin")));
+    f.sigmaA = hairAbsorption(s);
     return r;
 }
 
@@ -60,10 +57,10 @@ struct ReferenceOutput {
 class ReferenceStage final : public FrameStage {
   public:
     ReferenceStage(const Scene& scene, const ShotSettings& shot)
-        : shot_(shot), view_(makeView(scene)), scene_(scene),
+        : shot_(shot), view_(makeView(scene)), scene_(scene), display_(makeDisplaySettings(scene)),
           scale_(scene.number("reference.scale")), sceneName_(scene.name()) {
         checkCameraKeys(scene);
-        sequences_.push_back({referenceSettings(scene, view_, shot), checkedTemplate(scene, "reference.exr", true),
+        sequences_.push_back({referenceSettings(scene, shot), checkedTemplate(scene, "reference.exr", true),
                               checkedTemplate(scene, "reference.png", false)});
         if (scene.flag("reference.kajiya_kay.enabled")) {
             if (sequences_.front().settings.mode != ReferenceMode::Physical)
@@ -135,7 +132,7 @@ class ReferenceStage final : public FrameStage {
         std::vector<fs::path> paths;
         append(paths, sequence, data.frame);
         for (const fs::path& path : paths)
-            writeAtomically(path, [&](const fs::path& tmp) { writeImage(tmp.string(), image, options); });
+            writeAtomically(path, [&](const fs::path& tmp) { writeImageWithDisplay(tmp.string(), image, display_, options); });
     }
 
     ShotSettings shot_;
@@ -148,6 +145,7 @@ class ReferenceStage final : public FrameStage {
         if (!track_) track_ = makeCameraTrack(scene_, view_.camera, shot_.outputDir);
         return track_->at(frame);
     }
+    DisplaySettings display_;  // PNG frames only; EXRs stay linear
     double scale_;
     std::string sceneName_;
     /// The scene's reference, then (reference.kajiya_kay.enabled) its Kajiya-Kay companion.

@@ -16,6 +16,7 @@ set(_hp_slow_tests
   test_shot_simulation:ShotSimulation.CheckpointRestoreContinuesBitForBit
   test_sim_guards:SimGuards.LongViolentRunStaysBoundedAndFinite  # 10^4+ steps
   test_resources:Resources.ResidentMemoryDoesNotGrowOverThirtyFrames  # 30 frames
+  test_render_parity:RenderParity.ThreePointRigAndSkinMatch    # 5 reference renders
   test_camera:CameraAuto.ProjectHeadAndHairStayInFrame         # 2 x 84 frames projected
   test_camera:CameraAuto.FoxStaysInFrame
   test_camera:CameraAuto.RenderedBorderHasNoCoverage            # 3 Embree frames
