@@ -1,9 +1,11 @@
 #include "pipeline/camera_track.h"
 
 #include "core/log.h"
+#include "pipeline/clip_cuts.h"
 #include "pipeline/curly_settings.h"
 #include "pipeline/hair_source.h"
 #include "pipeline/head_setup.h"
+#include "pipeline/shot_simulation.h"
 #include "pipeline/strand_cache.h"
 
 #include <tbb/parallel_for.h>
@@ -64,8 +66,8 @@ FramingSettings framingSettings(const Scene& scene) {
     f.azimuthDegrees = float(scene.number("render.camera.azimuth"));
     f.elevationDegrees = float(scene.number("render.camera.elevation"));
     f.margin = float(scene.number("render.camera.margin"));
-    f.cutDistance = float(scene.number("simulation.teleport.distance"));
-    f.cutAngleDegrees = float(scene.number("simulation.teleport.angle"));
+    f.cutDistance = float(scene.number("simulation.cut_distance"));
+    f.cutAngleDegrees = float(scene.number("simulation.cut_angle"));
     if (f.facing.norm() < 1e-6f) scene.fail("render.camera.facing", "must be a non-zero direction");
     if (f.up.norm() < 1e-6f) scene.fail("render.camera.up", "must be a non-zero direction");
     return f;
@@ -107,6 +109,27 @@ void addCachedHair(FramingSample& sample, const StrandFrame& hair, const std::ar
 
 namespace {
 
+/// For each sample, the index of its segment's first sample: a segment ends
+/// where the shot cuts, found as the simulation finds its cuts (per
+/// simulation step, simulation.cut_distance / cut_angle), so the camera
+/// re-frames on the frame where the hair restarts.
+std::vector<size_t> clipSegmentStarts(const Scene& scene, const HeadSetup& head,
+                                      const std::vector<FramingSample>& samples, double fps) {
+    std::vector<size_t> starts(samples.size(), 0);
+    if (samples.empty()) return starts;
+    const double step = frameAlignedStep(fps, scene.number("simulation.time_step"));
+    const std::vector<ClipCut> cuts =
+        findClipCuts(scene, head, samples.front().frame / fps, samples.back().frame / fps, step);
+    size_t c = 0;
+    for (size_t i = 1; i < samples.size(); ++i) {
+        const double before = samples[i - 1].frame / fps, now = samples[i].frame / fps + 1e-9;
+        bool cut = false;
+        for (; c < cuts.size() && cuts[c].time <= now; ++c) cut |= cuts[c].time > before;
+        starts[i] = cut ? i : starts[i - 1];
+    }
+    return starts;
+}
+
 CameraTrack computeCameraTrack(const Scene& scene, const Camera& lens, const std::filesystem::path& outputDir,
                                bool allowCache) {
     const std::string mode = cameraMode(scene);
@@ -130,8 +153,8 @@ CameraTrack computeCameraTrack(const Scene& scene, const Camera& lens, const std
     const bool cached = allowCache && cameraReadsStrandCache(scene);
     std::vector<FramingSample> samples =
         sampleHeadForFraming(posed, head.scalp, cached ? 0.f : hairReach(scene), frames, scene.number("fps"));
-    // Cuts and view directions come from the head alone.
-    const std::vector<size_t> starts = segmentStarts(samples, settings);
+    // Segments between the shot's cuts: the simulation's own test (pipeline/clip_cuts.h).
+    const std::vector<size_t> starts = clipSegmentStarts(scene, head, samples, scene.number("fps"));
     if (cached) {
         const std::vector<Vec3f> directions = viewDirections(samples, starts, settings);
         ShotSettings shot;

@@ -48,7 +48,8 @@ std::vector<FramingSample> sampleHeadForFraming(const HeadMotion& head, const st
 float hairReach(const Scene& scene);
 
 /// render.camera.azimuth/elevation/margin/facing/up and the cut thresholds
-/// (simulation.teleport.distance/angle, applied per frame).
+/// (simulation.cut_distance/cut_angle). makeCameraTrack finds the shot's
+/// cuts as the simulation does (pipeline/clip_cuts.h).
 FramingSettings framingSettings(const Scene& scene);
 
 /// True when camera auto/follow frames the hair read from the strand cache

@@ -2,6 +2,7 @@
 
 #include "core/log.h"
 #include "pipeline/camera_track.h"
+#include "pipeline/clip_cuts.h"
 #include "pipeline/curly_settings.h"
 #include "pipeline/frame_jobs.h"
 #include "pipeline/frame_range.h"
@@ -9,6 +10,7 @@
 #include "pipeline/head_setup.h"
 #include "pipeline/output.h"
 #include "pipeline/shot_outputs.h"
+#include "pipeline/shot_simulation.h"
 #include "pipeline/stages.h"
 #include "pipeline/progress.h"
 #include "pipeline/schema.h"
@@ -17,6 +19,7 @@
 #include <tbb/global_control.h>
 
 #include <chrono>
+#include <cstdio>
 #include <iostream>
 
 namespace hp {
@@ -210,6 +213,26 @@ CommandSpec validateCommandSpec() {
     return c;
 }
 
+namespace {
+
+/// The scene cuts of the shot's clip (simulation.cut_*), as `info` prints them.
+void printClipCuts(const Scene& scene, const ShotSettings& shot) {
+    if (shot.frames.empty()) return;
+    const double start = shot.frames.front() / shot.fps, end = shot.frames.back() / shot.fps;
+    const double step = frameAlignedStep(shot.fps, scene.number("simulation.time_step"));
+    const std::vector<ClipCut> cuts = findClipCuts(scene, loadHead(scene), start, end, step);
+    std::cout << "cuts:    " << cuts.size() << " (simulation.cut_distance " << scene.number("simulation.cut_distance")
+              << " m, cut_angle " << scene.number("simulation.cut_angle") << " deg per step)\n";
+    for (const ClipCut& c : cuts) {
+        char line[160];
+        std::snprintf(line, sizeof line, "  t = %.4f s (frame %.2f): head moved %.3f m, turned %.1f deg, a root moved %.3f m\n",
+                      c.time, c.time * shot.fps, c.jump.headMove, c.jump.headTurn, c.jump.rootMove);
+        std::cout << line;
+    }
+}
+
+}  // namespace
+
 CommandSpec infoCommandSpec() {
     CommandSpec c;
     c.name = "info";
@@ -229,6 +252,7 @@ CommandSpec infoCommandSpec() {
             } catch (const RigSelectionError& e) {
                 ctx.scene.fail("head.meshes", e.what());
             }
+            printClipCuts(ctx.scene, shot);
         }
         std::cout << "\nresolved keys:\n" << ctx.scene.dump();
         return int(kExitOk);

@@ -71,7 +71,7 @@ std::string renderThumbnail(const std::string& path, const DisplaySettings& disp
     try {
         return pngDataUri(toDisplay(resizeToWidth(readImage(path, true), width), display), false);
     } catch (const Error& e) {
-        logWarning("compare report: no thumbnail of ", path, ": ", e.what());  // as thumbnail()
+        logWarning("compare report: no thumbnail of ", path, ": ", e.what());
         return {};
     }
 }

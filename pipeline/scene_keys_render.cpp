@@ -37,8 +37,8 @@ void addRenderKeys(SchemaBuilder& b) {
               "hair by itself (mode auto, the default when no position is given).")
         .choice("render.camera.mode", "auto", {"auto", "follow", "fixed"},
                 "auto: frame the head and the hair's reach (scalp grown by the hair length) over the whole clip "
-                "from a three-quarter view, framed anew after a cut (a head jump beyond simulation.teleport.* "
-                "between frames); follow: the same, framed on each frame alone; fixed: position and target. "
+                "from a three-quarter view, framed anew after a scene cut (simulation.cut_distance / "
+                "cut_angle: where the simulation restarts the hair); follow: the same, framed on each frame alone; fixed: position and target. "
                 "Without the key, a scene that gives render.camera.position is fixed, any other auto; auto without "
                 "a head keeps the fixed camera.")
         .choice("render.camera.hair", "reach", {"reach", "cache"},

@@ -26,16 +26,6 @@ double msSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-/// The largest step <= maxStep that divides the frame interval, so every
-/// frame falls on a step and is written without interpolation (a root
-/// interpolated between two steps cuts the chord of its arc on a turning head).
-float frameAlignedStep(double fps, double maxStep) {
-    const double frame = 1.0 / fps;
-    // The step keys are floats (0.02f is 0.0199999996): compare with a tolerance.
-    const double steps = std::max(1.0, std::ceil(frame / maxStep - 1e-5));
-    return float(frame / steps);
-}
-
 void evaluateRoots(const TriangleMesh& mesh, const std::vector<SurfacePoint>& roots, std::vector<SurfaceFrame>& out) {
     out.resize(roots.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, roots.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
@@ -44,6 +34,13 @@ void evaluateRoots(const TriangleMesh& mesh, const std::vector<SurfacePoint>& ro
 }
 
 }  // namespace
+
+float frameAlignedStep(double fps, double maxStep) {
+    const double frame = 1.0 / fps;
+    // The step keys are floats (0.02f is 0.0199999996): compare with a tolerance.
+    const double steps = std::max(1.0, std::ceil(frame / maxStep - 1e-5));
+    return float(frame / steps);
+}
 
 /// The two strand models behind one interface: the rigid chain
 /// (sim/guides.h: rope or rigid formulation) and curly-wet (sim/curly_wet.h).

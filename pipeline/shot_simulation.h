@@ -23,6 +23,11 @@
 
 namespace hp {
 
+/// The largest step <= maxStep that divides the frame interval, so every
+/// frame falls on a step and is written without interpolation (a root
+/// interpolated between two steps cuts the chord of its arc on a turning head).
+float frameAlignedStep(double fps, double maxStep);
+
 /// What the simulation measured for one output frame.
 struct SimFrameStats {
     int frame = 0;

@@ -17,8 +17,15 @@ set(_hp_slow_tests
   test_sim_guards:SimGuards.LongViolentRunStaysBoundedAndFinite  # 10^4+ steps
   test_resources:Resources.ResidentMemoryDoesNotGrowOverThirtyFrames  # 30 frames
   test_render_parity:RenderParity.ThreePointRigAndSkinMatch    # 5 reference renders
+  test_scene_cut:SceneCut.NoVertexInsideAnyColliderOnTheCutFrameAndAfter  # 60 solver steps, two formulations
+  test_scene_cut:SceneCut.InfoListsTheCutsOfTheClip             # three head imports
+  test_scene_cut:SceneCut.StressClipCutFrameHasNoVertexInsideAnyCollider  # exact collider per step
+  test_collision_world:CollisionWorld.HairOnAShoulderBoxStaysOnIt  # 300 solver steps
+  test_collision_world:CollisionWorld.PropColliderFromASecondFile  # head import + grid
+  test_stress_clip:StressClip.DISABLED_NoStretchNoPenetrationAfterAnyFrameOnOneAndTwoThreads  # two 62-frame shots
   test_camera:CameraAuto.ProjectHeadAndHairStayInFrame         # 2 x 84 frames projected
   test_camera:CameraAuto.FoxStaysInFrame
+  test_camera:CameraAuto.StressClipIsReframedAtItsSceneCut
   test_camera:CameraAuto.RenderedBorderHasNoCoverage            # 3 Embree frames
   test_camera:CameraAuto.RunSimulatesTheClipFirstAndChunksFrameAlike  # 3 hairpipe runs
 )

@@ -181,6 +181,23 @@ TEST(CameraAuto, ProjectHeadAndHairStayInFrame) {
     expectHeadAndHairInFrame(follow);
 }
 
+TEST(CameraAuto, StressClipIsReframedAtItsSceneCut) {
+    // The stress clip cuts to another pose at 2 s (frame 50; `hairpipe info
+    // scenes/stress.yaml`): the camera changes exactly there, and head and
+    // hair stay in frame on both sides.
+    std::string yaml = test::readFile(test::sourcePath("scenes/stress.yaml"));
+    const size_t at = yaml.find("position: [0.55, 0.05, 0.55], target: [0, -0.1, -0.02], ");
+    ASSERT_NE(at, std::string::npos) << "the stress scene's fixed camera moved; update this test";
+    yaml.erase(at, std::string("position: [0.55, 0.05, 0.55], target: [0, -0.1, -0.02], ").size());  // camera auto
+    const Scene scene = Scene::parse(yaml, "stress.yaml", test::sourcePath("scenes"));
+    const CameraTrack track = makeCameraTrack(scene, makeView(scene).camera, std::filesystem::temp_directory_path(), false);
+    for (int frame = 2; frame <= 62; ++frame) {
+        const bool moved = !track.at(frame).position.isApprox(track.at(frame - 1).position);
+        EXPECT_EQ(moved, frame == 50) << "frame " << frame;
+    }
+    expectHeadAndHairInFrame(scene);
+}
+
 TEST(CameraAuto, FoxStaysInFrame) {
     HP_REQUIRE_ASSET(fox, "Fox.glb");
     const Scene scene = Scene::parse("frames: 1-40\nhead: {file: '" + fox.string() +
