@@ -1,6 +1,7 @@
 // `hairpipe view scene.yaml`: the preview pass in an interactive window
 // (render/viewer.h), fed by the scene's frame source.
 #include "core/log.h"
+#include "pipeline/camera_track.h"
 #include "pipeline/commands.h"
 #include "pipeline/preview_settings.h"
 #include "pipeline/stages.h"
@@ -78,7 +79,13 @@ CommandSpec viewCommandSpec() {
     c.run = [](const CommandLine& cl) {
         CommandContext ctx(cl);
         const ShotSettings shot = resolveShot(ctx.scene, ctx.options);
-        const View view = makeView(ctx.scene);
+        View view = makeView(ctx.scene);
+        try {  // the orbit starts from the shot's camera
+            view.camera = makeCameraTrack(ctx.scene, view.camera, shot.outputDir).at(shot.frames.front());
+        } catch (const FrameError& e) {
+            logWarning(e.what(), "; framing the hair by its reach instead");
+            view.camera = makeCameraTrack(ctx.scene, view.camera, shot.outputDir, false).at(shot.frames.front());
+        }
         const PreviewSettings settings = makePreviewSettings(ctx.scene);
         ViewerOptions options;
         options.frames = shot.frames;

@@ -1,6 +1,7 @@
 #include "pipeline/commands.h"
 
 #include "core/log.h"
+#include "pipeline/camera_track.h"
 #include "pipeline/clip_cuts.h"
 #include "pipeline/curly_settings.h"
 #include "pipeline/frame_jobs.h"
@@ -131,8 +132,12 @@ int runShotCommand(const CommandContext& ctx, const std::set<std::string>& only)
         stages.clear();
         report = runShotInJobs(ctx.scene, ctx.options, only);
     } else {
+        RunReport simulation;
+        if (cameraReadsStrandCache(ctx.scene)) simulateFirst(ctx.scene, shot, stages, simulation);
         std::unique_ptr<FrameSource> source = makeFrameSource(ctx.scene, shot);
         report = runFrames(*source, stages, shot);
+        report.outputsSkipped += simulation.outputsSkipped;
+        report.failures.insert(report.failures.begin(), simulation.failures.begin(), simulation.failures.end());
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     logInfo("hairpipe: ", report.framesDone, " frames in ", formatDuration(seconds), ", ", report.outputsSkipped,
@@ -199,6 +204,7 @@ CommandSpec validateCommandSpec() {
         resolveShot(ctx.scene, ctx.options);
         makeView(ctx.scene);             // checks across render keys
         makeDisplaySettings(ctx.scene);  // the OCIO config loads; its display and view exist
+        checkCameraKeys(ctx.scene);
         if (sceneHasHead(ctx.scene)) loadHead(ctx.scene);  // mesh, clip and scalp selections
         if (usesCurlyWetModel(ctx.scene)) curlyWetSettings(ctx.scene).validate();  // across hair.curly/wet keys
         std::cout << ctx.scene.name() << ": ok\n";

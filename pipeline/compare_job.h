@@ -43,6 +43,10 @@ struct CompareJob {
     /// How the report shows A and B: the scene's display transform
     /// (render.ocio.*, render.exposure, render.background), as its PNGs.
     DisplaySettings display;
+    /// What A and B are ("preview (OpenGL)", "reference (Embree, physical, 8 spp)"); empty: "A", "B".
+    std::string aLabel, bLabel;
+    /// A third sequence the report shows beside A and B without measuring it; empty: none.
+    std::string beside, besideLabel;
 };
 
 /// The job the scene's compare.* keys describe, with templates and folders

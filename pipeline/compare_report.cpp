@@ -3,6 +3,7 @@
 #include "core/errors.h"
 #include "core/log.h"
 #include "pipeline/compare_table.h"
+#include "pipeline/path_template.h"
 #include "render/image_encode.h"
 
 #include <tbb/parallel_for.h>
@@ -47,7 +48,7 @@ std::string fixed(double v, int decimals) {
 
 /// Data URIs of one frame's four panels; empty where the image is unavailable.
 struct FrameImages {
-    std::string a, b, flip, diff;
+    std::string a, b, beside, flip, diff;
 };
 
 /// The image as an embedded PNG, or empty (the page then says the image is
@@ -79,6 +80,7 @@ FrameImages loadImages(const CompareJob& job, const FrameRecord& r) {
     FrameImages f;
     f.a = renderThumbnail(r.a, job.display, job.reportWidth);
     f.b = renderThumbnail(r.b, job.display, job.reportWidth);
+    if (!job.beside.empty()) f.beside = renderThumbnail(expandFrame(job.beside, r.frame), job.display, job.reportWidth);
     if (r.compared) {
         // The heat map PNG holds display values already: read and write it as stored.
         f.flip = thumbnail(flipImagePath(job, r.frame).string(), false, false, job.reportWidth);
@@ -162,9 +164,15 @@ std::string plotSvg(const Series& s, const std::vector<FrameRecord>& records) {
     return out.str();
 }
 
-std::string panel(const std::string& uri, const std::string& caption, const std::string& cls) {
+/// A side's name in the report: "A: preview (OpenGL)", or "A" without a label.
+std::string sideName(const char* side, const std::string& label) {
+    return label.empty() ? std::string(side) : cat(side, ": ", label);
+}
+
+std::string panel(const std::string& uri, const std::string& caption, const std::string& cls,
+                  const std::string& captionData = "") {
     std::ostringstream out;
-    out << "<figure>";
+    out << "<figure" << captionData << ">";
     if (uri.empty()) out << "<div class=\"missing\">not available</div>";
     else out << "<img class=\"" << cls << "\" alt=\"" << html(caption) << "\" src=\"" << uri << "\">";
     out << "<figcaption>" << html(caption) << "</figcaption></figure>";
@@ -187,7 +195,7 @@ td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}td.l,th.l{text-alig
 svg.plot text{font-size:11px;fill:#444}svg.plot .axis{stroke:#888}svg.plot .series{fill:none;stroke:#3949ab;stroke-width:1.5}
 svg.plot .threshold{stroke:#c62828;stroke-dasharray:5 4}svg.plot circle.ok{fill:#3949ab;cursor:pointer}
 svg.plot circle.bad{fill:#c62828;cursor:pointer}.viewer{background:#222;color:#eee;padding:10px;border-radius:4px}
-.panels{display:grid;grid-template-columns:repeat(4,minmax(0,1fr));gap:8px}.panels figure{margin:0}
+.panels{display:grid;grid-template-columns:repeat(4,minmax(0,1fr));gap:8px}.panels.five{grid-template-columns:repeat(5,minmax(0,1fr))}.panels figure{margin:0}
 .panels img{display:block;width:100%;height:auto}
 .panels figcaption{text-align:center;font-size:12px}.missing{aspect-ratio:16/9;display:flex;
 align-items:center;justify-content:center;border:1px dashed #888}.controls{margin-bottom:8px}
@@ -200,7 +208,7 @@ var slider=document.getElementById('slider'),label=document.getElementById('fram
 var cur=0,showB=false,timer=null;
 function swap(b){var f=frames[cur];if(!f)return;var img=f.querySelector('img.swap'),bi=f.querySelector('img.b');
 if(!img||!bi)return;if(!img.dataset.a)img.dataset.a=img.src;img.src=b?bi.src:img.dataset.a;showB=b;
-var c=f.querySelector('figure figcaption');if(c)c.textContent=b?'B (toggled: space)':'A (toggle: space)';}
+var g=f.querySelector('figure'),c=g.querySelector('figcaption');if(c)c.textContent=b?g.dataset.b:g.dataset.a;}
 function show(i){if(!frames.length)return;swap(false);cur=Math.max(0,Math.min(frames.length-1,i));
 frames.forEach(function(f,k){f.hidden=k!==cur;});slider.value=cur;
 label.textContent='frame '+frames[cur].dataset.frame+' ('+(cur+1)+'/'+frames.length+')';}
@@ -237,8 +245,16 @@ std::string compareReportHtml(const CompareJob& job, const std::vector<FrameReco
         << "<title>hairpipe compare: " << verdict << "</title>\n<style>" << kStyle << "</style></head>\n"
         << "<body data-status=\"loading\">\n<h1>hairpipe compare: <span class=\"" << (s.pass() ? "pass" : "fail")
         << "\">" << verdict << "</span></h1>\n"
-        << "<table><tr><th class=\"l\">A (reference)</th><td class=\"l\"><code>" << html(job.a) << "</code></td></tr>"
-        << "<tr><th class=\"l\">B (test)</th><td class=\"l\"><code>" << html(job.b) << "</code></td></tr>"
+        << "<table><tr><th class=\"l\">" << html(sideName("A", job.aLabel)) << "</th><td class=\"l\"><code>"
+        << html(job.a) << "</code></td></tr>"
+        << "<tr><th class=\"l\">" << html(sideName("B", job.bLabel)) << "</th><td class=\"l\"><code>"
+        << html(job.b) << "</code></td></tr>";
+    if (!job.beside.empty())
+        out << "<tr><th class=\"l\">" << html(sideName("beside", job.besideLabel))
+            << "</th><td class=\"l\">shown, not measured: <code>" << html(job.beside) << "</code></td></tr>";
+    out << "<tr><th class=\"l\">measured pair</th><td class=\"l\">" << html(sideName("A", job.aLabel)) << " against "
+        << html(sideName("B", job.bLabel))
+        << ": every metric, plot and threshold below is this pair (A is FLIP's reference side)</td></tr>"
         << "<tr><th class=\"l\">frames</th><td class=\"l\">" << s.frames << " (" << s.compared << " compared, "
         << s.failed << " failing)</td></tr><tr><th class=\"l\">settings</th><td class=\"l\">mask "
         << (job.settings.mask == MaskMode::Hair ? "hair (alpha &gt; 0 in A or B)" : "none (whole frame)")
@@ -274,8 +290,14 @@ std::string compareReportHtml(const CompareJob& job, const std::vector<FrameReco
                "<button id=\"toggle\">A ⇄ B</button> <button id=\"play\">play</button></div>\n";
     for (size_t i = 0; i < records.size(); ++i) {
         const FrameRecord& r = records[i];
-        out << "<div class=\"frame\" data-frame=\"" << r.frame << "\"" << (i ? " hidden" : "") << "><div class=\"panels\">"
-            << panel(images[i].a, "A (toggle: space)", "a swap") << panel(images[i].b, "B", "b")
+        const std::string a = sideName("A", job.aLabel), b = sideName("B", job.bLabel);
+        out << "<div class=\"frame\" data-frame=\"" << r.frame << "\"" << (i ? " hidden" : "") << "><div class=\"panels"
+            << (job.beside.empty() ? "" : " five") << "\">"
+            << panel(images[i].a, a + " (toggle: space)", "a swap",
+                     " data-a=\"" + html(a + " (toggle: space)") + "\" data-b=\"" + html(b + " (toggled: space)") + "\"");
+        // The unmeasured sequence (the physical reference) right beside A (the preview).
+        if (!job.beside.empty()) out << panel(images[i].beside, sideName("beside", job.besideLabel), "beside");
+        out << panel(images[i].b, b, "b")
             << panel(images[i].flip, "FLIP error (magma, 0 black → 1 yellow)", "flip")
             << panel(images[i].diff, "|A − B|", "diff") << "</div><p>frame " << r.frame << ": " << metricsLine(r)
             << "</p></div>\n";

@@ -1,6 +1,7 @@
 #include "pipeline/frame_jobs.h"
 
 #include "core/log.h"
+#include "pipeline/camera_track.h"
 #include "pipeline/child_process.h"
 #include "pipeline/cli.h"
 #include "pipeline/frame_range.h"
@@ -26,22 +27,41 @@ std::vector<std::string> sceneArguments(const RunOptions& options, const ShotSet
     return args;
 }
 
-namespace {
-
-/// Runs the sim stage alone in this process: the strand cache (and
-/// checkpoints) of the run's frames, so children only read.
-void simulateFirst(const Scene& scene, StagePtr sim, const ShotSettings& shot, RunReport& report) {
-    std::vector<StagePtr> stages;
-    stages.push_back(std::move(sim));
+void simulateFirst(const Scene& scene, const ShotSettings& shot, std::vector<StagePtr>& stages, RunReport& report) {
+    StagePtr sim;
+    std::vector<StagePtr> rest;
+    for (StagePtr& s : stages) {
+        if (s->name() == "sim") sim = std::move(s);
+        else rest.push_back(std::move(s));
+    }
+    stages = std::move(rest);
+    const bool hair = sceneHasHair(scene);
+    const bool needsData =
+        std::any_of(stages.begin(), stages.end(), [](const StagePtr& s) { return s->needsFrameData(); });
+    // render/vdb: fill the cache first, as `run` does.
+    if (!sim && hair && needsData && !shot.requireCache) sim = makeSimStage(scene, shot);
+    if (!sim) return;
     ShotSettings simShot = shot;
     simShot.writesCache = true;
     simShot.requireCache = false;
-    logInfo("--jobs: simulating first (sequential), writing the strand cache");
+    if (cameraReadsStrandCache(scene)) {
+        // Camera auto frames the cached hair of the whole clip: simulate all of it.
+        const std::vector<int>& clip = scene.frames("frames");
+        simShot.frames.insert(simShot.frames.end(), clip.begin(), clip.end());
+        std::sort(simShot.frames.begin(), simShot.frames.end());
+        simShot.frames.erase(std::unique(simShot.frames.begin(), simShot.frames.end()), simShot.frames.end());
+    }
+    logInfo("simulating first (sequential), writing the strand cache",
+            simShot.frames.size() > shot.frames.size() ? " of the whole clip (camera auto frames its hair)" : "");
+    std::vector<StagePtr> simStages;
+    simStages.push_back(std::move(sim));
     std::unique_ptr<FrameSource> source = makeFrameSource(scene, simShot);
-    const RunReport r = runFrames(*source, stages, simShot);
+    const RunReport r = runFrames(*source, simStages, simShot);
     report.outputsSkipped += r.outputsSkipped;
     report.failures.insert(report.failures.end(), r.failures.begin(), r.failures.end());
 }
+
+namespace {
 
 int defaultChunk(size_t frames, int jobs) {
     // About four chunks per job: enough to balance frames of unequal cost
@@ -64,16 +84,9 @@ RunReport runShotInJobs(const Scene& scene, const RunOptions& options, const std
         std::unique_ptr<FrameSource> source = makeFrameSource(scene, shot);
         return runFrames(*source, all, shot);
     }
-    StagePtr sim;
-    std::vector<StagePtr> stages;  // the frame-parallel ones
-    for (StagePtr& s : all) {
-        if (s->name() == "sim") sim = std::move(s);
-        else stages.push_back(std::move(s));
-    }
-    // render/vdb --jobs: fill the cache first, as `run` does.
-    if (!sim && hair && needsData && !shot.requireCache) sim = makeSimStage(scene, shot);
     RunReport report;
-    if (sim) simulateFirst(scene, std::move(sim), shot, report);
+    std::vector<StagePtr> stages = std::move(all);
+    simulateFirst(scene, shot, stages, report);  // leaves the frame-parallel stages
 
     const std::vector<int> todo = framesWithWork(stages, shot.frames, shot.force);
     if (!shot.force)

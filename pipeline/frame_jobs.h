@@ -22,6 +22,13 @@ namespace hp {
 /// overrides (--set, the seed), so the child sees exactly this run's scene.
 std::vector<std::string> sceneArguments(const RunOptions& options, const ShotSettings& shot);
 
+/// @brief Runs the simulation before the frame stages: moves the sim stage
+/// out of `stages` (or, when the other stages need strands and the run may
+/// simulate, makes one) and runs it over the run's frames, plus the whole
+/// clip when camera auto frames the cached hair (cameraReadsStrandCache).
+/// Its failures go into `report`.
+void simulateFirst(const Scene& scene, const ShotSettings& shot, std::vector<StagePtr>& stages, RunReport& report);
+
 /// Runs the shot's stages (`only`, all enabled ones if empty) with
 /// options.jobs child processes as described above. Frame failures of the
 /// children (their "error:" lines) and children that died are collected in

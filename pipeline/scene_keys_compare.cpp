@@ -16,6 +16,14 @@ void addCompareKeys(SchemaBuilder& b) {
               "(or absolute).")
         .text("compare.b", "reference/reference.####.exr",
               "Sequence B (the test side), a frame template relative to the output folder (or absolute).")
+        .text("compare.a_label", "",
+              "What sequence A is, for the report; empty: named from the scene (\"preview (OpenGL)\", "
+              "\"reference (Embree, physical, 8 spp)\", ...) when it is one of the shot's sequences, else its file.")
+        .text("compare.b_label", "", "What sequence B is, as compare.a_label.")
+        .text("compare.beside", "",
+              "A third sequence shown in the report beside A and B, not measured (e.g. the physical reference "
+              "when the gate compares against reference.kajiya_kay); a frame template, empty for none.")
+        .text("compare.beside_label", "", "What the beside sequence is, as compare.a_label.")
         .text("compare.output", "compare",
               "Folder, relative to the output folder, for flip.####.png (FLIP heat map), absdiff.####.exr "
               "(|A-B|), metrics.####.json and the run's metrics.csv / metrics.json.")

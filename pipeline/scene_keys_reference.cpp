@@ -18,7 +18,7 @@ void addReferenceKeys(SchemaBuilder& b) {
         .choice("reference.mode", "kajiya-kay", {"kajiya-kay", "physical"},
                 "Shading: `kajiya-kay` is the preview's model (render.hair.*) with direct light and ray-traced "
                 "shadows; `physical` path-traces Chiang et al. 2016's hair BSDF (reference.physical.*) and a "
-                "Lambertian head.")
+                "Lambertian head (reference.kajiya_kay adds the Kajiya-Kay one beside it).")
         .integer("reference.samples", 16, 1, 4096, "", "Samples per pixel (stratified over the pixel, box filter).")
         .integer("reference.depth", 4, 0, 64, "",
                  "Physical mode: indirect bounces after the first hit, as Cycles' max bounces (0 = direct light "
@@ -31,6 +31,13 @@ void addReferenceKeys(SchemaBuilder& b) {
                 "ray.")
         .number("reference.scale", 1, 0.01, 4, "",
                 "Image size relative to render.camera.width and height (e.g. 0.25 for a quick look).");
+    b.section("reference.kajiya_kay",
+              "Physical mode: a second reference of the same frames shaded with the preview's Kajiya-Kay model "
+              "(same camera, lights, samples and seed), so compare can gate the preview against a reference that "
+              "differs from it only in visibility, shadows and anti-aliasing, not in the hair's BSDF.")
+        .flag("reference.kajiya_kay.enabled", false, "Render the Kajiya-Kay reference too (about doubles the stage's time).")
+        .text("reference.kajiya_kay.exr", "reference/kajiya-kay.####.exr", "Its EXR template (channels as reference.exr).")
+        .text("reference.kajiya_kay.png", "reference/kajiya-kay.####.png", "Its PNG template; empty writes none.");
     b.section("reference.layers", "Extra EXR layers.")
         .flag("reference.layers.diffuse_specular", false,
               "Add diffuse.R/G/B and specular.R/G/B (Kajiya-Kay: its two terms; physical: the R lobe of direct "

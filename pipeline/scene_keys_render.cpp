@@ -32,10 +32,31 @@ std::string rigYaml() {
 
 void addRenderKeys(SchemaBuilder& b) {
     b.section("render", "The shot's look, shared by the preview and the reference renderer.");
-    b.section("render.camera", "A perspective camera (right-handed, Y up).")
-        .vec3("render.camera.position", 0, 0.05, 0.9, "m", "Camera position.")
-        .vec3("render.camera.target", 0, 0, 0, "m", "Point the camera looks at.")
+    b.section("render.camera",
+              "A perspective camera (right-handed, Y up): placed by hand (mode fixed) or framing the head and its "
+              "hair by itself (mode auto, the default when no position is given).")
+        .choice("render.camera.mode", "auto", {"auto", "follow", "fixed"},
+                "auto: frame the head and the hair's reach (scalp grown by the hair length) over the whole clip "
+                "from a three-quarter view, framed anew after a scene cut (simulation.cut_distance / "
+                "cut_angle: where the simulation restarts the hair); follow: the same, framed on each frame alone; fixed: position and target. "
+                "Without the key, a scene that gives render.camera.position is fixed, any other auto; auto without "
+                "a head keeps the fixed camera.")
+        .choice("render.camera.hair", "reach", {"reach", "cache"},
+                "auto/follow: what bounds the hair. reach: the scalp grown by the hair's length (needs no "
+                "simulation, frames loosely: hair could stand straight up); cache: the hair itself, read from the "
+                "strand cache of every clip frame (tight; `hairpipe run` then simulates the whole clip before it "
+                "renders the first frame, and a run without the cache fails naming the missing file).")
+        .vec3("render.camera.position", 0, 0.05, 0.9, "m", "Camera position (mode fixed).")
+        .vec3("render.camera.target", 0, 0, 0, "m", "Point the camera looks at (mode fixed).")
         .vec3("render.camera.up", 0, 1, 0, "", "Up direction.")
+        .vec3("render.camera.facing", 0, 0, 1, "",
+              "auto/follow: the head's front in its rest pose (glTF heads face +Z); the view is turned from it.")
+        .number("render.camera.azimuth", 35, -180, 180, "deg",
+                "auto/follow: camera turned from the face about the up axis (0 = front, 35 = three-quarter, "
+                "positive toward the head's left, +X for a +Z face).")
+        .number("render.camera.elevation", 8, -80, 80, "deg", "auto/follow: camera raised above the head's level.")
+        .number("render.camera.margin", 0.06, 0, 0.9, "",
+                "auto/follow: fraction of the half-frame left empty at each border around the framed bounds.")
         .number("render.camera.fov", 40, 1, 170, "deg", "Vertical field of view.")
         .integer("render.camera.width", 1920, 16, 16384, "px", "Image width.")
         .integer("render.camera.height", 1080, 16, 16384, "px", "Image height.")

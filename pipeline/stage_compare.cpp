@@ -13,14 +13,49 @@ namespace fs = std::filesystem;
 
 namespace hp {
 
+namespace {
+
+/// A template as the compare job sees it: a relative path is under the
+/// output folder, an absolute one replaces it.
+std::string resolved(const fs::path& outputDir, const std::string& t) {
+    return (outputDir / t).lexically_normal().string();
+}
+
+/// What the sequence `key` names is, from the scene: the preview, the
+/// reference (renderer, shading, samples) or its Kajiya-Kay companion;
+/// otherwise the template itself. compare.<x>_label overrides it.
+std::string sequenceLabel(const Scene& scene, const fs::path& outputDir, const std::string& key) {
+    if (!scene.text(key + "_label").empty()) return scene.text(key + "_label");
+    const std::string path = resolved(outputDir, scene.text(key));
+    auto is = [&](const char* other) {
+        return !scene.text(other).empty() && resolved(outputDir, scene.text(other)) == path;
+    };
+    const std::string spp = cat(scene.integer("reference.samples"), " spp");
+    if (is("preview.exr") || is("preview.png")) return "preview (OpenGL)";
+    if (is("reference.exr") || is("reference.png"))
+        return cat("reference (Embree, ", scene.text("reference.mode"), ", ", spp, ")");
+    if (scene.flag("reference.kajiya_kay.enabled") && (is("reference.kajiya_kay.exr") || is("reference.kajiya_kay.png")))
+        return cat("reference (Embree, kajiya-kay, ", spp, ")");
+    return scene.text(key);
+}
+
+}  // namespace
+
 CompareJob compareJobFromScene(const Scene& scene, const fs::path& outputDir) {
     CompareJob job;
     for (const char* key : {"compare.a", "compare.b"})
         if (!hasFrameToken(scene.text(key)))
             scene.fail(key, "'" + scene.text(key) + "' has no frame number (use #### or %04d)");
-    // A relative path is under the output folder; an absolute one replaces it.
-    job.a = (outputDir / scene.text("compare.a")).lexically_normal().string();
-    job.b = (outputDir / scene.text("compare.b")).lexically_normal().string();
+    if (!scene.text("compare.beside").empty() && !hasFrameToken(scene.text("compare.beside")))
+        scene.fail("compare.beside", "'" + scene.text("compare.beside") + "' has no frame number (use #### or %04d)");
+    job.a = resolved(outputDir, scene.text("compare.a"));
+    job.b = resolved(outputDir, scene.text("compare.b"));
+    job.aLabel = sequenceLabel(scene, outputDir, "compare.a");
+    job.bLabel = sequenceLabel(scene, outputDir, "compare.b");
+    if (!scene.text("compare.beside").empty()) {
+        job.beside = resolved(outputDir, scene.text("compare.beside"));
+        job.besideLabel = sequenceLabel(scene, outputDir, "compare.beside");
+    }
     job.outputDir = (outputDir / scene.text("compare.output")).lexically_normal();
     const std::string& report = scene.text("compare.report");
     if (!report.empty()) job.report = (outputDir / report).lexically_normal();

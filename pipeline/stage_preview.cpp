@@ -3,12 +3,15 @@
 // One headless GL context serves the whole run, created on the first frame
 // that needs it (so resumed runs with nothing to do never touch GL).
 #include "core/log.h"
+#include "pipeline/camera_track.h"
 #include "pipeline/output.h"
 #include "pipeline/path_template.h"
 #include "pipeline/preview_settings.h"
 #include "pipeline/stages.h"
 #include "pipeline/view_settings.h"
 #include "render/gl_context.h"
+
+#include <optional>
 
 namespace fs = std::filesystem;
 
@@ -19,8 +22,9 @@ namespace {
 class PreviewStage final : public FrameStage {
   public:
     PreviewStage(const Scene& scene, const ShotSettings& shot)
-        : view_(makeView(scene)), display_(makeDisplaySettings(scene)), settings_(makePreviewSettings(scene)),
-          outputDir_(shot.outputDir) {
+        : view_(makeView(scene)), scene_(scene), display_(makeDisplaySettings(scene)),
+          settings_(makePreviewSettings(scene)), outputDir_(shot.outputDir) {
+        checkCameraKeys(scene);
         for (const char* key : {"preview.exr", "preview.png"}) {
             const std::string& t = scene.text(key);
             if (!t.empty() && !hasFrameToken(t))
@@ -55,7 +59,9 @@ class PreviewStage final : public FrameStage {
             frame.head = &data.head->mesh;
             frame.headTransform = data.head->transform;
         }
-        const Image image = renderer_->render(view_, frame);
+        View view = view_;
+        view.camera = cameraAt(data.frame);
+        const Image image = renderer_->render(view, frame);
         ImageWriteOptions options;
         options.metadata = {{"hairpipe:scene", sceneName_},
                             {"hairpipe:frame", std::to_string(data.frame)},
@@ -84,6 +90,14 @@ class PreviewStage final : public FrameStage {
     }
 
     View view_;
+    Scene scene_;  ///< a copy: callers may pass a temporary scene
+    std::optional<CameraTrack> track_;  ///< made on the first frame: it may read the strand cache
+
+    /// The camera of `frame` (camera auto reads the clip once, on first use).
+    const Camera& cameraAt(int frame) {
+        if (!track_) track_ = makeCameraTrack(scene_, view_.camera, outputDir_);
+        return track_->at(frame);
+    }
     DisplaySettings display_;  // PNG frames only; EXRs stay linear
     PreviewSettings settings_;
     fs::path outputDir_;

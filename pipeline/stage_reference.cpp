@@ -1,6 +1,7 @@
 // The "reference" frame stage: renders each frame's strands and head with the
 // Embree reference renderer (render/reference.h) and writes EXR (+ PNG).
 #include "core/log.h"
+#include "pipeline/camera_track.h"
 #include "pipeline/output.h"
 #include "pipeline/path_template.h"
 #include "pipeline/stages.h"
@@ -9,6 +10,8 @@
 
 #include <algorithm>
 #include <cmath>
+
+#include <optional>
 
 namespace fs = std::filesystem;
 
@@ -45,23 +48,40 @@ std::string checkedTemplate(const Scene& s, const std::string& key, bool require
     return t;
 }
 
+/// One sequence the stage writes: its shading and file templates.
+struct ReferenceOutput {
+    ReferenceSettings settings;
+    std::string exr, png;
+};
+
 class ReferenceStage final : public FrameStage {
   public:
     ReferenceStage(const Scene& scene, const ShotSettings& shot)
-        : shot_(shot), view_(makeView(scene)), display_(makeDisplaySettings(scene)),
-          settings_(referenceSettings(scene, shot)),
-          exr_(checkedTemplate(scene, "reference.exr", true)), png_(checkedTemplate(scene, "reference.png", false)),
-          sceneName_(scene.name()) {
-        const double scale = scene.number("reference.scale");
-        view_.camera.width = std::max(1, int(std::lround(view_.camera.width * scale)));
-        view_.camera.height = std::max(1, int(std::lround(view_.camera.height * scale)));
+        : shot_(shot), view_(makeView(scene)), scene_(scene), display_(makeDisplaySettings(scene)),
+          scale_(scene.number("reference.scale")), sceneName_(scene.name()) {
+        checkCameraKeys(scene);
+        sequences_.push_back({referenceSettings(scene, shot), checkedTemplate(scene, "reference.exr", true),
+                              checkedTemplate(scene, "reference.png", false)});
+        if (scene.flag("reference.kajiya_kay.enabled")) {
+            if (sequences_.front().settings.mode != ReferenceMode::Physical)
+                scene.fail("reference.kajiya_kay.enabled",
+                           "adds a Kajiya-Kay reference beside a physical one, but reference.mode is already "
+                           "kajiya-kay");
+            ReferenceOutput kk = sequences_.front();
+            kk.settings.mode = ReferenceMode::KajiyaKay;
+            kk.exr = checkedTemplate(scene, "reference.kajiya_kay.exr", true);
+            kk.png = checkedTemplate(scene, "reference.kajiya_kay.png", false);
+            if (kk.exr == sequences_.front().exr)
+                scene.fail("reference.kajiya_kay.exr", "must differ from reference.exr, or one overwrites the other");
+            sequences_.push_back(std::move(kk));
+        }
     }
 
     std::string name() const override { return "reference"; }
 
     std::vector<fs::path> outputs(int frame) const override {
-        std::vector<fs::path> out{shot_.outputDir / expandFrame(exr_, frame)};
-        if (!png_.empty()) out.push_back(shot_.outputDir / expandFrame(png_, frame));
+        std::vector<fs::path> out;
+        for (const ReferenceOutput& s : sequences_) append(out, s, frame);
         return out;
     }
 
@@ -71,8 +91,21 @@ class ReferenceStage final : public FrameStage {
             throw FrameError(cat("frame ", data.frame,
                                  " has neither strands nor a head to render (no hair or head stage produced them)"));
         if (!data.strands) logVerbose("reference: frame ", data.frame, " has no strands; rendering the head alone");
+        View view = view_;
+        view.camera = cameraAt(data.frame);
+        view.camera.width = std::max(1, int(std::lround(view.camera.width * scale_)));
+        view.camera.height = std::max(1, int(std::lround(view.camera.height * scale_)));
+        for (const ReferenceOutput& s : sequences_) render(view, s, data, head);
+    }
 
-        ReferenceSettings settings = settings_;
+  private:
+    void append(std::vector<fs::path>& out, const ReferenceOutput& s, int frame) const {
+        out.push_back(shot_.outputDir / expandFrame(s.exr, frame));
+        if (!s.png.empty()) out.push_back(shot_.outputDir / expandFrame(s.png, frame));
+    }
+
+    void render(const View& view, const ReferenceOutput& sequence, const FrameData& data, const TriangleMesh* head) {
+        ReferenceSettings settings = sequence.settings;
         settings.frame = data.frame;
         int lastDecile = 0;
         settings.progress = [&](size_t done, size_t total) {
@@ -83,7 +116,7 @@ class ReferenceStage final : public FrameStage {
             }
         };
         ReferenceStats stats;
-        const Image image = renderer_.render(view_, data.strands, head, settings, &stats);
+        const Image image = renderer_.render(view, data.strands, head, settings, &stats);
         logVerbose("reference: frame ", data.frame, ": ", stats.strands, " strands, ", settings.samplesPerPixel,
                    " spp, ", referenceModeName(settings.mode), ", build ", stats.buildSeconds, " s, render ",
                    stats.renderSeconds, " s, Embree ", stats.sceneBytes / (1 << 20), " MiB");
@@ -96,18 +129,27 @@ class ReferenceStage final : public FrameStage {
                             {"hairpipe:mode", referenceModeName(settings.mode)},
                             {"hairpipe:samples", std::to_string(settings.samplesPerPixel)},
                             {"hairpipe:strands", std::to_string(stats.strands)}};
-        const std::vector<fs::path> paths = outputs(data.frame);
+        std::vector<fs::path> paths;
+        append(paths, sequence, data.frame);
         for (const fs::path& path : paths)
             writeAtomically(path, [&](const fs::path& tmp) { writeImageWithDisplay(tmp.string(), image, display_, options); });
     }
 
-  private:
     ShotSettings shot_;
     View view_;
+    Scene scene_;  ///< a copy: callers may pass a temporary scene
+    std::optional<CameraTrack> track_;  ///< made on the first frame: it may read the strand cache
+
+    /// The camera of `frame` (camera auto reads the clip once, on first use).
+    const Camera& cameraAt(int frame) {
+        if (!track_) track_ = makeCameraTrack(scene_, view_.camera, shot_.outputDir);
+        return track_->at(frame);
+    }
     DisplaySettings display_;  // PNG frames only; EXRs stay linear
-    ReferenceSettings settings_;
-    std::string exr_, png_;
+    double scale_;
     std::string sceneName_;
+    /// The scene's reference, then (reference.kajiya_kay.enabled) its Kajiya-Kay companion.
+    std::vector<ReferenceOutput> sequences_;
     ReferenceRenderer renderer_;  // one Embree device for the whole shot
 };
 

@@ -24,6 +24,11 @@ set(_hp_slow_tests
   test_collision_world:CollisionWorld.HairOnAShoulderBoxStaysOnIt  # 300 solver steps
   test_collision_world:CollisionWorld.PropColliderFromASecondFile  # head import + grid
   test_stress_clip:StressClip.DISABLED_NoStretchNoPenetrationAfterAnyFrameOnOneAndTwoThreads  # two 62-frame shots
+  test_camera:CameraAuto.ProjectHeadAndHairStayInFrame         # 2 x 84 frames projected
+  test_camera:CameraAuto.FoxStaysInFrame
+  test_camera:CameraAuto.StressClipIsReframedAtItsSceneCut
+  test_camera:CameraAuto.RenderedBorderHasNoCoverage            # 3 Embree frames
+  test_camera:CameraAuto.RunSimulatesTheClipFirstAndChunksFrameAlike  # 3 hairpipe runs
 )
 foreach(_entry IN LISTS _hp_slow_tests)
   string(REPLACE ":" ";" _parts "${_entry}")

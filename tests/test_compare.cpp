@@ -3,6 +3,8 @@
 // the compare stage of `hairpipe run`, and the HTML report in headless Chromium.
 #include "core/errors.h"
 #include "pipeline/compare_job.h"
+#include "pipeline/compare_report.h"
+#include "pipeline/scene.h"
 #include "pipeline/compare_table.h"
 #include "pipeline/path_template.h"
 #include "render/colormap.h"
@@ -598,3 +600,35 @@ TEST(CompareReport, IsSelfContainedAndRendersInHeadlessChromium) {
     EXPECT_EQ(bodyAttribute(bad, "data-status"), "error");
     EXPECT_EQ(bodyAttribute(bad, "data-broken"), "1");
 }
+
+namespace hp {
+
+TEST(CompareReport, SidesAreLabelledFromTheScene) {
+    const Scene scene = Scene::parse("reference: {mode: physical, samples: 8, kajiya_kay: {enabled: true}}\n"
+                                     "compare: {b: reference/kajiya-kay.####.exr, beside: reference/reference.####.exr}\n",
+                                     "labels.yaml", ".");
+    const CompareJob job = compareJobFromScene(scene, "/tmp/shot");
+    EXPECT_EQ(job.aLabel, "preview (OpenGL)");
+    EXPECT_EQ(job.bLabel, "reference (Embree, kajiya-kay, 8 spp)");
+    EXPECT_EQ(job.beside, "/tmp/shot/reference/reference.####.exr");
+    EXPECT_EQ(job.besideLabel, "reference (Embree, physical, 8 spp)");
+    const std::string html = compareReportHtml(job, {});
+    EXPECT_NE(html.find("A: preview (OpenGL)"), std::string::npos);
+    EXPECT_NE(html.find("beside: reference (Embree, physical, 8 spp)"), std::string::npos);
+    EXPECT_NE(html.find("measured pair"), std::string::npos);
+    EXPECT_EQ(html.find("A (reference)"), std::string::npos);
+    EXPECT_EQ(html.find("B (test)"), std::string::npos);
+    // A label the scene gives wins; an unknown sequence is named by its template.
+    const CompareJob other = compareJobFromScene(
+        Scene::parse("compare: {a: other/x.####.exr, b_label: my render}\n", "labels.yaml", "."), "/tmp/shot");
+    EXPECT_EQ(other.aLabel, "other/x.####.exr");
+    EXPECT_EQ(other.bLabel, "my render");
+    try {
+        compareJobFromScene(Scene::parse("compare: {beside: still.exr}\n", "labels.yaml", "."), "/tmp/shot");
+        FAIL() << "a beside template without a frame number must be refused";
+    } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("compare.beside"), std::string::npos) << e.what();
+    }
+}
+
+}  // namespace hp

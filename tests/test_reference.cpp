@@ -375,3 +375,39 @@ TEST(ReferenceStage, DisabledOrBadTemplates) {
         EXPECT_NE(std::string(e.what()).find("frame token"), std::string::npos) << e.what();
     }
 }
+
+TEST(ReferenceStage, KajiyaKayCompanionBesidePhysical) {
+    TempDir dir;
+    ShotSettings shot;
+    shot.outputDir = dir.path();
+    const StagePtr stage =
+        makeReferenceStage(referenceScene("  mode: physical\n  png: \"\"\n  kajiya_kay: {enabled: true, png: \"\"}\n"), shot);
+    ASSERT_EQ(stage->outputs(1), (std::vector<std::filesystem::path>{dir.path() / "reference/reference.0001.exr",
+                                                                     dir.path() / "reference/kajiya-kay.0001.exr"}));
+    HeadPose pose;
+    pose.mesh = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
+    FrameData data;
+    data.frame = 1;
+    data.head = &pose;
+    stage->run(data);
+    const Image physical = readImage(stage->outputs(1)[0].string());
+    const Image kk = readImage(stage->outputs(1)[1].string());
+    ASSERT_EQ(physical.width, kk.width);
+    // Same camera, samples and seed: the same coverage, pixel for pixel; a different shading of the head.
+    double alphaDiff = 0.0, colourDiff = 0.0;
+    const int a = physical.channelIndex("A");
+    for (int y = 0; y < kk.height; ++y)
+        for (int x = 0; x < kk.width; ++x) {
+            alphaDiff += std::abs(physical.at(x, y, a) - kk.at(x, y, a));
+            colourDiff += std::abs(physical.at(x, y, 0) - kk.at(x, y, 0));
+        }
+    EXPECT_EQ(alphaDiff, 0.0);
+    EXPECT_GT(colourDiff, 1.0);
+
+    try {
+        makeReferenceStage(referenceScene("  kajiya_kay: {enabled: true}\n"), shot);
+        FAIL() << "a Kajiya-Kay companion of a Kajiya-Kay reference must be refused";
+    } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("reference.kajiya_kay.enabled"), std::string::npos) << e.what();
+    }
+}
