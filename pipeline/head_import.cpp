@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <map>
 #include <system_error>
 
@@ -182,6 +183,21 @@ RigClip convertClip(const aiAnimation* a, const std::map<std::string, int>& node
     return c;
 }
 
+/// Metres per unit an FBX file declares: assimp's FBX importer copies
+/// GlobalSettings' UnitScaleFactor (centimetres per unit) into the scene
+/// metadata without applying it. 0 when absent or not a positive number.
+double declaredUnitScale(const aiScene* scene) {
+    if (!scene->mMetaData) return 0.0;
+    double cm = 0.0;
+    float cmf = 0.f;
+    int32_t cmi = 0;
+    if (!scene->mMetaData->Get("UnitScaleFactor", cm)) {
+        if (scene->mMetaData->Get("UnitScaleFactor", cmf)) cm = cmf;
+        else if (scene->mMetaData->Get("UnitScaleFactor", cmi)) cm = cmi;
+    }
+    return std::isfinite(cm) && cm > 0.0 ? cm / 100.0 : 0.0;
+}
+
 }  // namespace
 
 Eigen::Matrix3f upAxisRotation(UpAxis up) {
@@ -249,8 +265,10 @@ HeadRig importHead(const HeadImportSettings& settings) {
     for (unsigned i = 0; i < scene->mNumAnimations; ++i)
         rig.clips.push_back(convertClip(scene->mAnimations[i], nodeIndex, instances));
 
+    rig.fileUnitScale = declaredUnitScale(scene);
+    rig.unitScale = settings.unitScaleGiven || rig.fileUnitScale <= 0.0 ? settings.unitScale : rig.fileUnitScale;
     rig.placement = settings.placement;
-    rig.placement.linear() *= upAxisRotation(settings.upAxis) * float(settings.unitScale);
+    rig.placement.linear() *= upAxisRotation(settings.upAxis) * float(rig.unitScale);
     logVerbose("head: ", file, ": ", rig.meshes.size(), " meshes, ", rig.triangleCount(), " triangles, ",
                rig.boneCount(), " bones, ", rig.morphCount(), " morph targets, ", rig.clips.size(), " clips");
     return rig;
