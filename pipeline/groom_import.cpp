@@ -140,6 +140,9 @@ ImportedGroom importGroom(const Scene& scene, const HeadSetup& head, int vertice
         }
         for (uint32_t i : chooseGuides(features, guideCount)) isGuide[kept[i]] = 1;
     }
+    for (int pass = 0; pass < 2; ++pass)
+        for (uint32_t s : kept)
+            if (isGuide[s] == (pass == 0)) g.sources.push_back(s);
     for (uint32_t s : kept) {
         if (isGuide[s]) {
             g.roots.guides.push_back(roots[s]);

@@ -32,6 +32,8 @@ struct ImportedGroom {
     GroomRoots roots;           ///< guides: chosen strands; followers: the others (or procedural ones)
     RestShapes guideShapes;     ///< root-local rest shapes, [t, n, t × n] frames, `vertices` points each
     RestShapes followerShapes;  ///< one per follower root when the groom is dense; empty otherwise
+    /// The file's strand index of each guide, then of each follower (dense grooms).
+    std::vector<uint32_t> sources;
     size_t read = 0;            ///< strands in the file
     size_t dropped = 0;         ///< strands too far from the scalp
 };

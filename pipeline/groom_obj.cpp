@@ -28,7 +28,7 @@ GroomCurves readObjCurves(const std::filesystem::path& path) {
         if (!(mesh->mPrimitiveTypes & aiPrimitiveType_LINE)) continue;
         for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
             const aiFace& face = mesh->mFaces[f];
-            if (face.mNumIndices < 2) continue;  // points and faces of other kinds
+            if (face.mNumIndices != 2) continue;  // points, triangles and polygons are not strands
             for (unsigned i = 0; i < face.mNumIndices; ++i) {
                 if (face.mIndices[i] >= mesh->mNumVertices)
                     throw AssetError(name, cat("a line refers to vertex ", face.mIndices[i] + 1, " of ", mesh->mNumVertices));

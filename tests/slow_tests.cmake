@@ -16,6 +16,9 @@ set(_hp_slow_tests
   test_shot_simulation:ShotSimulation.CheckpointRestoreContinuesBitForBit
   test_sim_guards:SimGuards.LongViolentRunStaysBoundedAndFinite  # 10^4+ steps
   test_resources:Resources.ResidentMemoryDoesNotGrowOverThirtyFrames  # 30 frames
+  test_groom:Units.FbxInCentimetresIsReadInMetresAndInfoSaysSo  # two hairpipe runs
+  test_groom:Settle.ConvergesLiesOnTheHeadHoldsStillAndIsReusedByteForByte  # three settles
+  test_groom:GroomImport.ExportedUsdaImportsBackAsTheCachedFrame  # sim + export-usd runs
 )
 foreach(_entry IN LISTS _hp_slow_tests)
   string(REPLACE ":" ";" _parts "${_entry}")
