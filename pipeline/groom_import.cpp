@@ -14,17 +14,6 @@ namespace hp {
 
 namespace {
 
-/// The followers' root frame [t, n, t × n] (sim/followers.cpp: Gram-Schmidt,
-/// so slightly inexact mesh frames give the same axes there and here).
-Eigen::Matrix3f rootAxes(const SurfaceFrame& f) {
-    const Vec3f n = f.normal.normalized();
-    Vec3f t = f.tangent - n * n.dot(f.tangent);
-    t = t.norm() > 1e-6f ? Vec3f(t.normalized()) : Vec3f(n.unitOrthogonal());
-    Eigen::Matrix3f m;
-    m << t, n, t.cross(n);
-    return m;
-}
-
 /// `n` points evenly spaced along the arc length of the polyline p[0, count).
 std::vector<Vec3f> resample(const Vec3f* p, size_t count, int n) {
     std::vector<float> arc(count, 0.f);
@@ -73,6 +62,15 @@ std::vector<uint32_t> chooseGuides(const std::vector<std::array<Vec3f, 3>>& feat
 }
 
 }  // namespace
+
+Eigen::Matrix3f rootAxes(const SurfaceFrame& f) {
+    const Vec3f n = f.normal.normalized();
+    Vec3f t = f.tangent - n * n.dot(f.tangent);
+    t = t.norm() > 1e-6f ? Vec3f(t.normalized()) : Vec3f(n.unitOrthogonal());
+    Eigen::Matrix3f m;
+    m << t, n, t.cross(n);
+    return m;
+}
 
 bool sceneHasGroomFile(const Scene& scene) { return !scene.file("hair.groom.file").empty(); }
 

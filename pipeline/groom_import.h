@@ -45,6 +45,10 @@ bool sceneHasGroomFile(const Scene& scene);
 /// AssetError naming the file, SceneError at the key for settings).
 ImportedGroom importGroom(const Scene& scene, const HeadSetup& head, int vertices);
 
+/// The followers' root frame [t, n, t × n] of a surface frame as columns
+/// (Gram-Schmidt, as sim/followers.cpp, so inexact mesh frames agree).
+Eigen::Matrix3f rootAxes(const SurfaceFrame& frame);
+
 /// @brief World-space strands of root-local `shapes` at the root frames
 /// `roots` (one per shape): x = t, y = n, z = t × n of each (Gram-Schmidt).
 std::vector<std::vector<Vec3f>> strandsAt(const RestShapes& shapes, const std::vector<SurfaceFrame>& roots);

@@ -220,7 +220,10 @@ HeadSetup loadHead(const Scene& scene) {
     if (!h.scalpGiven) {
         std::string why;
         scalp = defaultScalp(*h.rig, h.rest, why);
-        logInfo("head: hair grows on ", why, "; choose another scalp with head.scalp.method (material, "
+        // An imported groom binds to every triangle; the scalp then only
+        // places procedural followers, not worth a line.
+        if (scene.file("hair.groom.file").empty())
+            logInfo("head: hair grows on ", why, "; choose another scalp with head.scalp.method (material, "
                 "vertex_color, texture, region, or all for every triangle)");
     }
     h.scalpUsed = scalp;

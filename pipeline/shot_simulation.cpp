@@ -132,17 +132,18 @@ class CurlyWetModel final : public GuideModel {
 };
 
 /// Rest shapes of the guides in their own root frames (x = tangent,
-/// y = normal, z = tangent × normal), from the guides as written at t0.
+/// y = normal, z = tangent × normal: the followers' frame, sim/followers.h),
+/// from the guides as written at t0. (The frame's z once was normal ×
+/// tangent, a mirror image: a guide's rest shape with any sideways part then
+/// read as a rotation away from rest, and the followers turned by it.)
 RestShapes restShapes(const StrandFrame& guides, const std::vector<SurfaceFrame>& roots) {
     RestShapes shapes;
     std::vector<Vec3f> local;
     for (size_t g = 0; g < roots.size(); ++g) {
-        const SurfaceFrame& r = roots[g];
-        Eigen::Matrix3f toWorld;
-        toWorld << r.tangent, r.normal, r.bitangent();
+        const Eigen::Matrix3f toWorld = rootAxes(roots[g]);
         const uint32_t first = guides.first(g), n = guides.vertexCount(g);
         local.resize(n);
-        for (uint32_t v = 0; v < n; ++v) local[v] = toWorld.transpose() * (guides.positions[first + v] - r.position);
+        for (uint32_t v = 0; v < n; ++v) local[v] = toWorld.transpose() * (guides.positions[first + v] - roots[g].position);
         shapes.add(local.data(), n);
     }
     return shapes;

@@ -254,7 +254,10 @@ TestGroom makeGroom(const HeadSetup& head, size_t count) {
         if (head.scalp[t]) scalp.push_back(t);
     TestGroom g;
     for (size_t i = 0; i < count; ++i) {
-        const SurfaceFrame f = evaluate(head.rest, SurfacePoint{scalp[i * scalp.size() / count], 1.f / 3, 1.f / 3});
+        // Roots anywhere on their triangles (near corners too), so neighbouring
+        // roots' tangent frames differ (mesh tangents follow triangle edges).
+        const float b1 = 0.05f + 0.9f * float(i % 7) / 7.f, b2 = (1.f - b1) * float(i % 3) / 3.f;
+        const SurfaceFrame f = evaluate(head.rest, SurfacePoint{scalp[i * scalp.size() / count], b1, b2});
         const Vec3f n = f.normal.normalized();
         const Vec3f t = (f.tangent - n * n.dot(f.tangent)).normalized();
         const Vec3f root = f.position, corner = root + kUp * n;
