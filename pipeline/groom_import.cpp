@@ -162,6 +162,25 @@ ImportedGroom importGroom(const Scene& scene, const HeadSetup& head, int vertice
     return g;
 }
 
+RestShapes nearestGuideShapes(const StrandFrame& guides, const std::vector<SurfaceFrame>& guideRoots,
+                              const std::vector<SurfaceFrame>& followerRoots) {
+    const size_t F = followerRoots.size();
+    std::vector<std::vector<Vec3f>> local(F);
+    tbb::parallel_for(size_t(0), F, [&](size_t f) {
+        const Vec3f& p = followerRoots[f].position;
+        size_t best = 0;  // lowest index among equals: deterministic
+        for (size_t g = 1; g < guideRoots.size(); ++g)
+            if ((guideRoots[g].position - p).squaredNorm() < (guideRoots[best].position - p).squaredNorm()) best = g;
+        const Eigen::Matrix3f axes = rootAxes(followerRoots[f]);
+        const Vec3f& root = guides.positions[guides.first(best)];
+        for (uint32_t v = 0; v < guides.vertexCount(best); ++v)
+            local[f].push_back(axes.transpose() * (guides.positions[guides.first(best) + v] - root));
+    });
+    RestShapes shapes;
+    for (const auto& l : local) shapes.add(l.data(), l.size());
+    return shapes;
+}
+
 std::vector<std::vector<Vec3f>> strandsAt(const RestShapes& shapes, const std::vector<SurfaceFrame>& roots) {
     std::vector<std::vector<Vec3f>> out(shapes.count());
     for (size_t s = 0; s < out.size(); ++s) {

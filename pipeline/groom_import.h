@@ -49,6 +49,15 @@ ImportedGroom importGroom(const Scene& scene, const HeadSetup& head, int vertice
 /// (Gram-Schmidt, as sim/followers.cpp, so inexact mesh frames agree).
 Eigen::Matrix3f rootAxes(const SurfaceFrame& frame);
 
+/// @brief Rest shapes for followers that copy the world-space shape of their
+/// nearest guide (by root distance), moved to their own root: for grooms
+/// that gravity shaped (settled or imported), where copying the guide's
+/// root-local shape instead would turn hair that hangs beside a guide on
+/// the side of the head into hair that sticks out from the crown.
+/// `guides` holds the guides at rest (strand g at `guideRoots[g]`).
+RestShapes nearestGuideShapes(const StrandFrame& guides, const std::vector<SurfaceFrame>& guideRoots,
+                              const std::vector<SurfaceFrame>& followerRoots);
+
 /// @brief World-space strands of root-local `shapes` at the root frames
 /// `roots` (one per shape): x = t, y = n, z = t × n of each (Gram-Schmidt).
 std::vector<std::vector<Vec3f>> strandsAt(const RestShapes& shapes, const std::vector<SurfaceFrame>& roots);

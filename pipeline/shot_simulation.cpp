@@ -215,6 +215,8 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame, c
     for (uint32_t v = 1; v < rest.vertexCount(0); ++v) length += (rest.positions[v] - rest.positions[v - 1]).norm();
     groom.followerLengths = {length};
     if (imported) groom.followerShapes = std::move(imported->followerShapes);
+    if (groom.followerShapes.count() == 0 && (imported || settleRan_))
+        groom.followerShapes = nearestGuideShapes(rest, guideFrames_, followerFrames_);
     FollowerSettings followerOptions = followerSettings(scene);
     if (usesCurlyWetModel(scene)) {
         const CurlyWetSettings curly = curlyWetSettings(scene);
@@ -239,22 +241,32 @@ void ShotSimulation::initializeGuides(const GuideSettings& settings, const Impor
     }
     std::vector<std::vector<Vec3f>> strands;
     bool shaped = false;
+    auto combed = [&](float droop, const Vec3f& direction) {
+        GroomSettings groom;
+        groom.style = GroomStyle::Combed;
+        groom.segments = settings.segments;
+        groom.length = settings.length;
+        groom.droop = droop;
+        groom.direction = direction;
+        groom.clearance = 2.f * settings.collisionRadius;
+        return groomStrands(guideFrames_, groom, pose_.collider.get());
+    };
     if (imported) {
         // The user's groom, as drawn: its shape is the rest shape.
         strands = strandsAt(imported->guideShapes, guideFrames_);
         shaped = true;
     } else if (scene_.text("hair.groom.style") == "combed") {
-        GroomSettings groom;
-        groom.style = GroomStyle::Combed;
-        groom.segments = settings.segments;
-        groom.length = settings.length;
-        groom.droop = float(scene_.number("hair.groom.droop"));
-        groom.direction = scene_.vec3f("hair.groom.direction");
-        groom.clearance = 2.f * settings.collisionRadius;
-        strands = groomStrands(guideFrames_, groom, pose_.collider.get());
+        strands = combed(float(scene_.number("hair.groom.droop")), scene_.vec3f("hair.groom.direction"));
         shaped = true;
     }
     const double settle = scene_.number("hair.groom.settle");
+    if (!imported && settle > 0 && !shaped) {
+        // A straight strand on the crown stands exactly against gravity, a
+        // balance it never leaves: tilt the straight groom a little toward
+        // the back (-Z, the default scalp's side) before it settles.
+        strands = combed(0.2f, Vec3f(0.f, 0.f, -1.f));
+        shaped = true;
+    }
     if (!imported && settle > 0) {
         SettledGroom s = settleGroom(settings, guideFrames_, pose_, shaped ? &strands : nullptr, settle,
                                      float(scene_.number("hair.groom.settle_stiffness")), settleCache,

@@ -214,6 +214,12 @@ TEST(Settle, ConvergesLiesOnTheHeadHoldsStillAndIsReusedByteForByte) {
             EXPECT_GT(pose.collider->signedDistance(f1.positions[f1.first(g) + v]), -1e-3f) << "guide " << g << " vertex " << v;
     }
     EXPECT_GT(below, first.guideCount() * 3 / 4) << "most tips hang below their roots";
+    // Followers copy their nearest guide's hanging shape (in world space, not
+    // in their own root frame, which would turn it out from the crown).
+    size_t followersBelow = 0;
+    for (size_t s = first.guideCount(); s < f1.strandCount(); ++s)
+        followersBelow += f1.positions[f1.first(s) + f1.vertexCount(s) - 1].y() < f1.positions[f1.first(s)].y() - 0.05f;
+    EXPECT_GT(followersBelow, first.followerCount() * 3 / 4) << "most follower tips hang 5 cm below their roots";
     // The settled shape is the rest shape: the head is still over the clip's
     // first frames, and so is the hair (no sag, no bounce).
     const StrandFrame f4 = first.advanceTo(4);
