@@ -198,6 +198,17 @@ double declaredUnitScale(const aiScene* scene) {
     return std::isfinite(cm) && cm > 0.0 ? cm / 100.0 : 0.0;
 }
 
+/// The up axis an FBX file declares (assimp copies GlobalSettings' UpAxis, 0 =
+/// X, 1 = Y, 2 = Z, and UpAxisSign into the metadata); 0 when absent or
+/// negative (a down axis has no up_axis equivalent).
+char declaredUpAxis(const aiScene* scene) {
+    int32_t axis = -1, sign = 1;
+    if (!scene->mMetaData || !scene->mMetaData->Get("UpAxis", axis)) return 0;
+    scene->mMetaData->Get("UpAxisSign", sign);
+    if (sign < 0 || axis < 0 || axis > 2) return 0;
+    return "xyz"[axis];
+}
+
 }  // namespace
 
 Eigen::Matrix3f upAxisRotation(UpAxis up) {
@@ -267,8 +278,12 @@ HeadRig importHead(const HeadImportSettings& settings) {
 
     rig.fileUnitScale = declaredUnitScale(scene);
     rig.unitScale = settings.unitScaleGiven || rig.fileUnitScale <= 0.0 ? settings.unitScale : rig.fileUnitScale;
+    rig.fileUpAxis = declaredUpAxis(scene);
+    UpAxis up = settings.upAxis;
+    if (!settings.upAxisGiven && rig.fileUpAxis) up = rig.fileUpAxis == 'z' ? UpAxis::Z : rig.fileUpAxis == 'x' ? UpAxis::X : UpAxis::Y;
+    rig.upAxis = up == UpAxis::Z ? 'z' : up == UpAxis::X ? 'x' : 'y';
     rig.placement = settings.placement;
-    rig.placement.linear() *= upAxisRotation(settings.upAxis) * float(rig.unitScale);
+    rig.placement.linear() *= upAxisRotation(up) * float(rig.unitScale);
     logVerbose("head: ", file, ": ", rig.meshes.size(), " meshes, ", rig.triangleCount(), " triangles, ",
                rig.boneCount(), " bones, ", rig.morphCount(), " morph targets, ", rig.clips.size(), " clips");
     return rig;

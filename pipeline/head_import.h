@@ -11,7 +11,9 @@
 //   Unless the scene sets it, the file's own unit is used where assimp
 //   exposes one: an FBX file's GlobalSettings UnitScaleFactor (centimetres
 //   per unit) in the scene metadata. glTF is metres by specification, and
-//   assimp already applies a Collada file's <unit>.
+//   assimp already applies a Collada file's <unit>. The same for the up
+//   axis: an FBX file's UpAxis (X, Y or Z, positive sign) unless the scene
+//   sets head.up_axis.
 // - `upAxis` names the asset's up axis; Z up is turned to Y up by a -90°
 //   rotation about X ((x, y, z) -> (x, z, -y)), X up by +90° about Z.
 // - `placement` (the scene's translate/rotate) is applied last, in metres.
@@ -41,6 +43,9 @@ struct HeadImportSettings {
     /// declares (FBX UnitScaleFactor) replaces `unitScale`.
     bool unitScaleGiven = true;
     UpAxis upAxis = UpAxis::Y;
+    /// False: the scene leaves head.up_axis unset, so an up axis the file
+    /// declares (FBX UpAxis) replaces `upAxis`.
+    bool upAxisGiven = true;
     Affine3f placement = Affine3f::Identity();
 };
 

@@ -100,6 +100,9 @@ struct HeadRig {
     /// Metres per file unit applied (head.unit_scale, or the file's own
     /// when the scene does not set it).
     double unitScale = 1.0;
+    /// The up axis the file declares ('x', 'y', 'z'; FBX GlobalSettings
+    /// UpAxis with a positive sign), 0: none; and the one applied.
+    char fileUpAxis = 0, upAxis = 'y';
 
     size_t vertexCount() const;
     size_t triangleCount() const;

@@ -58,6 +58,7 @@ HeadImportSettings headImportSettings(const Scene& scene) {
     s.unitScale = scene.number("head.unit_scale");
     s.unitScaleGiven = scene.given("head.unit_scale");
     s.upAxis = sceneUpAxis(scene, "head");
+    s.upAxisGiven = scene.given("head.up_axis");
     s.placement = scenePlacement(scene, "head");
     return s;
 }

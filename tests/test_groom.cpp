@@ -164,10 +164,24 @@ TEST(Units, FbxInCentimetresIsReadInMetresAndInfoSaysSo) {
     settings.unitScale = 0.001;
     EXPECT_NEAR(importHead(settings).restMesh().bounds().sizes().y(), 0.1f * (2.2f * r + r), 1e-4f);
 
+    // The file's up axis: the same data declared Z up turns its Y extent into Z.
+    std::string zUp = readFile(dir / "cm.fbx");
+    const std::string yAxis = "\"UpAxis\", \"int\", \"Integer\", \"\", 1";
+    ASSERT_NE(zUp.find(yAxis), std::string::npos) << "assimp's FBX exporter no longer writes UpAxis 1";
+    zUp.replace(zUp.find(yAxis), yAxis.size(), "\"UpAxis\", \"int\", \"Integer\", \"\", 2");
+    writeFile(dir / "zup.fbx", zUp);
+    settings.file = dir / "zup.fbx";
+    settings.unitScaleGiven = false;
+    settings.upAxisGiven = false;
+    const HeadRig zRig = importHead(settings);
+    EXPECT_EQ(zRig.fileUpAxis, 'z');
+    EXPECT_NEAR(zRig.restMesh().bounds().sizes().z(), 2.2f * r + r, 1e-3f) << "the file's Y extent, now along Z";
+
     writeFile(dir / "s.yaml", "head: {file: cm.fbx, collider: {method: none}}\n");
     const ProcessResult info = runHairpipe("info s.yaml", dir.path());
     EXPECT_EQ(info.exitCode, 0) << info.output;
     EXPECT_NE(info.output.find("unit:      0.01 m per file unit (the file declares 0.01 m"), std::string::npos) << info.output;
+    EXPECT_NE(info.output.find("up axis:   y (the file declares y"), std::string::npos) << info.output;
     // The same head as an OBJ, which declares no unit: 31 m... no, 0.31 m
     // read as 31 m tall: warned about, naming head.unit_scale.
     writeFile(dir / "o.yaml", "head: {file: cm.obj, collider: {method: none}}\n");
