@@ -276,9 +276,14 @@ HeadRig importHead(const HeadImportSettings& settings) {
     for (unsigned i = 0; i < scene->mNumAnimations; ++i)
         rig.clips.push_back(convertClip(scene->mAnimations[i], nodeIndex, instances));
 
-    rig.fileUnitScale = declaredUnitScale(scene);
+    // FBX only: other importers apply their format's unit and axis themselves
+    // (Collada) or have none (glTF is metres and Y up, OBJ has no units).
+    std::string ext = settings.file.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+    const bool fbx = ext == ".fbx";
+    rig.fileUnitScale = fbx ? declaredUnitScale(scene) : 0.0;
     rig.unitScale = settings.unitScaleGiven || rig.fileUnitScale <= 0.0 ? settings.unitScale : rig.fileUnitScale;
-    rig.fileUpAxis = declaredUpAxis(scene);
+    rig.fileUpAxis = fbx ? declaredUpAxis(scene) : 0;
     UpAxis up = settings.upAxis;
     if (!settings.upAxisGiven && rig.fileUpAxis) up = rig.fileUpAxis == 'z' ? UpAxis::Z : rig.fileUpAxis == 'x' ? UpAxis::X : UpAxis::Y;
     rig.upAxis = up == UpAxis::Z ? 'z' : up == UpAxis::X ? 'x' : 'y';
