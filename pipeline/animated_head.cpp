@@ -53,6 +53,11 @@ AnimatedHead::AnimatedHead(std::shared_ptr<const HeadRig> rig, HeadAnimationSett
     std::vector<uint32_t> all(rest_.positions.size());
     for (uint32_t i = 0; i < all.size(); ++i) all[i] = i;
     fitVertices_ = thinned(std::move(all));
+    if (!settings_.colliders.empty()) {
+        std::vector<ColliderShape> shapes;
+        for (const ExtraCollider& c : settings_.colliders) shapes.push_back(c.shape);
+        world_ = std::make_shared<const CollisionWorld>(shapes);
+    }
 }
 
 double AnimatedHead::clipTime(double time) const {
@@ -122,6 +127,17 @@ HeadPose AnimatedHead::sample(double time) const {
         }
         case ColliderMethod::Exact: pose.collider = std::make_shared<MeshCollider>(pose.mesh, weld_); break;
         case ColliderMethod::None: break;
+    }
+    if (world_) {
+        std::vector<Eigen::Isometry3f> poses;
+        std::vector<std::vector<Vec3f>> skins(settings_.colliders.size());
+        for (size_t i = 0; i < settings_.colliders.size(); ++i) {
+            const ExtraCollider& c = settings_.colliders[i];
+            poses.push_back(c.followsHead ? pose.transform * c.place(time) : c.place(time));
+            if (c.skin) skins[i] = c.skin->sample(time).mesh.positions;
+        }
+        pose.collider =
+            std::make_shared<CompositeCollider>(std::move(pose.collider), world_->posed(poses, 0.05f, std::move(skins)));
     }
     return pose;
 }

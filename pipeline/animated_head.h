@@ -4,6 +4,7 @@
 #pragma once
 
 #include "pipeline/head_rig.h"
+#include "sim/collision_world.h"
 #include "sim/level_set.h"
 #include "sim/mesh_collider.h"
 
@@ -21,6 +22,20 @@ enum class ColliderMethod {
     None,      ///< no collider
 };
 
+class AnimatedHead;
+
+/// One collider beside the head (scene key head.colliders[]): a Bullet
+/// shape placed at each time by `place` (local -> world, or local -> the
+/// head's rest frame when it follows the head's rigid motion).
+struct ExtraCollider {
+    ColliderShape shape;
+    bool followsHead = false;
+    std::function<Eigen::Isometry3f(double)> place;
+    /// Skinned mesh: its own file's animation, sampled at the shot time
+    /// for the vertices of each pose (shape.kind SkinnedMesh).
+    std::shared_ptr<const AnimatedHead> skin;
+};
+
 struct HeadAnimationSettings {
     int clip = -1;            ///< index in HeadRig::clips; -1: the rest pose (a static head)
     double clipOffset = 0.0;  ///< clip time = shot time · clipSpeed + clipOffset
@@ -32,6 +47,9 @@ struct HeadAnimationSettings {
     std::function<Eigen::Isometry3f(double)> motion;
     ColliderMethod collider = ColliderMethod::Rigid;
     LevelSetSettings levelSet;
+    /// Colliders beside the head; the pose's collider joins them to the
+    /// head's (CompositeCollider). Empty: the head's collider alone.
+    std::vector<ExtraCollider> colliders;
 };
 
 /// @brief A posed, animated head. sample() is thread-safe and deterministic.
@@ -70,6 +88,7 @@ class AnimatedHead final : public HeadMotion {
     mutable std::once_flag gridOnce_;
     mutable std::shared_ptr<const LevelSet> grid_;
     mutable std::shared_ptr<const MeshCollider> restExact_;
+    std::shared_ptr<const CollisionWorld> world_;  ///< settings_.colliders in Bullet; null when none
 };
 
 /// @brief Least-squares rigid transform (Kabsch / Umeyama without scale)

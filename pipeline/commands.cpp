@@ -3,6 +3,7 @@
 #include "pipeline/groom_import.h"
 
 #include "core/log.h"
+#include "pipeline/clip_cuts.h"
 #include "pipeline/curly_settings.h"
 #include "pipeline/frame_jobs.h"
 #include "pipeline/frame_range.h"
@@ -11,6 +12,7 @@
 #include "pipeline/head_setup.h"
 #include "pipeline/output.h"
 #include "pipeline/shot_outputs.h"
+#include "pipeline/shot_simulation.h"
 #include "pipeline/stages.h"
 #include "pipeline/progress.h"
 #include "pipeline/schema.h"
@@ -19,6 +21,7 @@
 #include <tbb/global_control.h>
 
 #include <chrono>
+#include <cstdio>
 #include <iostream>
 
 namespace hp {
@@ -197,7 +200,8 @@ CommandSpec validateCommandSpec() {
     c.run = [](const CommandLine& cl) {
         CommandContext ctx(cl);
         resolveShot(ctx.scene, ctx.options);
-        makeView(ctx.scene);  // checks across render keys
+        makeView(ctx.scene);             // checks across render keys
+        makeDisplaySettings(ctx.scene);  // the OCIO config loads; its display and view exist
         if (sceneHasHead(ctx.scene)) {
             const HeadSetup head = loadHead(ctx.scene);  // mesh, clip and scalp selections
             if (sceneHasGroomFile(ctx.scene))  // the groom file read, bound and resampled
@@ -209,6 +213,26 @@ CommandSpec validateCommandSpec() {
     };
     return c;
 }
+
+namespace {
+
+/// The scene cuts of the shot's clip (simulation.cut_*), as `info` prints them.
+void printClipCuts(const Scene& scene, const ShotSettings& shot) {
+    if (shot.frames.empty()) return;
+    const double start = shot.frames.front() / shot.fps, end = shot.frames.back() / shot.fps;
+    const double step = frameAlignedStep(shot.fps, scene.number("simulation.time_step"));
+    const std::vector<ClipCut> cuts = findClipCuts(scene, loadHead(scene), start, end, step);
+    std::cout << "cuts:    " << cuts.size() << " (simulation.cut_distance " << scene.number("simulation.cut_distance")
+              << " m, cut_angle " << scene.number("simulation.cut_angle") << " deg per step)\n";
+    for (const ClipCut& c : cuts) {
+        char line[160];
+        std::snprintf(line, sizeof line, "  t = %.4f s (frame %.2f): head moved %.3f m, turned %.1f deg, a root moved %.3f m\n",
+                      c.time, c.time * shot.fps, c.jump.headMove, c.jump.headTurn, c.jump.rootMove);
+        std::cout << line;
+    }
+}
+
+}  // namespace
 
 CommandSpec infoCommandSpec() {
     CommandSpec c;
@@ -229,6 +253,7 @@ CommandSpec infoCommandSpec() {
             } catch (const RigSelectionError& e) {
                 ctx.scene.fail("head.meshes", e.what());
             }
+            printClipCuts(ctx.scene, shot);
         }
         std::cout << "\nresolved keys:\n" << ctx.scene.dump();
         return int(kExitOk);

@@ -13,6 +13,7 @@
 #pragma once
 
 #include "render/compare.h"
+#include "render/display_transform.h"
 
 #include <filesystem>
 #include <string>
@@ -39,6 +40,9 @@ struct CompareJob {
     CompareSettings settings;
     CompareThresholds thresholds;
     int reportWidth = 512;  ///< width of the images embedded in the report, pixels
+    /// How the report shows A and B: the scene's display transform
+    /// (render.ocio.*, render.exposure, render.background), as its PNGs.
+    DisplaySettings display;
 };
 
 /// The job the scene's compare.* keys describe, with templates and folders

@@ -1,6 +1,7 @@
 #include "pipeline/compare_report.h"
 
 #include "core/errors.h"
+#include "core/log.h"
 #include "pipeline/compare_table.h"
 #include "render/image_encode.h"
 
@@ -49,19 +50,35 @@ struct FrameImages {
     std::string a, b, flip, diff;
 };
 
+/// The image as an embedded PNG, or empty (the page then says the image is
+/// missing) when it cannot be read: a report of a partly failed shot must
+/// still be written, so this warns with the file and the reason instead of
+/// failing the report.
 std::string thumbnail(const std::string& path, bool linearize, bool srgbEncode, int width) {
     try {
         const Image image = readImage(path, linearize);
         return pngDataUri(resizeToWidth(displayImage(image), width), srgbEncode);
-    } catch (const Error&) {
+    } catch (const Error& e) {
+        logWarning("compare report: no thumbnail of ", path, ": ", e.what());
+        return {};
+    }
+}
+
+/// A render (linear EXR, or an 8-bit file linearised) through the job's
+/// display transform, as the stages' PNGs show it.
+std::string renderThumbnail(const std::string& path, const DisplaySettings& display, int width) {
+    try {
+        return pngDataUri(toDisplay(resizeToWidth(readImage(path, true), width), display), false);
+    } catch (const Error& e) {
+        logWarning("compare report: no thumbnail of ", path, ": ", e.what());
         return {};
     }
 }
 
 FrameImages loadImages(const CompareJob& job, const FrameRecord& r) {
     FrameImages f;
-    f.a = thumbnail(r.a, true, true, job.reportWidth);
-    f.b = thumbnail(r.b, true, true, job.reportWidth);
+    f.a = renderThumbnail(r.a, job.display, job.reportWidth);
+    f.b = renderThumbnail(r.b, job.display, job.reportWidth);
     if (r.compared) {
         // The heat map PNG holds display values already: read and write it as stored.
         f.flip = thumbnail(flipImagePath(job, r.frame).string(), false, false, job.reportWidth);

@@ -56,6 +56,51 @@ void headAngles(double t, double& pitch, double& yaw) {
     if (t > 2.55) yaw = 75.0 * smoothstep(0.f, 1.f, float((t - 2.55) / 0.3));      // fast turn, ~375°/s peak
 }
 
+/// The stress clip (seconds, degrees): the head tips back 70° in 0.25 s
+/// and forward again (the nape folds onto the neck: hair there is pinched),
+/// turns 180° in 0.3 s, holds, and at kStressCut cuts to a pose looking
+/// down and to the side.
+void stressAngles(double t, double& pitch, double& yaw) {
+    pitch = yaw = 0.0;
+    if (t < kStressCut) {
+        if (t >= 0.25 && t < 0.5) pitch = -70.0 * smoothstep(0.f, 1.f, float((t - 0.25) / 0.25));
+        if (t >= 0.5 && t < 0.75) pitch = -70.0 * (1.0 - smoothstep(0.f, 1.f, float((t - 0.5) / 0.25)));
+        if (t > 1.0) yaw = 180.0 * smoothstep(0.f, 1.f, float((t - 1.0) / 0.3));
+    } else {
+        pitch = 25.0;
+        yaw = -40.0;
+    }
+}
+
+/// A clip keyed at `times` from an angle function: the neck bone takes 40 %
+/// of the rotation, the head bone the rest.
+RigClip headClip(const HeadRig& rig, const char* name, double duration, double keyRate,
+                 const std::vector<double>& times, void (*angles)(double, double&, double&)) {
+    RigClip clip;
+    clip.name = name;
+    clip.duration = duration;
+    clip.keyRate = keyRate;
+    for (int node : {3, 4}) {
+        NodeTrack t;
+        t.node = node;
+        const double share = node == 3 ? 0.4 : 0.6;
+        t.translation.times = {0.0};
+        t.translation.values = {rig.nodes[size_t(node)].local.translation()};
+        t.scale.times = {0.0};
+        t.scale.values = {Vec3f::Ones()};
+        for (const double time : times) {
+            double pitch, yaw;
+            angles(time, pitch, yaw);
+            const float toRad = float(M_PI / 180.0 * share);
+            t.rotation.times.push_back(time);
+            t.rotation.values.push_back(Eigen::Quaternionf(Eigen::AngleAxisf(float(yaw) * toRad, Vec3f::UnitY()) *
+                                                           Eigen::AngleAxisf(float(pitch) * toRad, Vec3f::UnitX())));
+        }
+        clip.tracks.push_back(std::move(t));
+    }
+    return clip;
+}
+
 }  // namespace
 
 float defaultHeadField(const Vec3f& p) {
@@ -152,32 +197,17 @@ HeadRig makeDefaultHead(const DefaultHeadOptions& o) {
         rig.meshes.push_back(std::move(m));
     }
 
-    // The clip: the neck takes 40 % of the rotation, the head the rest.
-    RigClip clip;
-    clip.name = "nod_shake_turn";
-    clip.duration = kDefaultHeadClipSeconds;
-    clip.keyRate = o.keyRate;
-    const int keys = int(std::lround(kDefaultHeadClipSeconds * o.keyRate)) + 1;
-    for (int node : {3, 4}) {
-        NodeTrack t;
-        t.node = node;
-        const double share = node == 3 ? 0.4 : 0.6;
-        t.translation.times = {0.0};
-        t.translation.values = {rig.nodes[size_t(node)].local.translation()};
-        t.scale.times = {0.0};
-        t.scale.values = {Vec3f::Ones()};
-        for (int k = 0; k < keys; ++k) {
-            const double time = k / o.keyRate;
-            double pitch, yaw;
-            headAngles(time, pitch, yaw);
-            const float toRad = float(M_PI / 180.0 * share);
-            t.rotation.times.push_back(time);
-            t.rotation.values.push_back(Eigen::Quaternionf(Eigen::AngleAxisf(float(yaw) * toRad, Vec3f::UnitY()) *
-                                                           Eigen::AngleAxisf(float(pitch) * toRad, Vec3f::UnitX())));
-        }
-        clip.tracks.push_back(std::move(t));
+    std::vector<double> times;
+    for (int k = 0; k <= int(std::lround(kDefaultHeadClipSeconds * o.keyRate)); ++k) times.push_back(k / o.keyRate);
+    rig.clips.push_back(headClip(rig, "nod_shake_turn", kDefaultHeadClipSeconds, o.keyRate, times, headAngles));
+    // The stress clip's cut: the pose before it is held until 1 ms before.
+    times.clear();
+    for (int k = 0; k <= int(std::lround(kStressClipSeconds * o.keyRate)); ++k) {
+        const double t = k / o.keyRate;
+        if (t >= kStressCut && times.back() < kStressCut) times.push_back(kStressCut - 1e-3);
+        times.push_back(t);
     }
-    rig.clips.push_back(std::move(clip));
+    rig.clips.push_back(headClip(rig, "stress", kStressClipSeconds, o.keyRate, times, stressAngles));
     return rig;
 }
 

@@ -4,6 +4,7 @@
 
 #include "pipeline/scene.h"
 #include "sim/followers.h"
+#include "sim/groom_modifiers.h"
 
 namespace hp {
 
@@ -11,5 +12,9 @@ namespace hp {
 /// the seed of the per-segment random values. Radii keep FollowerSettings'
 /// defaults (0.04 mm root, 0.01 mm tip) until a hair radius key exists.
 FollowerSettings followerSettings(const Scene& scene);
+
+/// The groom modifiers of hair.followers.* (length_variation, clump*, wave*,
+/// curl, frizz), seeded by the shot seed.
+GroomModifiers groomModifiers(const Scene& scene);
 
 }  // namespace hp

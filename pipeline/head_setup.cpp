@@ -63,6 +63,79 @@ HeadImportSettings headImportSettings(const Scene& scene) {
     return s;
 }
 
+std::vector<ExtraCollider> extraColliders(const Scene& scene, const HeadAnimationSettings& head) {
+    std::vector<ExtraCollider> out;
+    const double fps = scene.number("fps");
+    for (size_t i = 0; i < scene.count("head.colliders"); ++i) {
+        const std::string k = cat("head.colliders[", i, "].");
+        ExtraCollider c;
+        const std::string type = scene.text(k + "type");
+        c.shape.kind = type == "sphere"    ? ColliderShape::Kind::Sphere
+                       : type == "capsule" ? ColliderShape::Kind::Capsule
+                       : type == "mesh"    ? ColliderShape::Kind::ConvexMesh
+                       : type == "skinned" ? ColliderShape::Kind::SkinnedMesh
+                                           : ColliderShape::Kind::Box;
+        c.shape.radius = float(scene.number(k + "radius"));
+        c.shape.length = float(scene.number(k + "length"));
+        c.shape.halfExtents = 0.5f * scene.vec3f(k + "size");
+        if (c.shape.kind == ColliderShape::Kind::Box && !(c.shape.halfExtents.minCoeff() > 0.f))
+            scene.fail(k + "size", "a box needs positive extents");
+        if (c.shape.kind == ColliderShape::Kind::ConvexMesh || c.shape.kind == ColliderShape::Kind::SkinnedMesh) {
+            // Another file, or (no file) meshes of the head's own file, placed as the head is.
+            HeadImportSettings mesh = headImportSettings(scene);
+            if (!scene.file(k + "file").empty()) {
+                mesh = HeadImportSettings{};
+                mesh.file = scene.file(k + "file");
+                mesh.unitScale = scene.number(k + "unit_scale");
+            }
+            if (mesh.file.empty()) scene.fail(k + "file", cat("a ", type, " collider needs a file (or head.file)"));
+            mesh.meshes = splitList(scene.text(k + "meshes"));
+            std::shared_ptr<const HeadRig> rig;
+            try {
+                rig = std::make_shared<const HeadRig>(importHead(mesh));
+            } catch (const RigSelectionError& e) {
+                scene.fail(k + "meshes", e.what());
+            }
+            c.shape.points = rig->restMesh().positions;
+            if (c.shape.kind == ColliderShape::Kind::SkinnedMesh) {
+                // The file's clip on the head's timing (clip_offset, clip_speed, loop).
+                HeadAnimationSettings body = head;
+                body.motion = nullptr;
+                body.collider = ColliderMethod::None;
+                body.colliders.clear();
+                try {
+                    const std::string clip = scene.text(k + "clip");
+                    body.clip = findClip(*rig, clip.empty() ? scene.text("head.clip") : clip);
+                } catch (const RigSelectionError& e) {
+                    scene.fail(k + "clip", e.what());
+                }
+                auto skin = std::make_shared<const AnimatedHead>(rig, body);
+                c.shape.triangles = skin->rest().triangles;
+                c.skin = std::move(skin);
+            }
+            if (c.shape.points.size() < 4)
+                scene.fail(k + "file", cat(mesh.file.string(), " has ", c.shape.points.size(),
+                                           " vertices; a collider needs at least 4"));
+        }
+        c.followsHead = scene.text(k + "parent") == "head";
+        Eigen::Isometry3f base = Eigen::Isometry3f::Identity();
+        base.linear() = eulerXYZ(scene.vec3f(k + "rotate"));
+        base.translation() = scene.vec3f(k + "translate");
+        const Curve& mx = scene.curve(k + "move_x");
+        const Curve& my = scene.curve(k + "move_y");
+        const Curve& mz = scene.curve(k + "move_z");
+        // Curves are keyed by frame; the placement is asked by time.
+        c.place = [=](double time) {
+            const double f = time * fps;
+            Eigen::Isometry3f t = base;
+            t.translation() += Vec3f(float(mx.eval(f)), float(my.eval(f)), float(mz.eval(f)));
+            return t;
+        };
+        out.push_back(std::move(c));
+    }
+    return out;
+}
+
 HeadAnimationSettings headAnimationSettings(const Scene& scene, const HeadRig& rig) {
     HeadAnimationSettings s;
     try {
@@ -107,6 +180,7 @@ HeadAnimationSettings headAnimationSettings(const Scene& scene, const HeadRig& r
         scene.fail("head.collider.exterior_band", "must be at least head.collider.voxel_size");
     if (s.levelSet.interiorBand < s.levelSet.voxelSize)
         scene.fail("head.collider.interior_band", "must be at least head.collider.voxel_size");
+    s.colliders = extraColliders(scene, s);
     return s;
 }
 

@@ -25,6 +25,9 @@ Affine3f scenePlacement(const Scene& scene, const std::string& prefix);
 HeadImportSettings headImportSettings(const Scene& scene);
 /// head.clip*, head.loop, head.rest_time, head.animate.*, head.collider.* (`rig` resolves the clip name).
 HeadAnimationSettings headAnimationSettings(const Scene& scene, const HeadRig& rig);
+/// head.colliders[]: the colliders beside the head (a mesh collider's file is
+/// imported here; a skinned one plays its clip on `head`'s timing).
+std::vector<ExtraCollider> extraColliders(const Scene& scene, const HeadAnimationSettings& head);
 ScalpSettings scalpSettings(const Scene& scene);
 
 /// Everything about the head a shot needs, loaded once.

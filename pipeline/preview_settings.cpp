@@ -17,9 +17,10 @@ PreviewSettings makePreviewSettings(const Scene& s) {
 
     PreviewShadowSettings& sh = p.shadow;
     sh.light = int(s.integer("preview.shadow.light"));
-    if (sh.light >= 0 && size_t(sh.light) >= s.count("render.lights"))
-        s.fail("preview.shadow.light", cat("names light ", sh.light, " but render.lights has ", s.count("render.lights"),
-                                           " (use -1 for no shadows)"));
+    const size_t lights = s.count("render.lights");
+    if (sh.light >= 0 && size_t(sh.light) >= lights)
+        s.fail("preview.shadow.light",
+               cat("names light ", sh.light, " but render.lights has ", lights, " (use -1 for no shadows)"));
     sh.voxels = s.flag("preview.shadow.voxels");
     sh.mode = s.text("preview.shadow.voxel_mode") == "binary" ? VoxelMode::Binary : VoxelMode::Additive;
     sh.splat = s.text("preview.shadow.splat") == "trilinear" ? VoxelSplat::Trilinear : VoxelSplat::Nearest;

@@ -36,6 +36,36 @@ void addHeadKeys(SchemaBuilder& b) {
         .curve("head.animate.pitch", 0, -1e6, 1e6, "deg", "Rotation about +X through the pivot (after yaw).")
         .curve("head.animate.roll", 0, -1e6, 1e6, "deg", "Rotation about +Z through the pivot (after pitch).")
         .vec3("head.animate.pivot", 0, 0, 0, "m", "Centre of the rotations (world).");
+    b.section("head.colliders",
+              "Colliders beside the head (body, shoulders, hat, hand, props), each a Bullet collision object in one "
+              "collision world that every hair vertex queries (sim/collision_world.h); the head keeps its own "
+              "collider (head.collider) as the fast path.")
+        .list("head.colliders", "[]", 64, "The colliders, a list of maps.")
+        .choice("head.colliders[].type", "box", {"sphere", "capsule", "box", "mesh", "skinned"},
+                "sphere, capsule, box: Bullet's primitives; mesh: the convex hull of a mesh file's vertices "
+                "(a rigid prop; split a concave prop into convex parts, one entry each); skinned: a mesh file "
+                "played by its own clip (a body), a triangle mesh rebuilt on each pose's vertices.")
+        .number("head.colliders[].radius", 0.05, 1e-5, 100, "m", "sphere, capsule: radius.")
+        .number("head.colliders[].length", 0.1, 0, 100, "m", "capsule: distance between the cap centres (along local Y).")
+        .vec3("head.colliders[].size", 0.1, 0.1, 0.1, "m", "box: full extents along local X, Y, Z.")
+        .file("head.colliders[].file", "",
+              "mesh, skinned: the mesh file (any format assimp reads). Empty: the head's own file, imported and "
+              "placed as the head (head.unit_scale, up_axis, translate, rotate).")
+        .text("head.colliders[].meshes", "",
+              "mesh, skinned: comma-separated meshes of the file (names or indices as `hairpipe info` lists them); "
+              "empty: every mesh.")
+        .text("head.colliders[].clip", "",
+              "skinned: the file's clip by name or index, on the head's timing (head.clip_offset, clip_speed, loop); "
+              "empty: the clip head.clip names; 'none': the rest pose.")
+        .number("head.colliders[].unit_scale", 1, 1e-9, 1e9, "", "mesh, skinned: metres per file unit.")
+        .choice("head.colliders[].parent", "world", {"world", "head"},
+                "world: placed in the world; head: carried by the head's rigid motion (placement in the rest "
+                "pose's world frame).")
+        .vec3("head.colliders[].translate", 0, 0, 0, "m", "Placement: translation (after rotate).")
+        .vec3("head.colliders[].rotate", 0, 0, 0, "deg", "Placement: rotation about X, then Y, then Z.")
+        .curve("head.colliders[].move_x", 0, -1e6, 1e6, "m", "Keyed motion per frame, added to translate along X.")
+        .curve("head.colliders[].move_y", 0, -1e6, 1e6, "m", "Keyed motion along Y.")
+        .curve("head.colliders[].move_z", 0, -1e6, 1e6, "m", "Keyed motion along Z.");
     b.section("head.scalp", "Which triangles of the rest mesh grow hair.")
         .choice("head.scalp.method", "auto", {"auto", "all", "material", "vertex_color", "texture", "region"},
                 "auto: the materials whose name contains 'scalp' or 'hair', else a cap over the top and back of "

@@ -42,7 +42,12 @@ void addSimKeys(SchemaBuilder& b) {
                  "the thread count.")
         .number("simulation.max_speed", 50, 0, 1e4, "m/s",
                 "Guard (rope formulation): a guide vertex faster than this after a step is slowed to it; the "
-                "frame's statistics count the clamped vertices. 0: no clamp.");
+                "frame's statistics count the clamped vertices. 0: no clamp.")
+        // Scene cuts (sim/scene_cut.h); `hairpipe info` lists the cuts of the clip.
+        .number("simulation.cut_distance", 0.1, 0, 1e6, "m",
+                "Scene cut: the head or a root moving farther than this in one step is a cut; every guide restarts "
+                "in its rest shape on the new pose, placed outside the colliders before the frame is written.")
+        .number("simulation.cut_angle", 45, 0, 180, "deg", "Scene cut: the head turning more than this in one step.");
     b.section("simulation.limits", "Joint limits (seed: ±30° bend, ±10° twist, soft, with a projection limit).")
         .number("simulation.limits.bend", 30, 0.1, 179, "deg", "Bend limit about the two bending axes.")
         .number("simulation.limits.twist", 10, 0.1, 89, "deg", "Rigid only: twist limit about the segment.")
@@ -51,9 +56,6 @@ void addSimKeys(SchemaBuilder& b) {
                 "A joint beyond its limit by more than this is snapped back.")
         .number("simulation.limits.projection_distance", 0.1, 0, 10, "",
                 "Rigid only: a joint pulled apart by more than this fraction of a segment is snapped back.");
-    b.section("simulation.teleport", "Scene cuts: a jump beyond these in one step resets the guides to rest.")
-        .number("simulation.teleport.distance", 0.1, 0, 1e6, "m", "Largest head or root move per step.")
-        .number("simulation.teleport.angle", 45, 0, 180, "deg", "Largest head turn per step.");
 }
 
 }  // namespace hp

@@ -27,16 +27,6 @@ double msSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-/// The largest step <= maxStep that divides the frame interval, so every
-/// frame falls on a step and is written without interpolation (a root
-/// interpolated between two steps cuts the chord of its arc on a turning head).
-float frameAlignedStep(double fps, double maxStep) {
-    const double frame = 1.0 / fps;
-    // The step keys are floats (0.02f is 0.0199999996): compare with a tolerance.
-    const double steps = std::max(1.0, std::ceil(frame / maxStep - 1e-5));
-    return float(frame / steps);
-}
-
 void evaluateRoots(const TriangleMesh& mesh, const std::vector<SurfacePoint>& roots, std::vector<SurfaceFrame>& out) {
     out.resize(roots.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, roots.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
@@ -45,6 +35,13 @@ void evaluateRoots(const TriangleMesh& mesh, const std::vector<SurfacePoint>& ro
 }
 
 }  // namespace
+
+float frameAlignedStep(double fps, double maxStep) {
+    const double frame = 1.0 / fps;
+    // The step keys are floats (0.02f is 0.0199999996): compare with a tolerance.
+    const double steps = std::max(1.0, std::ceil(frame / maxStep - 1e-5));
+    return float(frame / steps);
+}
 
 /// The two strand models behind one interface: the rigid chain
 /// (sim/guides.h: rope or rigid formulation) and curly-wet (sim/curly_wet.h).
@@ -108,6 +105,11 @@ class CurlyWetModel final : public GuideModel {
     GuideStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
         solver_.setSaturation(sceneSaturation(scene_, head.time));
         const CurlyWetStats& c = solver_.step(roots, head);
+        if (c.implicitFailures > 0)
+            logWarning("curly-wet: at t = ", head.time, " s the implicit spring step of ", c.implicitFailures,
+                       " strand-substep(s) was not finite; those strands skipped their curl, bending and core "
+                       "forces for it (try a smaller simulation.time_step, more substeps or softer hair.curly "
+                       "stiffnesses)");
         GuideStats g;
         g.maxLengthError = c.maxLengthError;
         g.meanLengthError = c.meanLengthError;
@@ -167,6 +169,13 @@ std::string SimFrameStats::json() const {
         o << ", \"settle\": {\"seconds\": " << settleSeconds << ", \"kinetic_energy\": " << settleEnergy
           << ", \"at_rest\": " << (settleConverged ? "true" : "false") << ", \"cached\": "
           << (settleCached ? "true" : "false") << "}";
+    o << ", \"guides\": {\"max_length_error\": " << guides.maxLengthError
+      << ", \"mean_length_error\": " << guides.meanLengthError << ", \"penetration_count\": " << guides.penetrationCount
+      << ", \"max_penetration\": " << guides.maxPenetration << "}";
+    o << ", \"followers\": {\"max_length_error\": " << followers.maxLengthError
+      << ", \"mean_length_error\": " << followers.meanLengthError
+      << ", \"penetration_count\": " << followers.penetrationCount
+      << ", \"max_penetration\": " << followers.maxPenetration << ", \"projected\": " << followerProjected << "}";
     o << "}";
     return o.str();
 }
@@ -217,6 +226,7 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame, c
     if (imported) groom.followerShapes = std::move(imported->followerShapes);
     if (groom.followerShapes.count() == 0 && (imported || settleRan_))
         groom.followerShapes = nearestGuideShapes(rest, guideFrames_, followerFrames_);
+    applyGroomModifiers(groom, groomModifiers(scene));  // rest shapes of clumped, wavy, frizzy followers
     FollowerSettings followerOptions = followerSettings(scene);
     if (usesCurlyWetModel(scene)) {
         const CurlyWetSettings curly = curlyWetSettings(scene);
@@ -337,6 +347,8 @@ void ShotSimulation::produceFrame(double time) {
     stats_.guides = pendingSteps_ ? pending_ : GuideStats{};
     stats_.guides.steps = pendingSteps_;
     stats_.followerProjected = fs.projected;
+    const Followers::LengthError lengthError = followers_->lengthError(strands_);
+    stats_.followers = {lengthError.max, lengthError.mean, fs.penetrationCount, fs.maxPenetration};
     stats_.followerMs = msSince(followerStart);
     stats_.headMs = headMs;
     stats_.strands = strands_.strandCount();

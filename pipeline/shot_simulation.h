@@ -24,12 +24,23 @@
 
 namespace hp {
 
+/// The largest step <= maxStep that divides the frame interval, so every
+/// frame falls on a step and is written without interpolation (a root
+/// interpolated between two steps cuts the chord of its arc on a turning head).
+float frameAlignedStep(double fps, double maxStep);
+
 /// What the simulation measured for one output frame.
 struct SimFrameStats {
     int frame = 0;
     double time = 0.0;
     GuideStats guides;             ///< folded over the guide steps since the previous frame
     size_t followerProjected = 0;  ///< follower vertices pushed out of the head
+    /// Followers at the output frame (they are rebuilt per frame, not per step).
+    struct FollowerFigures {
+        double maxLengthError = 0, meanLengthError = 0;  ///< |segment length / rest - 1|
+        size_t penetrationCount = 0;  ///< vertices left inside the head (signed distance < 0)
+        double maxPenetration = 0;    ///< m
+    } followers;
     double headMs = 0;             ///< sampling the head animation (all steps)
     double followerMs = 0;         ///< rebuilding the followers
     double totalMs = 0;            ///< the whole frame
@@ -39,7 +50,9 @@ struct SimFrameStats {
     /// (-1: none), final kinetic energy, whether it came to rest.
     double settleSeconds = -1, settleEnergy = 0;
     bool settleConverged = false, settleCached = false;
-    /// One JSON object (a line of the run's statistics).
+    /// One JSON object (a line of the run's statistics): the guides' figures
+    /// at the top level (as before) and again under "guides", the followers'
+    /// under "followers".
     std::string json() const;
 };
 

@@ -30,8 +30,8 @@ GuideSettings guideSettings(const Scene& scene) {
     s.limitStiffness = float(scene.number("simulation.limits.stiffness"));
     s.projectionAngle = float(scene.number("simulation.limits.projection_angle"));
     s.projectionDistance = float(scene.number("simulation.limits.projection_distance"));
-    s.teleportDistance = float(scene.number("simulation.teleport.distance"));
-    s.teleportAngle = float(scene.number("simulation.teleport.angle"));
+    s.teleportDistance = float(scene.number("simulation.cut_distance"));
+    s.teleportAngle = float(scene.number("simulation.cut_angle"));
     s.maxSpeed = float(scene.number("simulation.max_speed"));
 
     const float segment = s.length / float(s.segments);

@@ -7,6 +7,7 @@
 #include "pipeline/path_template.h"
 #include "pipeline/scene.h"
 #include "pipeline/stages.h"
+#include "pipeline/view_settings.h"
 
 namespace fs = std::filesystem;
 
@@ -30,6 +31,7 @@ CompareJob compareJobFromScene(const Scene& scene, const fs::path& outputDir) {
     job.thresholds.minSsim = scene.number("compare.min_ssim");
     job.thresholds.maxRmse = scene.number("compare.max_rmse");
     job.reportWidth = int(scene.integer("compare.report_width"));
+    job.display = makeDisplaySettings(scene);
     return job;
 }
 

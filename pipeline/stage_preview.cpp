@@ -19,7 +19,8 @@ namespace {
 class PreviewStage final : public FrameStage {
   public:
     PreviewStage(const Scene& scene, const ShotSettings& shot)
-        : view_(makeView(scene)), settings_(makePreviewSettings(scene)), outputDir_(shot.outputDir) {
+        : view_(makeView(scene)), display_(makeDisplaySettings(scene)), settings_(makePreviewSettings(scene)),
+          outputDir_(shot.outputDir) {
         for (const char* key : {"preview.exr", "preview.png"}) {
             const std::string& t = scene.text(key);
             if (!t.empty() && !hasFrameToken(t))
@@ -61,7 +62,7 @@ class PreviewStage final : public FrameStage {
                             {"hairpipe:stage", "preview"},
                             {"hairpipe:renderer", renderer_->stats().renderer}};
         for (const fs::path& path : outputs(data.frame))
-            writeAtomically(path, [&](const fs::path& tmp) { writeImage(tmp.string(), image, options); });
+            writeAtomically(path, [&](const fs::path& tmp) { writeImageWithDisplay(tmp.string(), image, display_, options); });
     }
 
   private:
@@ -83,6 +84,7 @@ class PreviewStage final : public FrameStage {
     }
 
     View view_;
+    DisplaySettings display_;  // PNG frames only; EXRs stay linear
     PreviewSettings settings_;
     fs::path outputDir_;
     std::string exr_, png_, sceneName_;

@@ -16,7 +16,7 @@ namespace hp {
 
 namespace {
 
-ReferenceSettings referenceSettings(const Scene& s, const View& view, const ShotSettings& shot) {
+ReferenceSettings referenceSettings(const Scene& s, const ShotSettings& shot) {
     ReferenceSettings r;
     r.mode = s.text("reference.mode") == "physical" ? ReferenceMode::Physical : ReferenceMode::KajiyaKay;
     r.samplesPerPixel = int(s.integer("reference.samples"));
@@ -31,10 +31,7 @@ ReferenceSettings referenceSettings(const Scene& s, const View& view, const Shot
     f.azimuthalRoughness = float(s.number("reference.physical.azimuthal_roughness"));
     f.cuticleTiltDegrees = float(s.number("reference.physical.cuticle_tilt"));
     f.ior = float(s.number("reference.physical.ior"));
-    f.sigmaA = s.flag("reference.physical.use_hair_color")
-                   ? hairAbsorptionFromColor(view.hair.color, f.azimuthalRoughness)
-                   : hairAbsorptionFromMelanin(float(s.number("reference.physical.melanin")),
-                                               float(s.number("reference.physical.pheomelanin")));
+    f.sigmaA = hairAbsorption(s);
     return r;
 }
 
@@ -51,7 +48,8 @@ std::string checkedTemplate(const Scene& s, const std::string& key, bool require
 class ReferenceStage final : public FrameStage {
   public:
     ReferenceStage(const Scene& scene, const ShotSettings& shot)
-        : shot_(shot), view_(makeView(scene)), settings_(referenceSettings(scene, view_, shot)),
+        : shot_(shot), view_(makeView(scene)), display_(makeDisplaySettings(scene)),
+          settings_(referenceSettings(scene, shot)),
           exr_(checkedTemplate(scene, "reference.exr", true)), png_(checkedTemplate(scene, "reference.png", false)),
           sceneName_(scene.name()) {
         const double scale = scene.number("reference.scale");
@@ -100,12 +98,13 @@ class ReferenceStage final : public FrameStage {
                             {"hairpipe:strands", std::to_string(stats.strands)}};
         const std::vector<fs::path> paths = outputs(data.frame);
         for (const fs::path& path : paths)
-            writeAtomically(path, [&](const fs::path& tmp) { writeImage(tmp.string(), image, options); });
+            writeAtomically(path, [&](const fs::path& tmp) { writeImageWithDisplay(tmp.string(), image, display_, options); });
     }
 
   private:
     ShotSettings shot_;
     View view_;
+    DisplaySettings display_;  // PNG frames only; EXRs stay linear
     ReferenceSettings settings_;
     std::string exr_, png_;
     std::string sceneName_;

@@ -111,7 +111,10 @@ void accumulateShadow(const RTCFilterFunctionNArguments* args) {
     const EmbreeScene::Impl& s = *q->scene;
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
-        if (RTCHitN_geomID(args->hit, args->N, i) != s.hairGeom) continue;  // the head is opaque: accept
+        if (RTCHitN_geomID(args->hit, args->N, i) != s.hairGeom) {
+            if (q->start.throughHead) args->valid[i] = 0;  // a ray from the head ignores it
+            continue;                                      // otherwise the head is opaque: accept
+        }
         const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
         if (ownSurface(s, q->start, prim)) {
             args->valid[i] = 0;

@@ -66,6 +66,12 @@ struct SceneHit {
 struct RayStart {
     uint32_t strand = kNoStrand;  ///< starting strand, kNoStrand for camera rays and the head
     uint32_t segment = 0;
+    /// Shadow rays leaving the head pass through it: the head casts no shadow
+    /// on itself. A low-poly head's flat triangles would otherwise cut its
+    /// smooth shading into a staircase along the terminator (the "shadow
+    /// terminator" problem); its own shading (n·l) darkens the far side.
+    /// The preview does the same (shaders/head.frag).
+    bool throughHead = false;
 };
 
 /// Position, unit tangent (root to tip) and radius on a strand's axis.

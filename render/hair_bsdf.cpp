@@ -111,16 +111,29 @@ Vec3f hairAbsorptionFromMelanin(float eumelanin, float pheomelanin) {
     return eumelanin * eu + pheomelanin * pheo;
 }
 
+namespace {
+/// Chiang 2016 eq. 9's denominator: σa = (ln c / D(β_n))².
+float colorFitScale(float b) {
+    return 5.969f - 0.215f * b + 2.532f * b * b - 10.73f * b * b * b + 5.574f * b * b * b * b +
+           0.245f * b * b * b * b * b;
+}
+}  // namespace
+
 Vec3f hairAbsorptionFromColor(const Vec3f& color, float betaN) {
-    const float b = betaN;
-    const float d = 5.969f - 0.215f * b + 2.532f * b * b - 10.73f * b * b * b + 5.574f * b * b * b * b +
-                    0.245f * b * b * b * b * b;
+    const float d = colorFitScale(betaN);
     Vec3f sigma;
     for (int c = 0; c < 3; ++c) {
         const float l = std::log(std::clamp(color[c], 1e-4f, 1.f)) / d;
         sigma[c] = l * l;
     }
     return sigma;
+}
+
+Vec3f hairColorFromAbsorption(const Vec3f& sigmaA, float betaN) {
+    const float d = colorFitScale(betaN);
+    Vec3f color;
+    for (int c = 0; c < 3; ++c) color[c] = std::exp(-std::sqrt(std::max(sigmaA[c], 0.f)) * d);
+    return color;
 }
 
 HairModel::HairModel(const HairFiberParams& params) : params_(params) {
@@ -178,20 +191,19 @@ float HairBsdf::refractedOffset(float sinThetaO, float cosThetaO, Vec3f* T) cons
 }
 
 void HairBsdf::tilt(int p, float sinThetaO, float cosThetaO, float* sinOp, float* cosOp) const {
-    // The cuticle scales rotate the reflection cones: R by −2α, TT by α,
-    // TRT by 4α (Chiang §4.1, after Marschner).
+    // The cuticle scales' free edges point to the tip (x > 0), so a scale's
+    // surface normal leans toward the root by α. Mirror reflection about it
+    // gives θo = −θi − 2α: the primary (R) highlight moves toward the root
+    // (Marschner et al. 2003, §4.1 and Table 1). Mp peaks where θi = −θo', so
+    // R is evaluated at θo' = θo + 2α, and the refracted lobes, which the
+    // scales bend the other way, at θo' = θo − α (TT) and θo − 4α (TRT)
+    // (Chiang 2016 §4.1 magnitudes). pbrt-v3 uses the opposite signs, which
+    // moves R toward the tip (Tungsten issue #50).
     const HairModel& m = model_;
-    if (p == 0) {
-        *sinOp = sinThetaO * m.cos2kAlpha(1) - cosThetaO * m.sin2kAlpha(1);
-        *cosOp = cosThetaO * m.cos2kAlpha(1) + sinThetaO * m.sin2kAlpha(1);
-    } else if (p == 1) {
-        *sinOp = sinThetaO * m.cos2kAlpha(0) + cosThetaO * m.sin2kAlpha(0);
-        *cosOp = cosThetaO * m.cos2kAlpha(0) - sinThetaO * m.sin2kAlpha(0);
-    } else {
-        *sinOp = sinThetaO * m.cos2kAlpha(2) + cosThetaO * m.sin2kAlpha(2);
-        *cosOp = cosThetaO * m.cos2kAlpha(2) - sinThetaO * m.sin2kAlpha(2);
-    }
-    *cosOp = std::abs(*cosOp);
+    const int k = p == 0 ? 1 : p == 1 ? 0 : 2;
+    const float s = p == 0 ? m.sin2kAlpha(k) : -m.sin2kAlpha(k);  // sin of the signed shift
+    *sinOp = sinThetaO * m.cos2kAlpha(k) + cosThetaO * s;
+    *cosOp = std::abs(cosThetaO * m.cos2kAlpha(k) - sinThetaO * s);
 }
 
 Vec3f HairBsdf::evaluate(const Vec3f& wo, const Vec3f& wi, Vec3f* lobes, float* pdf) const {

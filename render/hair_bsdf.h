@@ -42,6 +42,16 @@ Vec3f hairAbsorptionFromMelanin(float eumelanin, float pheomelanin);
 /// (Chiang 2016 §4.2, their fit).
 Vec3f hairAbsorptionFromColor(const Vec3f& color, float betaN);
 
+/// The inverse of hairAbsorptionFromColor: c = exp(−√σa · D(β_n)), the
+/// multiply scattered colour of a head of hair with absorption σa (Chiang
+/// 2016 eq. 9 solved for c). The one fit between melanin and the Kajiya-Kay
+/// colour: render.hair.melanin sets σa (hairAbsorptionFromMelanin) and this
+/// colour. At β_n = 0.3 (D = 5.888): eumelanin 0.3 -> (0.124, 0.068, 0.023),
+/// eumelanin 0.3 + pheomelanin 0.8 -> (0.046, 0.014, 0.001), 1.3 -> (0.013,
+/// 0.004, 0.000), 8 -> black. Linear albedos: dark hair leaves its look to
+/// the specular lobes, as in the physical reference.
+Vec3f hairColorFromAbsorption(const Vec3f& sigmaA, float betaN);
+
 /// Material parameters of one hair fibre.
 struct HairFiberParams {
     Vec3f sigmaA = hairAbsorptionFromMelanin(1.3f, 0.f);  ///< absorption per unit radius

@@ -191,6 +191,7 @@ struct PreviewRenderer::Impl {
         set3(u.secondColor, h.secondaryColor, h.secondaryKs);
         set4(u.hairShape, h.shininess, h.secondaryShininess, h.primaryShift, h.secondaryShift);
         set3(u.headColor, view.head.color, view.head.ambient);
+        set4(u.headSkin, view.head.wrap, view.head.specular, view.head.shininess, 0.f);
         const PreviewShadowSettings& sh = settings.shadow;
         // Optical depth of one unit of C (shaders/shadow.glsl).
         const float depthPerUnit = sh.weight == VoxelWeight::Crossings
@@ -457,7 +458,8 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
 
     const PreviewShadowSettings& sh = settings.shadow;
     grid = LightGrid();
-    const bool lightExists = sh.light >= 0 && size_t(sh.light) < view.lights.size();
+    const bool lightExists =
+        sh.light >= 0 && size_t(sh.light) < view.lights.size() && view.lights[size_t(sh.light)].castsShadows;
     if (lightExists && (sh.voxels || sh.shadowMap) && !bounds.isEmpty()) {
         grid = LightGrid::fit(view.lights[size_t(sh.light)], bounds);
         if (!grid.valid && !warnedUnshadowed) {
@@ -504,7 +506,11 @@ const PreviewSettings& PreviewRenderer::settings() const { return impl_->setting
 void PreviewRenderer::setSettings(const PreviewSettings& settings) { impl_->settings = settings; }
 const PreviewStats& PreviewRenderer::stats() const { return impl_->stats; }
 
-void PreviewRenderer::draw(const View& view, const PreviewFrame& frame) { impl_->draw(view, frame); }
+void PreviewRenderer::draw(const View& shotView, const PreviewFrame& frame) {
+    View view = shotView;
+    view.lights = shotView.worldLights();  // a camera-relative rig follows this frame's camera
+    impl_->draw(view, frame);
+}
 
 void PreviewRenderer::finish() const { glFinish(); }
 

@@ -27,6 +27,7 @@ struct FrameUniforms {
     float secondColor[4];
     float hairShape[4];
     float headColor[4];
+    float headSkin[4];
     float shadow[4];
     float tess[4];
     float blend[4];

@@ -119,8 +119,10 @@ uint64_t renderTile(const ShadingContext& ctx, Image& image, int x0, int y0, int
 
 }  // namespace
 
-Image ReferenceRenderer::render(const View& view, const StrandFrame* strands, const TriangleMesh* head,
+Image ReferenceRenderer::render(const View& shotView, const StrandFrame* strands, const TriangleMesh* head,
                                 const ReferenceSettings& settings, ReferenceStats* stats) {
+    View view = shotView;
+    view.lights = shotView.worldLights();  // a camera-relative rig follows this frame's camera
     checkSettings(view, settings);
     EmbreeDevice& device = impl_->device;
     device.resetPeak();

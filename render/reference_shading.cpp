@@ -13,6 +13,9 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 
 /// Offset off the head's surface for rays leaving it: far above float error
 /// at head scale, far below a hair radius.
+/// Shadow rays from the head see hair only (RayStart::throughHead says why).
+const RayStart kFromHead{kNoStrand, 0, true};
+
 float surfaceOffset(const Vec3f& p) { return 4e-6f * (1.f + p.cwiseAbs().maxCoeff()); }
 
 /// Local frame of a fibre hit: x along the tangent, z the viewer's direction
@@ -80,7 +83,7 @@ Vec3f incident(const ShadingContext& ctx, const Light& light, const Vec3f& p, fl
     Vec3f radiance;
     float distance;
     *l = light.toLight(p, &radiance, &distance);
-    if (radiance.maxCoeff() <= 0.f) return radiance;
+    if (radiance.maxCoeff() <= 0.f || !light.castsShadows) return radiance;
     return radiance * visibility(ctx, p, *l, distance, hairTransmittance, start, rays);
 }
 
@@ -115,12 +118,14 @@ SampleResult shadeKajiyaKay(const ShadingContext& ctx, const Vec3f& o, const Vec
         if (ng.dot(v) < 0.f) ng = -ng;
         if (n.dot(ng) < 0.f) n = -n;
         const Vec3f q = p + surfaceOffset(p) * ng;
-        Vec3f irradiance = Vec3f::Constant(view.head.ambient) + view.environment;
+        r.diffuse = view.head.color.cwiseProduct(Vec3f::Constant(view.head.ambient) + view.environment);
         for (const Light& light : view.lights) {
-            const Vec3f radiance = incident(ctx, light, q, T, RayStart{}, &l, &r.rays);
-            irradiance += std::max(0.f, n.dot(l)) * radiance;
+            Vec3f radiance;
+            l = light.toLight(q, &radiance, nullptr);
+            const Vec3f f = skinShade(view.head, n, l, v);
+            if (f.maxCoeff() <= 0.f) continue;  // no shadow ray where the light cannot reach
+            r.diffuse += f.cwiseProduct(incident(ctx, light, q, T, kFromHead, &l, &r.rays));
         }
-        r.diffuse = view.head.color.cwiseProduct(irradiance);
     }
     r.radiance = r.diffuse + r.specular;
     return r;
@@ -160,7 +165,8 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
                 const Vec3f f = bsdf.eval(woL, frame.toLocal(l), lobes);
                 const float weight = shadowRoulette(beta.cwiseProduct(f), ctx.settings.shadowRouletteThreshold, u);
                 if (weight <= 0.f) continue;
-                radiance *= weight * visibility(ctx, p, l, distance, 0.f, start, &r.rays);
+                if (light.castsShadows) radiance *= visibility(ctx, p, l, distance, 0.f, start, &r.rays);
+                radiance *= weight;
                 r.radiance += beta.cwiseProduct(f).cwiseProduct(radiance);
                 if (bounce == 0) r.specular += lobes[0].cwiseProduct(radiance);
             }
@@ -182,12 +188,15 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
                 Vec3f radiance;
                 float distance;
                 l = light.toLight(nextOrigin, &radiance, &distance);
-                const float c = n.dot(l);
-                if (!(c > 0.f && l.dot(ng) > 0.f) || radiance.maxCoeff() <= 0.f) continue;
-                const Vec3f f = albedo * (c * kInvPi);  // Lambert with the cosine, as S is for hair
+                if (radiance.maxCoeff() <= 0.f) continue;
+                // The head's material with the cosine, as S is for hair; over π
+                // for a Lambert part that conserves energy (render/view.h).
+                const Vec3f f = skinShade(view.head, n, l, wo) * kInvPi;
+                if (f.maxCoeff() <= 0.f) continue;
                 const float weight = shadowRoulette(beta.cwiseProduct(f), ctx.settings.shadowRouletteThreshold, u);
                 if (weight <= 0.f) continue;
-                radiance *= weight * visibility(ctx, nextOrigin, l, distance, 0.f, RayStart{}, &r.rays);
+                if (light.castsShadows) radiance *= visibility(ctx, nextOrigin, l, distance, 0.f, kFromHead, &r.rays);
+                radiance *= weight;
                 r.radiance += beta.cwiseProduct(f).cwiseProduct(radiance);
             }
             if (last && !environment) break;

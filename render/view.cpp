@@ -56,6 +56,43 @@ Vec3f Light::toLight(const Vec3f& p, Vec3f* radiance, float* distance) const {
     return d / std::sqrt(r2);
 }
 
+std::vector<Light> View::worldLights() const {
+    std::vector<Light> out = lights;
+    const Vec3f back = (camera.position - camera.target).normalized();
+    const Vec3f right = camera.up.cross(back).normalized();
+    const Vec3f up = back.cross(right);
+    for (Light& l : out) {
+        if (!l.cameraRelative) continue;
+        l.direction = l.direction.x() * right + l.direction.y() * up + l.direction.z() * back;
+        l.position = camera.target + l.position.x() * right + l.position.y() * up + l.position.z() * back;
+        l.cameraRelative = false;
+    }
+    return out;
+}
+
+std::vector<Light> threePointRig() {
+    auto light = [](Vec3f direction, Vec3f color, float intensity, bool shadows) {
+        Light l;
+        l.direction = direction;
+        l.color = color;
+        l.intensity = intensity;
+        l.castsShadows = shadows;
+        l.cameraRelative = true;
+        return l;
+    };
+    return {light({0.85f, -0.5f, -0.3f}, {1.f, 0.95f, 0.88f}, 1.6f, true),
+            light({-0.8f, -0.1f, -0.55f}, {0.85f, 0.9f, 1.f}, 0.25f, false),
+            light({-0.25f, -0.6f, 0.8f}, {1.f, 1.f, 1.f}, 1.f, false)};
+}
+
+Vec3f skinShade(const SurfaceMaterial& m, const Vec3f& n, const Vec3f& l, const Vec3f& v) {
+    const float c = n.dot(l);
+    const float w = std::max(m.wrap, 0.f);
+    Vec3f f = m.color * std::max(0.f, (c + w) / (1.f + w));
+    if (c > 0.f && m.specular > 0.f) f += Vec3f::Constant(m.specular * std::pow(std::max(0.f, n.dot((l + v).normalized())), m.shininess));
+    return f;
+}
+
 namespace {
 float sinBetween(const Vec3f& a, const Vec3f& b) {
     const float c = std::clamp(a.dot(b), -1.f, 1.f);

@@ -66,6 +66,14 @@ struct Light {
     Vec3f position{0.f, 1.f, 1.f};      ///< point lights
     Vec3f color{1.f, 1.f, 1.f};
     float intensity = 3.f;              ///< radiance scale (directional) or power/(4π) (point)
+    /// Whether the light is blocked by hair and head. The preview shadows one
+    /// light (PreviewShadowSettings::light); the rig's fill and rim lights are
+    /// unshadowed in both renderers, so the two stay the same picture.
+    bool castsShadows = true;
+    /// Direction and position are given in the camera's frame (x right, y up,
+    /// z toward the viewer; positions relative to the camera target), so a
+    /// rig follows any camera. View::worldLights() resolves them.
+    bool cameraRelative = false;
 
     /// Unit vector from `p` toward the light, and the light's radiance at `p`.
     Vec3f toLight(const Vec3f& p, Vec3f* radiance, float* distance) const;
@@ -92,11 +100,23 @@ struct HairMaterial {
     float transmittance = 0.8f;
 };
 
-/// Opaque head material (simple Lambert + ambient).
+/// Opaque head material: a skin-like wrapped diffuse plus a faint specular
+/// sheen (see skinShade()); wrap = specular = 0 is plain Lambert.
 struct SurfaceMaterial {
     Vec3f color{0.75f, 0.6f, 0.5f};
     float ambient = 0.05f;
+    /// Light wrapping past the terminator, (n·l + w) / (1 + w): the soft
+    /// falloff light scattered under skin gives (0 = Lambert).
+    float wrap = 0.f;
+    float specular = 0.f;    ///< Blinn-Phong weight of the oily sheen (untinted)
+    float shininess = 30.f;  ///< its exponent
 };
+
+/// Reflected radiance factor of the head material for unit normal n, light
+/// direction l and view direction v, without the ambient term: albedo ·
+/// max(0, (n·l + w)/(1 + w)) + specular · (n·h)^shininess · [n·l > 0].
+/// Multiply by the light's radiance. shaders/head.frag mirrors it.
+Vec3f skinShade(const SurfaceMaterial& m, const Vec3f& n, const Vec3f& l, const Vec3f& v);
 
 /// Everything a renderer needs about the shot besides geometry.
 struct View {
@@ -105,7 +125,16 @@ struct View {
     Vec3f environment{0.f, 0.f, 0.f};  ///< constant environment radiance (black by default)
     HairMaterial hair;
     SurfaceMaterial head;
+
+    /// The lights in world space: camera-relative ones turned by the camera.
+    std::vector<Light> worldLights() const;
 };
+
+/// The default three-point rig (camera-relative, so it follows the camera):
+/// a warm key from the upper left in front (the one shadowed light), a cool,
+/// weak fill from the right and a rim light from behind and above. The
+/// scene's default render.lights spells the same rig out.
+std::vector<Light> threePointRig();
 
 /// Reflected radiance factor of Kajiya-Kay for tangent `t`, normal `n` (the
 /// shading normal used only to shift tangents), unit direction to the light

@@ -17,6 +17,7 @@ layout(std140, binding = 0) uniform Frame {
     vec4 uSecondColor;  // rgb, secondary ks
     vec4 uHairShape;    // shininess, secondary shininess, primary shift, secondary shift
     vec4 uHeadColor;    // rgb albedo, ambient
+    vec4 uHeadSkin;     // wrap, specular weight, shininess (render/view.h skinShade)
     vec4 uShadow;       // optical depth per unit of C, pcf radius, 1 / shadow map size, shadow-map depth bias
     vec4 uTess;         // max level, target pixels per piece, curve (0 Catmull-Rom, 1 B-spline), min width (px)
     vec4 uBlend;        // reference depth (m), depth scale (m), thin strands drawn as lines (0/1)

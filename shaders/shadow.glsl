@@ -37,6 +37,14 @@ float voxelDensity(vec3 world) {
                    texture(uDensity, g + vec3(-h, h, 0.0)).r + texture(uDensity, g + vec3(h, h, 0.0)).r);
 }
 
+// The head's own visibility: hair shadows only, as in the reference
+// (render/embree_scene.h RayStart::throughHead: a low-poly head shadowing
+// itself cuts its smooth shading into a staircase along the terminator).
+float hairOnlyVisibility(int light, vec3 world) {
+    if (light != uCounts.y || (uCounts.z & kFlagVoxels) == 0) return 1.0;
+    return exp(-uShadow.x * voxelDensity(world));
+}
+
 float lightVisibility(int light, vec3 world) {
     if (light != uCounts.y) return 1.0;
     float v = 1.0;

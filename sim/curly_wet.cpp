@@ -68,6 +68,7 @@ void CurlyWetStats::accumulate(const CurlyWetStats& s) {
     meanSaturation = s.meanSaturation;
     meanCohesionNeighbours = s.meanCohesionNeighbours;
     adhesionCount = std::max(adhesionCount, s.adhesionCount);
+    implicitFailures += s.implicitFailures;
     steps += s.steps;
 }
 
@@ -302,7 +303,7 @@ const CurlyWetStats& CurlyWetSolver::step(const std::vector<SurfaceFrame>& roots
     for (size_t g = 0; g < set.count; ++g) rootJump = std::max(rootJump, (set.rootPos1[g] - set.rootPos0[g]).norm());
     const bool teleport = headJump > s.teleportDistance || rootJump > s.teleportDistance ||
                           headTurn > s.teleportAngle * float(M_PI / 180.0);
-    size_t adhesion = 0;
+    size_t adhesion = 0, failures = 0;
     double neighbours = 0;
     if (teleport) {
         for (size_t g = 0; g < set.count; ++g) set.resetGuide(g);
@@ -330,6 +331,7 @@ const CurlyWetStats& CurlyWetSolver::step(const std::vector<SurfaceFrame>& roots
             m.parallel(m.groups.size(), 1, [&](size_t b, size_t e) {
                 for (size_t i = b; i < e; ++i) counters[i] = m.groups[i]->substep(ctx);
             });
+            for (const curly::GroupCounters& c : counters) failures += c.failed;
         }
         for (const curly::GroupCounters& c : counters) adhesion += c.adhesion;
     }
@@ -344,6 +346,7 @@ const CurlyWetStats& CurlyWetSolver::step(const std::vector<SurfaceFrame>& roots
     m.last = m.measure(head.collider.get());
     m.last.reset = teleport;
     m.last.adhesionCount = adhesion;
+    m.last.implicitFailures = failures;
     m.last.meanCohesionNeighbours = neighbours;
     m.last.msPerStep = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - clock0).count();
     return m.last;

@@ -112,6 +112,11 @@ struct CurlyWetStats {
     double meanSaturation = 0;      ///< mean σ over the free particles
     double meanCohesionNeighbours = 0; ///< mean other-strand neighbours within the cohesion radius
     size_t adhesionCount = 0;       ///< particles held by adhesion in the last Bullet step
+    /// Strand-substeps whose linearly implicit spring system was not finite:
+    /// those strands moved under gravity and constraints alone for that
+    /// substep (their seed forces were skipped). Non-zero means the settings
+    /// are too stiff for the step; the pipeline warns.
+    size_t implicitFailures = 0;
     size_t steps = 1;               ///< steps folded in (accumulate)
 
     /// Folds `s` into running maxima (kinetic energy, saturation: the last

@@ -298,18 +298,29 @@ HP_FOLLOWER_KERNEL Quat segmentRotation(const Quat& currentFrame, const Quat& re
 ///   n · (previous + length u - c) >= 0,  i.e.  n · u >= h = n · (c - previous) / length,
 /// is u = h n + sqrt(1 - h²) t̂ (t̂ the current direction's part across n).
 /// Exact for a plane, outside for a convex head; repeated for curved ones.
-/// When the previous vertex is too deep to reach out (h > 1), or after the
-/// rounds, p is pushed along n, giving up length rather than leaving a vertex
-/// inside. Returns true if p moved.
-inline bool projectSegmentOut(const Collider& head, const Eigen::Vector3f& previous, float length, float radius,
-                              float distance, Eigen::Vector3f normal, Eigen::Vector3f& p) {
-    if (distance >= radius) return false;
+/// When the previous vertex is too deep to reach out (h > 1), p goes as far
+/// out as the segment reaches, toward the pushed point c:
+///   p = previous + length (c - previous) / |c - previous|,
+/// and so after the rounds if p is still inside: the segment keeps its
+/// length and the vertex may stay inside (the depth is returned and counted
+/// in FollowerStats) rather than the strand stretching to reach out (issue
+/// 20: a follower pushed out of the head must not stretch). Returns the
+/// signed distance of p afterwards; `radius` or more when it did not move.
+inline float projectSegmentOut(const Collider& head, const Eigen::Vector3f& previous, float length, float radius,
+                               float distance, Eigen::Vector3f normal, Eigen::Vector3f& p) {
+    if (distance >= radius) return distance;
     const float margin = 1e-6f + 1e-3f * radius;
+    // The reachable point toward c, at the segment's length.
+    auto toward = [&](const Eigen::Vector3f& c) {
+        const Eigen::Vector3f d = c - previous;
+        const float n = d.norm();
+        return n > 0.f ? Eigen::Vector3f(previous + (length / n) * d) : c;
+    };
     for (int round = 0; round < 4 && distance < radius; ++round) {
         const Eigen::Vector3f c = p + (radius - distance + margin) * normal;
         const float h = normal.dot(c - previous) / length;
         if (h > 1.f || length <= 0.f) {
-            p = c;
+            p = toward(c);
         } else {
             Eigen::Vector3f across = (p - previous) - normal * normal.dot(p - previous);
             if (across.squaredNorm() < 1e-24f) across = normal.unitOrthogonal();
@@ -318,8 +329,11 @@ inline bool projectSegmentOut(const Collider& head, const Eigen::Vector3f& previ
         }
         distance = head.signedDistance(p, &normal);
     }
-    if (distance < radius) p += (radius - distance + margin) * normal;
-    return true;
+    if (distance < radius) {
+        p = toward(p + (radius - distance + margin) * normal);
+        distance = head.signedDistance(p);
+    }
+    return distance;
 }
 
 }  // namespace hp::follower

@@ -79,6 +79,15 @@ struct alignas(32) FollowerPacket {
     uint32_t own = 0;  ///< offset of the packet's own rest segments: P slots × 3 × 8 lanes
 };
 
+/// Barycentric mode: the second and third guide of each lane of a packet,
+/// the weights, and the rest twists K2, K3 (about y) into guide 1's frame.
+struct alignas(32) TrianglePacket {
+    static constexpr int kLanes = FollowerPacket::kLanes;
+    uint32_t guide2[kLanes], guide3[kLanes];
+    float b1[kLanes], b2[kLanes], b3[kLanes];
+    float k2c[kLanes], k2s[kLanes], k3c[kLanes], k3s[kLanes];
+};
+
 struct Followers::Impl {
     FollowerSettings settings;
     size_t guides = 0, followers = 0;
@@ -90,6 +99,7 @@ struct Followers::Impl {
 
     std::vector<FollowerClass> classes;
     std::vector<FollowerPacket> packets;  ///< all classes, class by class
+    std::vector<TrianglePacket> triangles;  ///< Barycentric mode: one per packet
 
     // Followers, structure of arrays.
     std::vector<FollowerNeighbours> neighbours;
@@ -134,6 +144,8 @@ struct StepContext {
 
 struct Counters {
     size_t projected = 0, queries = 0;
+    size_t inside = 0;      ///< projected vertices left inside (signed distance < 0)
+    float maxDepth = 0.f;   ///< deepest of those, m
 };
 
 /// Rebuilds the pair records [begin, end) of class `c` from its guide rows.

@@ -32,6 +32,7 @@
 #include "sim/follower_simd.h"
 #include "sim/follower_state.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hp::follower {
@@ -126,7 +127,11 @@ void collideLane(const StepContext& ctx, const FollowerClass& c, const float* g1
             const float* r = ownRest + size_t(v) * 3 * kLanes + k;
             length = std::sqrt(r[0] * r[0] + r[kLanes] * r[kLanes] + r[2 * kLanes] * r[2 * kLanes]);
         }
-        projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p);
+        const float after = projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p);
+        if (after < 0.f) {
+            ++counters.inside;
+            counters.maxDepth = std::max(counters.maxDepth, -after);
+        }
         sx += p.x() - qx;
         sy += p.y() - qy;
         sz += p.z() - qz;
@@ -173,6 +178,21 @@ template <FollowerMode M, bool Own>
     for (int k = 0; k < kLanes; ++k) {
         guideRec[k] = c.guideRecords.data() + size_t(pk.guide1[k]) * P * FollowerClass::kRecord;
         pairRec[k] = c.pairRecords.data() + size_t(pk.pair[k]) * P * FollowerClass::kRecord;
+    }
+    // Barycentric: guides 2 and 3 of each lane, their weights and twists.
+    constexpr bool kTri = M == FollowerMode::Barycentric;
+    static_assert(!kTri || Own, "barycentric followers read their own rest shapes");
+    const TrianglePacket* tp = kTri ? &im.triangles[size_t(&pk - im.packets.data())] : nullptr;
+    const float* guide2Rec[kLanes];
+    const float* guide3Rec[kLanes];
+    f8 b1{}, b2{}, b3{}, k2c{}, k2s{}, k3c{}, k3s{};
+    if constexpr (kTri) {
+        for (int k = 0; k < kLanes; ++k) {
+            guide2Rec[k] = c.guideRecords.data() + size_t(tp->guide2[k]) * P * FollowerClass::kRecord;
+            guide3Rec[k] = c.guideRecords.data() + size_t(tp->guide3[k]) * P * FollowerClass::kRecord;
+        }
+        b1 = load(tp->b1), b2 = load(tp->b2), b3 = load(tp->b3);
+        k2c = load(tp->k2c), k2s = load(tp->k2s), k3c = load(tp->k3c), k3s = load(tp->k3s);
     }
 
     // Root frames of the lanes: E = [t', n, z'] per lane, orthonormalised and
@@ -228,7 +248,7 @@ template <FollowerMode M, bool Own>
     for (uint32_t j = 1; j <= S; ++j) {
         f8 t{}, s{}, co = splat(1.f);
         f8 theta{}, e1{}, e2{}, e3{}, e4{}, e5{}, e6{}, dv{};
-        if constexpr (M != FollowerMode::Cluster) {
+        if constexpr (M != FollowerMode::Cluster && !kTri) {
             // The lanes' pair records (θ, ..., d_v), the slerp weight t
             // (Algorithm 1: d_r = fixedOffset d_f + rand_xy d_v), sin and cos of φ = tθ.
             for (int k = 0; k < kLanes; ++k) lane[k] = pairRec[k] + 8 * j;
@@ -255,6 +275,28 @@ template <FollowerMode M, bool Own>
                 vy += ss * e2 + cs * e5;
                 vz += ss * e3 + cs * e6;
             }
+        } else if constexpr (kTri) {
+            // q = normalize(b1 q1 + b2 ±K2 q2 K2⁻¹ + b3 ±K3 q3 K3⁻¹): K turns the
+            // vector part about y (x' = c x + s z, z' = -s x + c z); each sign
+            // puts the quaternion on q1's side (q and -q are one rotation).
+            auto corner = [&](const float* const* rec, f8 kc, f8 ks, f8 b, f8& ow, f8& ox, f8& oy, f8& oz) {
+                f8 m0, m1, m2, m3;
+                for (int k = 0; k < kLanes; ++k) lane[k] = rec[k] + 8 * j;
+                transpose8x4(lane, m0, m1, m2, m3);
+                const f8 x2 = kc * m1 + ks * m3, z2 = kc * m3 - ks * m1;
+                const f8 dot = l0 * m0 + l1 * x2 + l2 * m2 + l3 * z2;
+                const f8 sb = select(dot < splat(0.f), -b, b);
+                ow += sb * m0;
+                ox += sb * x2;
+                oy += sb * m2;
+                oz += sb * z2;
+            };
+            f8 qw = b1 * l0, qx = b1 * l1, qy = b1 * l2, qz = b1 * l3;
+            corner(guide2Rec, k2c, k2s, b2, qw, qx, qy, qz);
+            corner(guide3Rec, k3c, k3s, b3, qw, qx, qy, qz);
+            const f8 inv = splat(1.f) / sqrt8(qw * qw + qx * qx + qy * qy + qz * qz);
+            const float* f = ownRest + size_t(j) * 3 * kLanes;
+            rotate(qw * inv, qx * inv, qy * inv, qz * inv, load(f), load(f + kLanes), load(f + 2 * kLanes), vx, vy, vz);
         } else {  // (1): q = cos φ a + sin φ e, then q f q* of the lane's own rest segment
             const f8 qw = co * l0 + s * e1, qx = co * l1 + s * e2, qy = co * l2 + s * e3, qz = co * l3 + s * e4;
             const float* f = ownRest + size_t(j) * 3 * kLanes;
@@ -341,7 +383,19 @@ template <FollowerMode M, bool Own>
             for (size_t i = 0; i < n3; ++i) p[i] = row[i];
         }
     }
-    if (!ctx.difference) {
+    if (!ctx.difference && kTri) {
+        // No previous positions: the barycentric blend of the three guides' vertex velocities.
+        for (uint32_t k = 0; k < pk.count; ++k) {
+            const float* g[3] = {c.cold.data() + size_t(pk.guide1[k]) * FollowerClass::kCold * P,
+                                 c.cold.data() + size_t(tp->guide2[k]) * FollowerClass::kCold * P,
+                                 c.cold.data() + size_t(tp->guide3[k]) * FollowerClass::kCold * P};
+            const float b[3] = {tp->b1[k], tp->b2[k], tp->b3[k]};
+            float* vel = outVel[k];
+            for (uint32_t v = 0; v <= S; ++v)
+                for (int i = 0; i < 3; ++i)
+                    vel[3 * v + i] = b[0] * g[0][(4 + i) * P + v] + b[1] * g[1][(4 + i) * P + v] + b[2] * g[2][(4 + i) * P + v];
+        }
+    } else if (!ctx.difference) {
         // No previous positions: the slerp-weighted blend of the guides' vertex velocities.
         for (uint32_t k = 0; k < pk.count; ++k) {
             const float* g1 = c.cold.data() + size_t(pk.guide1[k]) * FollowerClass::kCold * P;
@@ -374,6 +428,8 @@ template <FollowerMode M, bool Own>
         case FollowerMode::Varied:
             return own ? processRangeT<FollowerMode::Varied, true>(ctx, begin, end, counters)
                        : processRangeT<FollowerMode::Varied, false>(ctx, begin, end, counters);
+        case FollowerMode::Barycentric:  // always own rest shapes (Followers' constructor)
+            return processRangeT<FollowerMode::Barycentric, true>(ctx, begin, end, counters);
     }
 }
 

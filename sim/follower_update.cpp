@@ -12,10 +12,12 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <vector>
 
 namespace hp {
 
@@ -192,12 +194,18 @@ FollowerStats Followers::update(const FollowerStep& step, StrandFrame& out) {
     follower::StepContext ctx{&im, step.followerRoots.data(), collider, out.positions.data() + guideVertices,
                               out.velocities.data() + guideVertices, stats.differenceVelocities,
                               step.dt > 0.0 ? float(1.0 / step.dt) : 0.f};
-    std::atomic<size_t> projected{0}, queries{0};
+    std::atomic<size_t> projected{0}, queries{0}, inside{0};
+    std::atomic<uint32_t> depthBits{0};  // a non-negative float's bits order like the float
     auto packetsLoop = [&](const tbb::blocked_range<size_t>& r) {
         follower::Counters counters;
         follower::processPackets(ctx, r.begin(), r.end(), counters);
         projected += counters.projected;
         queries += counters.queries;
+        inside += counters.inside;
+        uint32_t bits;
+        std::memcpy(&bits, &counters.maxDepth, sizeof bits);
+        uint32_t seen = depthBits.load();
+        while (bits > seen && !depthBits.compare_exchange_weak(seen, bits)) {}
     };
     // Each pair and each follower depends only on the tables before it, so
     // any partition gives the same bits; the counters are integer sums.
@@ -215,6 +223,9 @@ FollowerStats Followers::update(const FollowerStep& step, StrandFrame& out) {
     }
     stats.projected = projected;
     stats.collisionQueries = queries;
+    stats.penetrationCount = inside;
+    const uint32_t bits = depthBits.load();
+    std::memcpy(&stats.maxPenetration, &bits, sizeof bits);
     im.lastPositions = out.positions.data();
     im.lastVertexCount = total;
     return stats;
@@ -237,6 +248,55 @@ void Followers::adoptPrevious(const StrandFrame& out) {
         throw Error("followers: the frame to adopt does not have this groom's follower layout");
     im.lastPositions = out.positions.data();
     im.lastVertexCount = total;
+}
+
+}  // namespace hp
+
+namespace hp {
+
+Followers::LengthError Followers::lengthError(const StrandFrame& out) const {
+    const Impl& im = *impl_;
+    const size_t G = im.guides, F = im.followers;
+    if (out.guideCount != G || out.strandCount() != G + F ||
+        !sameRange(out.offsets, G, im.vertexOffset, 0, F + 1, out.offsets[G]))
+        throw Error("followers: the frame to measure does not have this groom's follower layout");
+    const Vec3f* base = out.positions.data() + out.offsets[G];
+    constexpr int L = FollowerPacket::kLanes;
+    // Per packet, then summed in packet order: the same result on any thread count.
+    std::vector<double> sums(im.packets.size()), maxima(im.packets.size());
+    std::vector<size_t> counts(im.packets.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, im.packets.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            const FollowerPacket& pk = im.packets[i];
+            const FollowerClass& c = im.classes[pk.cls];
+            double sum = 0, worst = 0;
+            for (uint32_t k = 0; k < pk.count; ++k) {
+                const Vec3f* p = base + pk.vertexOffset[k];
+                for (uint32_t j = 1; j <= c.segments; ++j) {
+                    double rest = pk.scale[k];
+                    if (!im.ownRestData.empty()) {
+                        const float* o = im.ownRestData.data() + pk.own + size_t(j) * 3 * L + k;
+                        rest = std::sqrt(double(o[0]) * o[0] + double(o[L]) * o[L] + double(o[2 * L]) * o[2 * L]);
+                    }
+                    const double e = std::abs((p[j] - p[j - 1]).cast<double>().norm() / rest - 1.0);
+                    sum += e;
+                    worst = std::max(worst, e);
+                }
+            }
+            sums[i] = sum;
+            maxima[i] = worst;
+            counts[i] = size_t(pk.count) * c.segments;
+        }
+    });
+    LengthError e;
+    size_t segments = 0;
+    for (size_t i = 0; i < sums.size(); ++i) {
+        e.mean += sums[i];
+        e.max = std::max(e.max, maxima[i]);
+        segments += counts[i];
+    }
+    e.mean = segments ? e.mean / double(segments) : 0.0;
+    return e;
 }
 
 }  // namespace hp

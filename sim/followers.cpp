@@ -6,6 +6,7 @@
 #include "sim/follower_kernels.h"
 #include "sim/follower_neighbours.h"
 #include "sim/follower_state.h"
+#include "sim/follower_triangles.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -34,14 +35,8 @@ RestShapes RestShapes::straight(size_t count, int vertices, float length) {
     return s;
 }
 
-namespace {
-
-using Mat3d = Eigen::Matrix3d;
-using Vec3d = Eigen::Vector3d;
-
-/// Orthonormal root frame [t, n, t × n] of a rest SurfaceFrame (Gram-Schmidt,
-/// so slightly inexact mesh frames are accepted).
-Mat3d restFrame(const SurfaceFrame& f, const char* what, size_t i) {
+Eigen::Matrix3d restRootFrame(const SurfaceFrame& f, const char* what, size_t i) {
+    using Vec3d = Eigen::Vector3d;
     Vec3d n = f.normal.cast<double>(), t = f.tangent.cast<double>();
     if (!n.allFinite() || !t.allFinite() || !f.position.allFinite() || n.norm() < 1e-6)
         throw Error(cat("followers: ", what, " ", i, " has a non-finite or zero root frame"));
@@ -49,10 +44,15 @@ Mat3d restFrame(const SurfaceFrame& f, const char* what, size_t i) {
     t -= n * n.dot(t);
     if (t.norm() < 1e-6) throw Error(cat("followers: ", what, " ", i, " has a tangent parallel to its normal"));
     t.normalize();
-    Mat3d m;
+    Eigen::Matrix3d m;
     m << t, n, t.cross(n);
     return m;
 }
+
+namespace {
+
+using Mat3d = Eigen::Matrix3d;
+using Vec3d = Eigen::Vector3d;
 
 /// Rotation taking coordinates in frame A to coordinates in frame B after
 /// carrying A over to B's normal by the minimal rotation: B⁻¹ swing(n_A → n_B) A.
@@ -130,7 +130,79 @@ void buildPackets(Followers::Impl& im, const std::vector<size_t>& ownStart, cons
     }
 }
 
+/// Barycentric followers without own rest shapes: segment y's direction is
+/// the blend of the three corners' rest directions, each turned into the
+/// follower's frame by its rest twist,
+///   d_y = normalize(Σ_i b_i R_y(φ_i) r_i(y)),   x_{y+1} = x_y + (length / S) d_y,
+/// so the rest shape varies continuously over the triangulation like the motion.
+RestShapes blendedRestShapes(const FollowerGroom& groom, const std::vector<Mat3d>& guideFrames,
+                             const Followers::Impl& im, const std::vector<GuideTriangulation::Location>& corners) {
+    RestShapes out;
+    for (size_t f = 0; f < corners.size(); ++f) {
+        const uint32_t n = perFollower(groom.followerVertices, f);
+        const float length = perFollower(groom.followerLengths, f);
+        if (n < 2 || n > kMaxFollowerVertices)
+            throw Error(cat("followers: follower ", f, " has ", n, " vertices (2 to ", kMaxFollowerVertices, " supported)"));
+        if (!(length > 0.f) || !std::isfinite(length))
+            throw Error(cat("followers: follower ", f, " has length ", length, " (must be > 0)"));
+        const Mat3d frame = restRootFrame(groom.followerRoots[f], "follower", f);
+        double phi[3];
+        for (int i = 0; i < 3; ++i) phi[i] = twistAngle(guideFrames[corners[f].guide[i]], frame);
+        Vec3f p = Vec3f::Zero();
+        out.points.push_back(p);
+        for (uint32_t y = 0; y + 1 < n; ++y) {
+            Vec3d d = Vec3d::Zero(), first = Vec3d::Zero();
+            for (int i = 0; i < 3; ++i) {
+                const uint32_t g = corners[f].guide[i], a = im.guideSegmentOffsets[g];
+                const uint32_t gs = im.guideSegmentOffsets[g + 1] - a;
+                const Vec3d r = rotateY(phi[i], im.guideRestDirs[a + FollowerClass::guideSegment(y, n - 1, gs)].cast<double>());
+                if (i == 0) first = r;
+                d += double(corners[f].weight[i]) * r;
+            }
+            d = d.norm() > 1e-9 ? Vec3d(d.normalized()) : first;
+            p += (double(length) / double(n - 1) * d).cast<float>();
+            out.points.push_back(p);
+        }
+        out.offsets.push_back(uint32_t(out.points.size()));
+    }
+    return out;
+}
+
 }  // namespace
+
+RestShapes followerBaseShapes(const FollowerGroom& groom) {
+    if (groom.followerShapes.count() > 0) return groom.followerShapes;
+    const size_t G = groom.guideRoots.size(), F = groom.followerRoots.size();
+    RestShapes out;
+    if (F == 0) return out;
+    if (G == 0 || groom.guideShapes.count() != G) throw Error("followers: base shapes need one rest shape per guide");
+    std::vector<Vec3f> guideRootPositions(G);
+    for (size_t g = 0; g < G; ++g) guideRootPositions[g] = groom.guideRoots[g].position;
+    const PointGrid grid(std::move(guideRootPositions));
+    for (size_t f = 0; f < F; ++f) {
+        uint32_t g1 = 0;
+        float d2 = 0.f;
+        grid.nearest(groom.followerRoots[f].position, 1, &g1, &d2);
+        const uint32_t n = perFollower(groom.followerVertices, f);
+        if (n < 2) throw Error(cat("followers: follower ", f, " has ", n, " vertices (2 or more needed)"));
+        const float segment = perFollower(groom.followerLengths, f) / float(n - 1);
+        // The kernel's effective frame is R_f R_y(φ): a rest direction r of
+        // guide 1 is R_y(φ) r in the follower's own root frame.
+        const double phi = twistAngle(restRootFrame(groom.guideRoots[g1], "guide", g1),
+                                      restRootFrame(groom.followerRoots[f], "follower", f));
+        const uint32_t a = groom.guideShapes.offsets[g1], gs = groom.guideShapes.offsets[g1 + 1] - a - 1;
+        Vec3f p = Vec3f::Zero();
+        out.points.push_back(p);
+        for (uint32_t y = 0; y + 1 < n; ++y) {
+            const uint32_t k = a + FollowerClass::guideSegment(y, n - 1, gs);
+            const Vec3d d = (groom.guideShapes.points[k + 1] - groom.guideShapes.points[k]).cast<double>().normalized();
+            p += (double(segment) * rotateY(phi, d)).cast<float>();
+            out.points.push_back(p);
+        }
+        out.offsets.push_back(uint32_t(out.points.size()));
+    }
+    return out;
+}
 
 Followers::Followers(const FollowerGroom& groom, const FollowerSettings& settings) : impl_(std::make_unique<Impl>()) {
     Impl& im = *impl_;
@@ -138,15 +210,17 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
     const size_t G = groom.guideRoots.size(), F = groom.followerRoots.size();
     im.guides = G;
     im.followers = F;
-    const bool own = groom.followerShapes.count() > 0;
+    const bool given = groom.followerShapes.count() > 0;  // own rest shapes from the groom
+    const bool tri = settings.mode == FollowerMode::Barycentric;
+    const bool own = given || tri;  // barycentric followers always read their own rest shapes
 
     // --- Checks: every message names the strand and what is wrong.
     if (groom.guideShapes.count() != G)
         throw Error(cat("followers: ", G, " guide roots but ", groom.guideShapes.count(), " guide rest shapes"));
     if (F > 0 && G == 0) throw Error("followers: followers need at least one guide");
-    if (own && groom.followerShapes.count() != F)
+    if (given && groom.followerShapes.count() != F)
         throw Error(cat("followers: ", F, " follower roots but ", groom.followerShapes.count(), " follower rest shapes"));
-    if (!own) {
+    if (!given) {
         if (groom.followerVertices.size() != 1 && groom.followerVertices.size() != F)
             throw Error("followers: followerVertices needs one value or one per follower");
         if (groom.followerLengths.size() != 1 && groom.followerLengths.size() != F)
@@ -160,13 +234,13 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
     if (!(settings.rootRadius >= 0.f) || !(settings.tipRadius >= 0.f))
         throw Error("followers: radii must be non-negative");
     for (size_t g = 0; g < G; ++g) checkShape(groom.guideShapes, g, "guide");
-    if (own)
+    if (given)
         for (size_t f = 0; f < F; ++f) checkShape(groom.followerShapes, f, "follower");
 
     // --- Guides at rest: unit directions and inverse transported frames P_y⁻¹.
     std::vector<Mat3d> guideFrames(G);
     for (size_t g = 0; g < G; ++g) {
-        guideFrames[g] = restFrame(groom.guideRoots[g], "guide", g);
+        guideFrames[g] = restRootFrame(groom.guideRoots[g], "guide", g);
         const uint32_t a = groom.guideShapes.offsets[g], b = groom.guideShapes.offsets[g + 1];
         follower::Quat frame;
         Vec3f previous = Vec3f::UnitY();
@@ -180,9 +254,25 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
         im.guideSegmentOffsets.push_back(uint32_t(im.restInverse.size()));
     }
 
+    // --- Barycentric mode: the guide-root triangle over each follower and,
+    // without the groom's own shapes, rest shapes blended from its corners.
+    std::vector<GuideTriangulation::Location> corners;
+    RestShapes blended;
+    if (tri) {
+        std::vector<Vec3f> rootPositions(G);
+        for (size_t g = 0; g < G; ++g) rootPositions[g] = groom.guideRoots[g].position;
+        const GuideTriangulation triangulation(std::move(rootPositions));
+        corners.resize(F);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, F, 512), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t f = r.begin(); f != r.end(); ++f) corners[f] = triangulation.locate(groom.followerRoots[f].position);
+        });
+        if (!given) blended = blendedRestShapes(groom, guideFrames, im, corners);
+    }
+    const RestShapes& shapes = given ? groom.followerShapes : blended;
+
     // --- Segment-count classes.
     auto followerSegments = [&](size_t f) -> uint32_t {
-        return own ? groom.followerShapes.offsets[f + 1] - groom.followerShapes.offsets[f] - 1
+        return own ? shapes.offsets[f + 1] - shapes.offsets[f] - 1
                    : perFollower(groom.followerVertices, f) - 1;
     };
     im.classOf.resize(F);
@@ -269,7 +359,7 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
     // Frames and lengths are checked serially first, so the first bad follower is the one reported.
     std::vector<Mat3d> followerFrames(F);
     for (size_t f = 0; f < F; ++f) {
-        followerFrames[f] = restFrame(groom.followerRoots[f], "follower", f);
+        followerFrames[f] = restRootFrame(groom.followerRoots[f], "follower", f);
         if (!own) {
             const float length = perFollower(groom.followerLengths, f);
             if (!(length > 0.f) || !std::isfinite(length))
@@ -281,8 +371,9 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
         float d2[64];
         for (size_t f = range.begin(); f != range.end(); ++f) {
             const Mat3d& Rf = followerFrames[f];
-            const int found = grid.nearest(groom.followerRoots[f].position, k, idx, d2);
-            uint32_t g1 = idx[0], g2 = found > 1 ? idx[1] : idx[0];
+            const int found = tri ? 0 : grid.nearest(groom.followerRoots[f].position, k, idx, d2);
+            uint32_t g1 = tri ? corners[f].guide[0] : idx[0];
+            uint32_t g2 = tri ? corners[f].guide[1] : found > 1 ? idx[1] : idx[0];
             const uint32_t segs = followerSegments(f);
             if (byShape && found > 2) {
                 // Own rest shape: rank candidates by similarity to it. Without:
@@ -293,9 +384,9 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
                 for (int j = own ? 0 : 1; j < found; ++j) {
                     double s;
                     if (own) {
-                        const uint32_t a = groom.followerShapes.offsets[f];
+                        const uint32_t a = shapes.offsets[f];
                         auto dirs = [&](uint32_t y) {
-                            return Vec3d((groom.followerShapes.points[a + y + 1] - groom.followerShapes.points[a + y]).cast<double>().normalized());
+                            return Vec3d((shapes.points[a + y + 1] - shapes.points[a + y]).cast<double>().normalized());
                         };
                         s = shapeDistance(dirs, segs, Rf, idx[j]);
                     } else {
@@ -318,6 +409,10 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
             FollowerNeighbours& nb = im.neighbours[f];
             nb.guide1 = g1;
             nb.guide2 = g2;
+            if (tri) {
+                nb.guide3 = corners[f].guide[2];
+                for (int i = 0; i < 3; ++i) nb.weight[i] = corners[f].weight[i];
+            }
             nb.distance1 = std::sqrt(distance2(groom.followerRoots[f].position, groom.guideRoots[g1].position));
             nb.distance2 = std::sqrt(distance2(groom.followerRoots[f].position, groom.guideRoots[g2].position));
             im.weight[f] = follower::interpolationWeight(nb.distance1, nb.distance2);
@@ -333,9 +428,9 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
                 // Rest segments (direction × length) in the effective frame:
                 // f' = R_y(φ)ᵀ f, slot y + 1 for segment y.
                 float* out = ownRows.data() + ownStart[f];
-                const uint32_t a = groom.followerShapes.offsets[f];
+                const uint32_t a = shapes.offsets[f];
                 for (uint32_t y = 0; y < segs; ++y) {
-                    const Vec3d d = (groom.followerShapes.points[a + y + 1] - groom.followerShapes.points[a + y]).cast<double>();
+                    const Vec3d d = (shapes.points[a + y + 1] - shapes.points[a + y]).cast<double>();
                     const double len = d.norm();
                     const Vec3d r = len * rotateY(-phiF, d / len);
                     for (int i = 0; i < 3; ++i) out[i * c.pad + y + 1] = float(r[i]);
@@ -354,7 +449,8 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
         for (size_t f = 0; f < F; ++f) {
             FollowerClass& c = im.classes[im.classOf[f]];
             const uint32_t g1 = im.neighbours[f].guide1;
-            const uint32_t g2 = settings.mode == FollowerMode::Cluster ? g1 : im.neighbours[f].guide2;
+            // Cluster and barycentric followers read guide 1's rows only (no pair table).
+            const uint32_t g2 = settings.mode == FollowerMode::Cluster || tri ? g1 : im.neighbours[f].guide2;
             const auto [it, added] = index[im.classOf[f]].emplace(uint64_t(g1) << 32 | g2, uint32_t(c.pairs.size()));
             if (added) {
                 const double phiK = twistAngle(guideFrames[g2], guideFrames[g1]);
@@ -371,6 +467,26 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
     im.ids.resize(F);
     for (size_t f = 0; f < F; ++f) im.ids[f] = groom.followerIds.empty() ? uint32_t(G + f) : groom.followerIds[f];
     buildPackets(im, ownStart, ownRows);
+    if (tri) {
+        // K of guides 2 and 3 into guide 1's frame, as for the pairs.
+        im.triangles.resize(im.packets.size());
+        for (size_t i = 0; i < im.packets.size(); ++i)
+            for (int l = 0; l < FollowerPacket::kLanes; ++l) {
+                const FollowerNeighbours& nb = im.neighbours[im.packets[i].follower[l]];
+                TrianglePacket& t = im.triangles[i];
+                t.guide2[l] = nb.guide2;
+                t.guide3[l] = nb.guide3;
+                t.b1[l] = nb.weight[0];
+                t.b2[l] = nb.weight[1];
+                t.b3[l] = nb.weight[2];
+                const double phi2 = twistAngle(guideFrames[nb.guide2], guideFrames[nb.guide1]);
+                const double phi3 = twistAngle(guideFrames[nb.guide3], guideFrames[nb.guide1]);
+                t.k2c[l] = float(std::cos(phi2));
+                t.k2s[l] = float(std::sin(phi2));
+                t.k3c[l] = float(std::cos(phi3));
+                t.k3s[l] = float(std::sin(phi3));
+            }
+    }
 }
 
 Followers::~Followers() = default;

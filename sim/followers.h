@@ -65,6 +65,14 @@ enum class FollowerMode {
     Cluster,      ///< copy the nearest guide's segment rotations
     Interpolate,  ///< slerp between the two nearest guides by relative root distance
     Varied,       ///< seed 000's Algorithm 1 (recommended)
+    /// Three guides, the corners of the guide-root triangle over the
+    /// follower (sim/follower_triangles.h), rotations blended by the
+    /// barycentric weights b: q = normalize(b1 q1 + b2 ±K2 q2 K2⁻¹ + b3 ±K3 q3 K3⁻¹)
+    /// (signs toward q1, K the rest twist into guide 1's frame). Followers
+    /// fill the volume between guides instead of the ruled sheets between two.
+    /// Without followerShapes a follower's rest shape is the same blend of
+    /// its three guides' rest directions.
+    Barycentric,
 };
 
 enum class NeighbourRule {
@@ -116,10 +124,25 @@ struct FollowerGroom {
     std::vector<uint32_t> followerIds;
 };
 
+/// Each follower's rest shape as the followers take it when the groom has no
+/// followerShapes: its nearest guide's rest directions, resampled to the
+/// follower's vertex count (FollowerClass::guideSegment), turned by the rest
+/// twist between the two root frames, times the follower's segment length.
+/// Returns groom.followerShapes itself when it is not empty. Followers built
+/// from the result keep the same rest shapes (to float rounding).
+RestShapes followerBaseShapes(const FollowerGroom& groom);
+
+/// Orthonormal root frame [t, n, t × n] of a rest SurfaceFrame (Gram-Schmidt,
+/// so slightly inexact mesh frames are accepted). Throws hp::Error naming
+/// `what` `index` for a non-finite or degenerate frame.
+Eigen::Matrix3d restRootFrame(const SurfaceFrame& frame, const char* what, size_t index);
+
 /// The two guides a follower reads, in the order used (guide1 leads).
 struct FollowerNeighbours {
     uint32_t guide1 = 0, guide2 = 0;
     float distance1 = 0.f, distance2 = 0.f;  ///< rest root distances, m
+    uint32_t guide3 = 0;                     ///< Barycentric mode: the third corner
+    float weight[3] = {1.f, 0.f, 0.f};       ///< Barycentric mode: weights of guides 1, 2, 3
 };
 
 /// One step's inputs. `guides` may be the same object as update()'s `out`
@@ -136,6 +159,11 @@ struct FollowerStep {
 
 struct FollowerStats {
     size_t projected = 0;         ///< follower vertices pushed out of the head
+    /// Projected vertices the segment could not bring out (signed distance
+    /// < 0 after projection): the segment keeps its length instead. Every
+    /// other follower vertex is outside (queried, or cleared by the bound).
+    size_t penetrationCount = 0;
+    float maxPenetration = 0.f;   ///< deepest of those, m
     size_t collisionQueries = 0;  ///< collider queries the guide-distance bound could not skip
     bool differenceVelocities = false;  ///< velocities are (x - x_prev) / dt
     bool layoutWritten = false;   ///< offsets, ids and radii were (re)written this update
@@ -178,6 +206,16 @@ class Followers {
     /// update() had written it. Throws hp::Error when its layout does not
     /// match the groom.
     void adoptPrevious(const StrandFrame& out);
+
+    /// Segment length errors |length / rest - 1| of the followers in `out`
+    /// (this object's last output, or any frame with its layout): max and
+    /// mean over every follower segment. Rest lengths are the groom's (own
+    /// rest shapes' segments, or length / segments). Throws hp::Error when
+    /// `out` does not have this groom's layout.
+    struct LengthError {
+        double max = 0, mean = 0;
+    };
+    LengthError lengthError(const StrandFrame& out) const;
 
     size_t guideCount() const;
     size_t followerCount() const;

@@ -2,6 +2,7 @@
 // contacts), parallelism over Bullet worlds, statistics. The Bullet side of
 // each formulation is in sim/rope_group.cpp and sim/rigid_group.cpp.
 #include "sim/guides.h"
+#include "sim/scene_cut.h"
 #include "sim/state_blob.h"
 
 #include "core/errors.h"
@@ -284,16 +285,23 @@ const GuideStats& GuideSolver::step(const std::vector<SurfaceFrame>& roots, cons
     // than the limits allow. The guides restart at rest on the new roots.
     const Eigen::Isometry3f& T0 = m.headTransform;
     const Eigen::Isometry3f& T1 = head.transform;
-    const float headJump = (T1.translation() - T0.translation()).norm();
-    const float headTurn = Eigen::AngleAxisf(T1.linear() * T0.linear().transpose()).angle();
     float rootJump = 0.f;
     for (size_t g = 0; g < set.count; ++g) rootJump = std::max(rootJump, (set.rootPos1[g] - set.rootPos0[g]).norm());
-    const bool teleport = headJump > s.teleportDistance || rootJump > s.teleportDistance ||
-                          headTurn > s.teleportAngle * float(M_PI / 180.0);
+    const bool teleport = isCut(stepJump(T0, T1, rootJump), s.teleportDistance, s.teleportAngle);
     size_t strandContacts = 0;
     set.headTransform = T1;
     if (teleport) {
         m.forGroups([](guides::GuideGroup& grp) { grp.reset(); });
+        // The rest shape on the new pose may cross the head or another
+        // collider (the new pose is arbitrary): place it outside every one
+        // before the cut frame is written, lengths kept (strand::placeSegment).
+        if (s.headCollision && head.collider) {
+            strand::HeadQuery hq;
+            hq.collider = head.collider.get();
+            m.forGroups([&](guides::GuideGroup& grp) {
+                for (size_t g = grp.begin(); g < grp.end(); ++g) m.relax(g, &hq);
+            });
+        }
         ++set.version;
         set.xPrev = set.x;
         set.vPrev = set.v;

@@ -19,6 +19,13 @@ set(_hp_slow_tests
   test_groom:Units.FbxInCentimetresIsReadInMetresAndInfoSaysSo  # two hairpipe runs
   test_groom:Settle.ConvergesLiesOnTheHeadHoldsStillAndIsReusedByteForByte  # three settles
   test_groom:GroomImport.ExportedUsdaImportsBackAsTheCachedFrame  # sim + export-usd runs
+  test_render_parity:RenderParity.ThreePointRigAndSkinMatch    # 5 reference renders
+  test_scene_cut:SceneCut.NoVertexInsideAnyColliderOnTheCutFrameAndAfter  # 60 solver steps, two formulations
+  test_scene_cut:SceneCut.InfoListsTheCutsOfTheClip             # three head imports
+  test_scene_cut:SceneCut.StressClipCutFrameHasNoVertexInsideAnyCollider  # exact collider per step
+  test_collision_world:CollisionWorld.HairOnAShoulderBoxStaysOnIt  # 300 solver steps
+  test_collision_world:CollisionWorld.PropColliderFromASecondFile  # head import + grid
+  test_stress_clip:StressClip.DISABLED_NoStretchNoPenetrationAfterAnyFrameOnOneAndTwoThreads  # two 62-frame shots
 )
 foreach(_entry IN LISTS _hp_slow_tests)
   string(REPLACE ":" ";" _parts "${_entry}")

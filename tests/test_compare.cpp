@@ -300,7 +300,7 @@ TEST(CompareFiles, MismatchedResolutionNamesBothFiles) {
     test::TempDir dir;
     writeImage((dir / "a.0001.exr").string(), texture(160, 120));
     writeImage((dir / "b.0001.exr").string(), texture(80, 60));
-    CompareJob job{(dir / "a.####.exr").string(), (dir / "b.####.exr").string(), dir / "out", {}, {}, {}, 64};
+    CompareJob job{(dir / "a.####.exr").string(), (dir / "b.####.exr").string(), dir / "out", {}, {}, {}, 64, {}};
     try {
         compareFrame(job, 1);
         FAIL() << "expected an error";
@@ -322,7 +322,7 @@ TEST(CompareFiles, FrameRecordRoundTripsThroughJson) {
     test::TempDir dir;
     writeImage((dir / "a.0003.png").string(), texture());
     writeImage((dir / "b.0003.exr").string(), withNoise(texture(), 0.02f));
-    CompareJob job{(dir / "a.####.png").string(), (dir / "b.####.exr").string(), dir / "out", {}, {}, {}, 64};
+    CompareJob job{(dir / "a.####.png").string(), (dir / "b.####.exr").string(), dir / "out", {}, {}, {}, 64, {}};
     const FrameRecord r = compareFrame(job, 3);
     for (const fs::path& p : frameOutputs(job, 3)) EXPECT_TRUE(fs::exists(p)) << p;
     const FrameRecord back = loadFrameRecord(job, 3);
@@ -439,6 +439,8 @@ TEST(CompareCli, MissingOrMismatchedFramesFailOnlyThoseFrames) {
     EXPECT_TRUE(contains(r.output, "b/img.0002.exr: no such file")) << r.output;
     EXPECT_TRUE(contains(r.output, "a/img.0003.exr is 160x120")) << r.output;
     EXPECT_TRUE(contains(r.output, "b/img.0003.exr is 80x60")) << r.output;
+    // The report still gets written; the image it cannot show is named, not dropped silently.
+    EXPECT_TRUE(std::regex_search(r.output, std::regex("no thumbnail of [^\n]*b/img.0002.exr"))) << r.output;
     EXPECT_TRUE(fs::exists(dir / "out/metrics.0001.json")) << "frame 1 is still compared";
     const std::string csv = test::readFile(dir / "out/metrics.csv");
     EXPECT_TRUE(contains(csv, "\n1,")) << csv;

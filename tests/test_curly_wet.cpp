@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <vector>
 
 namespace hp {
@@ -130,17 +131,26 @@ TEST(CurlyWet, CurlRadiusAndPitchSurviveABouncingHead) {
     float worstRadius = 0.f, worstPitch = 0.f;
     CurlyWetStats acc;
     int k = 0;
+    // How far the hair moved relative to the head: the bounce must really
+    // deform it (flop over), or the curl checks below prove nothing.
+    const std::vector<Vec3f> rest = positions(solver);
+    float deformed = 0.f;
     simulate(solver, head, dirs, 0.1f, 75, [&](const CurlyWetStats& st) {
         acc.accumulate(st);
+        const double t = (k + 1) * double(s.timeStep);  // the head's path, as in `head` above
+        const Vec3f offset(0.f, t < 1.0 ? 0.05f * float(std::sin(6.0 * M_PI * t)) : 0.f, 0.f);
+        const std::vector<Vec3f> now = positions(solver);
+        for (size_t i = 0; i < now.size(); ++i) deformed = std::max(deformed, (now[i] - rest[i] - offset).norm());
         if (++k % 5) return;
         const Eigen::Vector2f c = solver.measureCurl();
         worstRadius = std::max(worstRadius, std::abs(c.x() / s.curlRadius - 1.f));
         worstPitch = std::max(worstPitch, std::abs(c.y() / s.curlPitch - 1.f));
     });
-    EXPECT_GT(acc.kineticEnergy + acc.maxLengthError, 0.0);  // it did move
+    EXPECT_GT(deformed, 0.01f) << "the bounce must move the hair relative to the head by more than 1 cm";
     const Eigen::Vector2f c = solver.measureCurl();
-    std::printf("curl after the bounce: radius %.2f mm, pitch %.2f mm; worst during it: %.1f%%, %.1f%%\n",
-                1e3f * c.x(), 1e3f * c.y(), 100.f * worstRadius, 100.f * worstPitch);
+    std::printf("curl after the bounce: radius %.2f mm, pitch %.2f mm; worst during it: %.1f%%, %.1f%%; "
+                "largest motion relative to the head %.1f mm\n",
+                1e3f * c.x(), 1e3f * c.y(), 100.f * worstRadius, 100.f * worstPitch, 1e3f * deformed);
     EXPECT_NEAR(c.x(), s.curlRadius, 0.1f * s.curlRadius);
     EXPECT_NEAR(c.y(), s.curlPitch, 0.1f * s.curlPitch);
     EXPECT_LT(worstRadius, 0.1f) << "during the bounce";
@@ -362,6 +372,32 @@ TEST(CurlyWet, WritesInterpolatedFramesAndResetsOnTeleport) {
     solver.write(mid, solver.time() - 0.5 * s.timeStep);
     EXPECT_EQ(mid.vertexCount(), f.vertexCount());
     EXPECT_THROW(solver.write(mid, solver.time() - 2.0 * s.timeStep), Error);
+}
+
+TEST(CurlyWet, NonFiniteImplicitStepIsCountedNotSilent) {
+    // A stretch stiffness at the float limit overflows the implicit system
+    // (h²·ks·|e| is not finite): the step must say so instead of quietly
+    // dropping the springs, and the strands must stay finite.
+    CurlyWetSettings s;
+    s.stretchStiffness = std::numeric_limits<float>::max();
+    CurlyWetSolver solver(s);
+    const MovingSphere head(0.1f, [](double) { return Vec3f::Zero(); });
+    const std::vector<Vec3f> dirs = fibonacciCap(4);
+    start(solver, head, dirs, 0.1f);
+    size_t failures = 0, nans = 0;
+    simulate(solver, head, dirs, 0.1f, 2, [&](const CurlyWetStats& st) {
+        failures += st.implicitFailures;
+        nans += st.nanCount;
+    });
+    EXPECT_GT(failures, 0u);
+    EXPECT_EQ(nans, 0u);
+
+    // Ordinary settings never fail.
+    CurlyWetSolver ordinary{CurlyWetSettings{}};
+    start(ordinary, head, dirs, 0.1f);
+    failures = 0;
+    simulate(ordinary, head, dirs, 0.1f, 2, [&](const CurlyWetStats& st) { failures += st.implicitFailures; });
+    EXPECT_EQ(failures, 0u);
 }
 
 TEST(CurlyWet, BadInputIsAClearError) {

@@ -36,6 +36,7 @@ class LocalSlurm {
     explicit LocalSlurm(const fs::path& state) : state_(state) {
         const ProcessResult r = runShell("'" + sourcePath("tools/farm/slurm-local").string() + "' start '" + state.string() + "'");
         output_ = r.output;
+        hostCannot_ = r.exitCode == 3;
         const std::string prefix = "export SLURM_CONF=";
         const size_t at = r.output.find(prefix);
         if (r.exitCode == 0 && at != std::string::npos) {
@@ -49,12 +50,16 @@ class LocalSlurm {
         ::unsetenv("SLURM_CONF");
     }
     bool started() const { return !conf_.empty(); }
+    /// slurm-local's exit 3: the host cannot run slurmd (a cgroup plugin
+    /// that does not initialise even with the plugins that need none).
+    bool hostCannot() const { return hostCannot_; }
     const std::string& output() const { return output_; }
     std::string logs() const { return readFile(state_ / "log/slurmctld.log") + readFile(state_ / "log/slurmd.log"); }
 
   private:
     fs::path state_;
     std::string conf_, output_;
+    bool hostCannot_ = false;
 };
 
 /// The pid in a daemon's pid file, or 0.
@@ -135,6 +140,8 @@ TEST(Farm, SlurmSingleNodeClusterRunsTheShotLikeALocalRun) {
     std::vector<pid_t> daemons;
     {
         LocalSlurm slurm(state);
+        // A reason of the host is a skip, never a failure of the suite.
+        if (slurm.hostCannot()) GTEST_SKIP() << "Slurm cannot be started here: " << slurm.output();
         ASSERT_TRUE(slurm.started()) << "tools/farm/slurm-local start failed:\n" << slurm.output() << slurm.logs();
         for (const char* pidFile : {"slurmctld.pid", "slurmd.pid", "munged.pid"}) {
             daemons.push_back(pidIn(state / pidFile));

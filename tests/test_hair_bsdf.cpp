@@ -171,22 +171,64 @@ TEST(HairBsdf, NearlyReciprocalEverywhere) {
     EXPECT_GT(wrong / sum, 1.0);  // the measure can tell the two apart
 }
 
-TEST(HairBsdf, TiltShiftsTheSpecularCone) {
-    // With tilt α the R lobe peaks at θi = 2α − θo instead of −θo.
+/// θ (degrees) of the peak of lobe `lobe` over incident directions in the
+/// plane of the fibre axis and of wo (h = 0: R reflects straight back).
+float lobePeakTheta(const HairModel& model, float thetaODeg, int lobe, float phiI) {
+    const HairBsdf bsdf(model, 0.f);
+    const Vec3f wo = direction(thetaODeg, 0.f);
+    float best = -1.f, bestTheta = 0.f;
+    for (float t = -80.f; t <= 80.f; t += 0.05f) {
+        Vec3f lobes[HairModel::kLobes];
+        bsdf.eval(wo, direction(t, phiI), lobes);
+        if (lobes[lobe].x() > best) best = lobes[lobe].x(), bestTheta = t;
+    }
+    return bestTheta;
+}
+
+TEST(HairBsdf, CuticleTiltMovesThePrimaryHighlightTowardTheRoot) {
+    // Marschner et al. 2003: the cuticle scales' free edges point to the tip,
+    // so the surface a ray reflects from is the fibre's surface turned by α
+    // toward the root. The expected R direction is computed here from that
+    // geometry alone: light arriving along −wi, mirrored about the scale
+    // normal n = (−sin α, cos α, 0) in the fibre frame (x root to tip, y the
+    // surface normal at h = 0). θ of the result is the R lobe's peak.
+    const float alphaDeg = 4.f, thetaO = 20.f;
     HairFiberParams p;
     p.sigmaA = hairAbsorptionFromMelanin(8.f, 0.f);  // black: R dominates
-    p.longitudinalRoughness = 0.15f;
-    p.cuticleTiltDegrees = 4.f;
+    p.longitudinalRoughness = 0.1f;
+    p.cuticleTiltDegrees = alphaDeg;
     const HairModel model(p);
-    const HairBsdf bsdf(model, 0.2f);
-    const Vec3f wo = direction(20.f, 1.57f);
-    float best = -1.f, bestTheta = 0.f;
-    for (float t = -60.f; t <= 60.f; t += 0.25f) {
-        Vec3f lobes[HairModel::kLobes];
-        bsdf.eval(wo, direction(t, 1.57f + 0.4f), lobes);
-        if (lobes[0].x() > best) best = lobes[0].x(), bestTheta = t;
-    }
-    EXPECT_NEAR(bestTheta, 2.f * 4.f - 20.f, 1.5f);
+    const float a = alphaDeg * kPi / 180.f;
+    const Vec3f n(-std::sin(a), std::cos(a), 0.f);
+    // Reciprocal geometry: the light direction whose mirror image leaves along wo.
+    const Vec3f wo = direction(thetaO, 0.f);
+    const Vec3f travel = -wo;                                // reversed outgoing ray
+    const Vec3f wi = travel - 2.f * travel.dot(n) * n;       // mirrored: the direction toward the light
+    const float expected = std::asin(wi.x()) * 180.f / kPi;  // −θo − 2α
+    const float peak = lobePeakTheta(model, thetaO, 0, 0.f);
+    std::printf("R peak at theta_i %.2f deg, mirror about the tilted scale %.2f deg\n", peak, expected);
+    EXPECT_NEAR(peak, expected, 0.5f);
+    // The shift's direction: toward the root (negative x), away from the
+    // untilted mirror direction −θo by about 2α.
+    EXPECT_LT(peak, -thetaO - alphaDeg);
+    // A negative tilt (scales pointing to the root) mirrors it.
+    p.cuticleTiltDegrees = -alphaDeg;
+    EXPECT_NEAR(lobePeakTheta(HairModel(p), thetaO, 0, 0.f), -thetaO + 2.f * alphaDeg, 0.5f);
+}
+
+TEST(HairBsdf, CuticleTiltMovesTransmittedLobesTowardTheTip) {
+    // Marschner 2003, Table 1: α_TT = −α_R / 2 and α_TRT = −3 α_R / 2, so
+    // both refracted lobes shift the other way from R (toward the tip).
+    HairFiberParams p;
+    p.sigmaA = hairAbsorptionFromMelanin(0.3f, 0.f);  // blond: TT and TRT are bright
+    p.longitudinalRoughness = 0.1f;
+    p.cuticleTiltDegrees = 0.f;
+    const float thetaO = 20.f;
+    const float ttFlat = lobePeakTheta(HairModel(p), thetaO, 1, kPi);
+    const float trtFlat = lobePeakTheta(HairModel(p), thetaO, 2, 0.f);
+    p.cuticleTiltDegrees = 4.f;
+    EXPECT_GT(lobePeakTheta(HairModel(p), thetaO, 1, kPi), ttFlat + 2.f);
+    EXPECT_GT(lobePeakTheta(HairModel(p), thetaO, 2, 0.f), trtFlat + 8.f);
 }
 
 TEST(HairBsdf, SamplingPdfMatchesEvaluation) {
@@ -224,4 +266,33 @@ TEST(HairBsdf, ColorInversionOrdersAbsorption) {
     EXPECT_LT(s.x(), s.y());
     EXPECT_LT(s.y(), s.z());
     EXPECT_NEAR(hairAbsorptionFromColor(Vec3f(1.f, 1.f, 1.f), 0.3f).norm(), 0.f, 1e-6f);
+}
+
+TEST(HairBsdf, MelaninColourFitInvertsChiangsFitAndIsMonotone) {
+    // The Kajiya-Kay colour of render.hair.melanin is Chiang's eq. 9 solved
+    // for the colour: feeding it back through the forward fit must return
+    // the melanin's σa, for any roughness.
+    for (float betaN : {0.2f, 0.3f, 0.6f})
+        for (float eu : {0.05f, 0.3f, 1.3f})
+            for (float pheo : {0.f, 0.5f}) {
+                const Vec3f sigma = hairAbsorptionFromMelanin(eu, pheo);
+                const Vec3f back = hairAbsorptionFromColor(hairColorFromAbsorption(sigma, betaN), betaN);
+                EXPECT_LT((back - sigma).cwiseAbs().maxCoeff(), 1e-3f * sigma.maxCoeff() + 1e-6f)
+                    << "eumelanin " << eu << " pheomelanin " << pheo << " beta_n " << betaN;
+            }
+    // More eumelanin darkens every channel; melanin absorbs blue most, so
+    // the colour is warm; pheomelanin reddens it (red over green rises).
+    Vec3f last = Vec3f::Ones();
+    for (float eu = 0.f; eu <= 8.f; eu += 0.25f) {
+        const Vec3f c = hairColorFromAbsorption(hairAbsorptionFromMelanin(eu, 0.f), 0.3f);
+        for (int k = 0; k < 3; ++k) EXPECT_LE(c[k], last[k]) << eu;
+        if (eu > 0.f) EXPECT_GT(c.x(), c.z()) << eu;
+        last = c;
+    }
+    const Vec3f plain = hairColorFromAbsorption(hairAbsorptionFromMelanin(0.3f, 0.f), 0.3f);
+    const Vec3f red = hairColorFromAbsorption(hairAbsorptionFromMelanin(0.3f, 0.8f), 0.3f);
+    EXPECT_GT(red.x() / red.y(), plain.x() / plain.y());
+    // The values render/hair_bsdf.h and the README document (β_n = 0.3).
+    EXPECT_LT((plain - Vec3f(0.124f, 0.068f, 0.023f)).cwiseAbs().maxCoeff(), 1e-3f) << plain.transpose();
+    EXPECT_LT((red - Vec3f(0.046f, 0.014f, 0.001f)).cwiseAbs().maxCoeff(), 1e-3f) << red.transpose();
 }

@@ -57,9 +57,11 @@ TEST(DefaultHead, CommittedAssetIsWhatTheToolWrites) {
     EXPECT_EQ(loaded.materials[loaded.meshes[0].material], "scalp");
     EXPECT_EQ(loaded.materials[loaded.meshes[1].material], "skin");
     EXPECT_EQ(loaded.boneCount(), 2u);
-    ASSERT_EQ(loaded.clips.size(), 1u);
+    ASSERT_EQ(loaded.clips.size(), 2u);
     EXPECT_EQ(loaded.clips[0].name, "nod_shake_turn");
     EXPECT_NEAR(loaded.clips[0].duration, kDefaultHeadClipSeconds, 1e-6);
+    EXPECT_EQ(loaded.clips[1].name, "stress");
+    EXPECT_NEAR(loaded.clips[1].duration, kStressClipSeconds, 1e-6);
     const TriangleMesh a = loaded.restMesh(), b = made.restMesh();
     ASSERT_EQ(a.triangles, b.triangles);
     for (double t : {0.5, 1.6, 2.7, 3.4}) {

@@ -160,12 +160,25 @@ TEST(Schema, ReferencePageIsUpToDate) {
 }
 
 #include "pipeline/view_settings.h"
+#include "render/hair_bsdf.h"
 
 TEST(SceneLists, DefaultListAndItemDefaults) {
     const Scene s = Scene::parse("", "shot.yaml", ".");
-    ASSERT_EQ(s.count("render.lights"), 1u);
+    // The default list is the three-point rig of render/view.cpp.
+    ASSERT_EQ(s.count("render.lights"), 3u);
     EXPECT_EQ(s.text("render.lights[0].type"), "directional");
-    EXPECT_EQ(s.number("render.lights[0].intensity"), 3.0);
+    EXPECT_EQ(s.text("render.lights[0].space"), "camera");
+    EXPECT_TRUE(s.flag("render.lights[0].shadows"));
+    EXPECT_FALSE(s.flag("render.lights[2].shadows"));
+    const View v = makeView(s);
+    const std::vector<Light> rig = threePointRig();
+    ASSERT_EQ(v.lights.size(), rig.size());
+    for (size_t i = 0; i < rig.size(); ++i) {
+        EXPECT_TRUE(v.lights[i].direction.isApprox(rig[i].direction, 1e-5f)) << i;
+        EXPECT_NEAR(v.lights[i].intensity, rig[i].intensity, 1e-6f) << i;
+        EXPECT_EQ(v.lights[i].castsShadows, rig[i].castsShadows) << i;
+        EXPECT_TRUE(v.lights[i].cameraRelative) << i;
+    }
 }
 
 TEST(SceneLists, ItemsFromFileGetDefaultsAndLocations) {
@@ -194,7 +207,7 @@ TEST(SceneLists, SetOverridesItemsAndWholeLists) {
     EXPECT_EQ(b.count("render.lights"), 2u);
     EXPECT_EQ(b.text("render.lights[1].type"), "point");
     const SceneError e = parseError("", {"render.lights[3].intensity=1"});
-    EXPECT_NE(e.detail().find("has only 1 items"), std::string::npos) << e.what();
+    EXPECT_NE(e.detail().find("has only 3 items"), std::string::npos) << e.what();
 }
 
 TEST(SceneLists, TooManyItems) {
@@ -204,13 +217,43 @@ TEST(SceneLists, TooManyItems) {
     EXPECT_NE(e.detail().find("at most 16"), std::string::npos) << e.what();
 }
 
+TEST(ViewSettings, DisplayAndMelaninKeys) {
+    const Scene s = Scene::parse(
+        "render:\n  exposure: 1.5\n  background: {type: gradient, color: [0.2, 0.2, 0.2]}\n"
+        "  hair: {melanin: 0.3}\n",
+        "shot.yaml", ".");
+    const DisplaySettings d = makeDisplaySettings(s);
+    EXPECT_EQ(d.exposure, 1.5f);
+    EXPECT_EQ(d.backdrop.kind, Backdrop::Kind::Gradient);
+    EXPECT_TRUE(d.backdrop.top.isApprox(Vec3f(0.2f, 0.2f, 0.2f)));
+    // One key drives both renderers: the physical σa and the Kajiya-Kay colour.
+    const View v = makeView(s);
+    EXPECT_TRUE(hairAbsorption(s).isApprox(hairAbsorptionFromMelanin(0.3f, 0.f)));
+    EXPECT_TRUE(v.hair.color.isApprox(hairColorFromAbsorption(hairAbsorptionFromMelanin(0.3f, 0.f), 0.3f)));
+    // A view the built-in transform does not know names the key and its line.
+    const Scene bad = Scene::parse("render:\n  ocio:\n    view: nope\n", "shot.yaml", ".");
+    try {
+        makeDisplaySettings(bad);
+        FAIL() << "an unknown view must be a scene error";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(e.key(), "render.ocio.view");
+        EXPECT_EQ(e.where().line, 3);
+        EXPECT_NE(std::string(e.what()).find("nope"), std::string::npos) << e.what();
+    }
+}
+
 TEST(ViewSettings, MapsKeysAndChecksAcrossThem) {
     const Scene s = Scene::parse("render:\n  camera: {width: 320, height: 240, fov: 30}\n", "shot.yaml", ".");
     const View v = makeView(s);
     EXPECT_EQ(v.camera.width, 320);
     EXPECT_EQ(v.camera.fovY, 30.f);
-    ASSERT_EQ(v.lights.size(), 1u);
-    EXPECT_TRUE(v.lights[0].direction.isApprox(Vec3f(-1, -1, -1)));
+    ASSERT_EQ(v.lights.size(), 3u);
+    // Camera-relative: the key comes from the camera's upper left.
+    const std::vector<Light> world = v.worldLights();
+    const Vec3f toKey = -world[0].direction.normalized();
+    const Vec3f right = (v.camera.target - v.camera.position).cross(v.camera.up).normalized();
+    EXPECT_LT(toKey.dot(right), 0.f);
+    EXPECT_GT(toKey.dot(v.camera.up), 0.f);
     const Scene bad = Scene::parse("render:\n  camera: {position: [0, 0, 0]}\n", "shot.yaml", ".");
     try {
         makeView(bad);

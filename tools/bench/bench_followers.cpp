@@ -11,9 +11,16 @@
 // steps the solver (or reads its frames) — only GuideSource::next changes.
 //
 // Usage: bench_followers [--quick] [--sizes 751,10000,...] [--steps N]
-//        [--modes varied,cluster,interpolate] [--threads 1,2] [--no-collide]
+//        [--modes varied,cluster,interpolate,barycentric] [--threads 1,2] [--no-collide]
+//        [--angle] [--length-variation X] [--clump X] [--clumps N]
+//        [--wave M] [--wave-length M] [--curl X] [--frizz M]
+// --angle adds a column: the median angle between mid-strand tangents of
+// root-neighbouring followers (sim/follower_metrics.h) after the last step;
+// the modifier options apply sim/groom_modifiers.h to the groom first.
 #include "core/errors.h"
+#include "sim/follower_metrics.h"
 #include "sim/followers.h"
+#include "sim/groom_modifiers.h"
 #include "sim/synthetic_groom.h"
 
 #include <tbb/task_arena.h>
@@ -44,12 +51,13 @@ struct GuideSource {
     double dt = 0.02;
 };
 
-GuideSource makeSyntheticSource(size_t guides, size_t followers) {
+GuideSource makeSyntheticSource(size_t guides, size_t followers, const GroomModifiers& modifiers) {
     GuideSource src;
     SphereGroomSettings s;
     s.guides = guides;
     s.followers = followers;
     src.groom = makeSphereGroom(s);
+    applyGroomModifiers(src.groom, modifiers);
     src.head = std::make_shared<SphereCollider>(Vec3f::Zero(), s.headRadius);
     auto motion = std::make_shared<SyntheticGuides>(src.groom, SyntheticGuideSettings{});
     const std::vector<SurfaceFrame> restRoots = src.groom.followerRoots;
@@ -71,10 +79,12 @@ struct Result {
     double median = 0, spread = 0, buildMs = 0;
     double cpu = 0;  ///< median CPU ms per step, all threads together
     double projected = 0, queries = 0;
+    double angle = 0;  ///< median neighbour angle after the last step, degrees
 };
 
 const char* modeName(FollowerMode m) {
-    return m == FollowerMode::Varied ? "varied" : m == FollowerMode::Cluster ? "cluster" : "interpolate";
+    return m == FollowerMode::Varied ? "varied" : m == FollowerMode::Cluster ? "cluster"
+           : m == FollowerMode::Barycentric ? "barycentric" : "interpolate";
 }
 
 Result measure(const GuideSource& src, FollowerMode mode, int threads, int steps, bool collide) {
@@ -114,6 +124,7 @@ Result measure(const GuideSource& src, FollowerMode mode, int threads, int steps
             cpu.push_back(totalCpu / steps);
         }
         frame.validate();
+        r.angle = medianNeighbourAngle(frame, frame.guideCount);
     });
     std::sort(runs.begin(), runs.end());
     r.median = runs[1];
@@ -142,7 +153,8 @@ int main(int argc, char** argv) {
     std::vector<FollowerMode> modes = {FollowerMode::Varied, FollowerMode::Cluster, FollowerMode::Interpolate};
     std::vector<int> threads = {1, 2};
     int steps = 0;  // 0: by size
-    bool collide = true;
+    bool collide = true, angle = false;
+    GroomModifiers modifiers;
     for (int a = 1; a < argc; ++a) {
         const std::string arg = argv[a];
         auto value = [&]() -> const char* {
@@ -160,11 +172,20 @@ int main(int argc, char** argv) {
                 if (s == "varied") return FollowerMode::Varied;
                 if (s == "cluster") return FollowerMode::Cluster;
                 if (s == "interpolate") return FollowerMode::Interpolate;
+                if (s == "barycentric") return FollowerMode::Barycentric;
                 std::fprintf(stderr, "unknown mode %s\n", s.c_str());
                 std::exit(1);
             });
         } else if (arg == "--threads") threads = parseList<int>(value(), [](const std::string& s) { return std::stoi(s); });
         else if (arg == "--no-collide") collide = false;
+        else if (arg == "--angle") angle = true;
+        else if (arg == "--length-variation") modifiers.lengthVariation = std::stof(value());
+        else if (arg == "--clump") modifiers.clump = std::stof(value());
+        else if (arg == "--clumps") modifiers.clumps = uint32_t(std::stoul(value()));
+        else if (arg == "--wave") modifiers.wave = std::stof(value());
+        else if (arg == "--wave-length") modifiers.waveLength = std::stof(value());
+        else if (arg == "--curl") modifiers.curl = std::stof(value());
+        else if (arg == "--frizz") modifiers.frizz = std::stof(value());
         else { std::fprintf(stderr, "unknown option %s\n", arg.c_str()); return 1; }
     }
 
@@ -172,17 +193,24 @@ int main(int argc, char** argv) {
     std::printf("# guides: synthetic drooping/swaying guides on the 90 deg/s spinning sphere (no solver on this branch)\n");
     std::printf("# head collision: %s; velocities: finite differences; 24 vertices per strand\n", collide ? "on" : "off");
     std::printf("# cpu ms/step: CPU time of all threads per step (on a shared machine, wall time includes waiting)\n\n");
-    std::printf("| guides | followers | mode | threads | ms/step | spread | cpu ms/step | build ms | queries/step | projected/step |\n");
-    std::printf("|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    if (modifiers.active())
+        std::printf("# groom modifiers: length variation %g, clump %g (%u centres), wave %g m / %g m, curl %g, frizz %g m\n",
+                    modifiers.lengthVariation, modifiers.clump, modifiers.clumps, modifiers.wave, modifiers.waveLength,
+                    modifiers.curl, modifiers.frizz);
+    std::printf("| guides | followers | mode | threads | ms/step | spread | cpu ms/step | build ms | queries/step | projected/step |%s\n",
+                angle ? " neighbour angle deg |" : "");
+    std::printf("|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|%s\n", angle ? "---:|" : "");
     for (const Scene& sc : scenes) {
-        const GuideSource src = makeSyntheticSource(sc.guides, sc.followers);
+        const GuideSource src = makeSyntheticSource(sc.guides, sc.followers, modifiers);
         const int n = steps > 0 ? steps : sc.followers >= 400000 ? 5 : sc.followers >= 100000 ? 10 : 30;
         for (FollowerMode mode : modes)
             for (int t : threads) {
                 const Result r = measure(src, mode, t, n, collide);
-                std::printf("| %zu | %zu | %s | %d | %.3f | %.3f | %.3f | %.1f | %.0f | %.0f |\n", sc.guides,
+                std::printf("| %zu | %zu | %s | %d | %.3f | %.3f | %.3f | %.1f | %.0f | %.0f |", sc.guides,
                             sc.followers, modeName(mode), t, r.median, r.spread, r.cpu, r.buildMs, r.queries,
                             r.projected);
+                if (angle) std::printf(" %.2f |", r.angle);
+                std::printf("\n");
                 std::fflush(stdout);
             }
     }

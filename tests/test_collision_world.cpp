@@ -1,0 +1,213 @@
+// Colliders beside the head (sim/collision_world.h): Bullet primitives and a
+// mesh prop in one collision world, joined to the head's collider; hair
+// lies on them. Distances are checked against the geometry computed here.
+#include "pipeline/head_import.h"
+#include "pipeline/head_setup.h"
+#include "pipeline/scene.h"
+#include "sim/collision_world.h"
+#include "sim/fibonacci.h"
+#include "sim/guides.h"
+#include "sim/mesh_collider.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace hp;
+using namespace hp::test;
+
+namespace {
+
+Eigen::Isometry3f at(const Vec3f& t, float yawDegrees = 0.f) {
+    Eigen::Isometry3f p = Eigen::Isometry3f::Identity();
+    p.linear() = Eigen::AngleAxisf(yawDegrees * float(M_PI / 180.0), Vec3f::UnitY()).toRotationMatrix();
+    p.translation() = t;
+    return p;
+}
+
+ColliderShape box(const Vec3f& half) {
+    ColliderShape s;
+    s.kind = ColliderShape::Kind::Box;
+    s.halfExtents = half;
+    return s;
+}
+
+}  // namespace
+
+TEST(CollisionWorld, SignedDistancesOfBulletPrimitivesMatchTheGeometry) {
+    ColliderShape sphere, capsule;
+    sphere.kind = ColliderShape::Kind::Sphere;
+    sphere.radius = 0.1f;
+    capsule.kind = ColliderShape::Kind::Capsule;
+    capsule.radius = 0.05f;
+    capsule.length = 0.2f;
+    const CollisionWorld world({sphere, box({0.2f, 0.05f, 0.1f}), capsule});
+    const auto posed = world.posed({at({1, 0, 0}), at({0, 0, 0}, 30.f), at({-1, 0, 0})}, 1.f);
+    Vec3f n;
+    // Sphere: |p - c| - r, normal along p - c.
+    EXPECT_NEAR(posed->signedDistance({1.3f, 0, 0}, &n), 0.2f, 1e-5f);
+    EXPECT_NEAR(posed->signedDistance({1.f, 0.05f, 0}, &n), -0.05f, 1e-4f);
+    EXPECT_GT(n.y(), 0.999f) << "inside, the normal points the way out";
+    // Box turned 30° about Y: above the top face the distance is the height
+    // over it; inside, minus the depth below it (closer than the sides).
+    const Vec3f local(0.1f, 0.f, 0.03f);
+    const Vec3f onTop = at({0, 0, 0}, 30.f) * local;
+    EXPECT_NEAR(posed->signedDistance(onTop + Vec3f(0, 0.08f, 0), &n), 0.03f, 1e-5f);
+    EXPECT_GT(n.y(), 0.999f);
+    EXPECT_NEAR(posed->signedDistance(onTop + Vec3f(0, 0.04f, 0), &n), -0.01f, 1e-5f);
+    EXPECT_GT(n.y(), 0.999f);
+    // Beside the rotated box: the distance to the face x = 0.2 (local).
+    const Vec3f beside = at({0, 0, 0}, 30.f) * Vec3f(0.25f, 0.f, 0.f);
+    EXPECT_NEAR(posed->signedDistance(beside, &n), 0.05f, 1e-5f);
+    EXPECT_NEAR(n.dot(at({0, 0, 0}, 30.f).linear() * Vec3f::UnitX()), 1.f, 1e-4f);
+    // Capsule along Y: distance to the segment minus the radius.
+    EXPECT_NEAR(posed->signedDistance({-0.9f, 0.05f, 0}, &n), 0.05f, 1e-5f);
+    EXPECT_NEAR(posed->signedDistance({-1.f, 0.25f, 0}, &n), 0.1f, 1e-5f) << "past the cap centre at y = 0.1";
+    // Far from every collider: the query range, a lower bound.
+    const auto near = world.posed({at({1, 0, 0}), at({0, 0, 0}, 30.f), at({-1, 0, 0})});
+    EXPECT_FLOAT_EQ(near->signedDistance({0, 5, 0}), 0.05f);
+    // The union with a head collider: the nearer surface wins.
+    const CompositeCollider both(std::make_shared<SphereCollider>(Vec3f(0, 1, 0), 0.1f), posed);
+    EXPECT_NEAR(both.signedDistance({0, 0.85f, 0}, &n), 0.05f, 1e-5f);
+    EXPECT_LT(n.y(), -0.999f) << "the head above is nearer than the box below";
+    EXPECT_NEAR(both.signedDistance({0, 0.07f, 0}, &n), 0.02f, 1e-5f);
+}
+
+// Limp guides from the side of a head fall under gravity; shoulders (a box
+// just below the head) catch them. Without the box the same hair hangs below
+// the box's top; with it, no vertex gets more than 1 mm inside and hair lies
+// on the top face.
+TEST(CollisionWorld, HairOnAShoulderBoxStaysOnIt) {
+    const Vec3f headCentre(0, 0.3f, 0);
+    const float headRadius = 0.1f, top = 0.19f;
+    const CollisionWorld shoulders({box({0.25f, 0.05f, 0.12f})});
+    const std::vector<Vec3f> dirs = fibonacciCap(40, Vec3f::UnitY(), -0.2f);
+    auto run = [&](bool withShoulders, size_t& below, size_t& resting, float& worstDepth, double& worstStretch) {
+        GuideSettings s;
+        s.preload = false;
+        s.bendStiffness = 1e-7f;
+        s.limitStiffness = 1e-7f;
+        s.length = 0.2f;
+        s.strandsPerWorld = 8;
+        GuideSolver solver(s);
+        HeadPose pose;
+        auto posed = shoulders.posed({at({0, top - 0.05f, 0})});
+        pose.transform = at(headCentre);
+        auto head = std::make_shared<SphereCollider>(headCentre, headRadius);
+        pose.collider = withShoulders ? std::shared_ptr<const Collider>(std::make_shared<CompositeCollider>(head, posed))
+                                      : std::shared_ptr<const Collider>(head);
+        std::vector<SurfaceFrame> roots(dirs.size());
+        for (size_t i = 0; i < dirs.size(); ++i) {
+            roots[i].position = headCentre + headRadius * dirs[i];
+            roots[i].normal = dirs[i];
+            roots[i].tangent = dirs[i].unitOrthogonal();
+        }
+        solver.initialize(roots, pose);
+        worstDepth = 0.f;
+        worstStretch = 0.0;
+        for (int k = 0; k < 150; ++k) {
+            pose.time = solver.nextTime();
+            const GuideStats& st = solver.step(roots, pose);
+            worstStretch = std::max(worstStretch, st.maxLengthError);
+            StrandFrame f;
+            solver.write(f);
+            for (const Vec3f& p : f.positions) worstDepth = std::max(worstDepth, -posed->signedDistance(p));
+        }
+        StrandFrame f;
+        solver.write(f);
+        below = resting = 0;
+        for (const Vec3f& p : f.positions) {
+            const bool over = std::abs(p.x()) < 0.24f && std::abs(p.z()) < 0.11f;
+            if (over && p.y() < top - 0.01f) ++below;
+            if (over && std::abs(p.y() - top) < 0.004f) ++resting;
+        }
+    };
+    size_t below = 0, resting = 0;
+    float depth = 0.f;
+    double stretch = 0.0;
+    run(false, below, resting, depth, stretch);
+    ASSERT_GT(below, 50u) << "without shoulders the hair hangs below their top";
+    run(true, below, resting, depth, stretch);
+    EXPECT_EQ(below, 0u) << "no vertex falls through the shoulders";
+    EXPECT_GT(resting, 50u) << "hair lies on the top face";
+    EXPECT_LE(depth, 1e-3f) << "deepest vertex inside the box, every step";
+    EXPECT_LE(stretch, 1e-3) << "lying on the box does not stretch the strands";
+}
+
+// A prop from a second file, placed and keyed by head.colliders[] keys.
+TEST(CollisionWorld, PropColliderFromASecondFile) {
+    TempDir dir;
+    // A 10 cm cube, in centimetres.
+    writeFile(dir / "prop.obj", "v -5 -5 -5\nv 5 -5 -5\nv 5 5 -5\nv -5 5 -5\nv -5 -5 5\nv 5 -5 5\nv 5 5 5\nv -5 5 5\n"
+                                "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 4 8 7\nf 4 7 3\n"
+                                "f 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\n");
+    writeFile(dir / "s.yaml", "fps: 25\nhead:\n  file: " + sourcePath("scenes/assets/head.glb").string() +
+                                  "\n  clip: none\n  colliders:\n"
+                                  "    - {type: mesh, file: prop.obj, unit_scale: 0.01, translate: [0.5, 0, 0],\n"
+                                  "       move_y: [[0, 0], [25, 0.2]]}\n");
+    const Scene scene = Scene::load(dir / "s.yaml");
+    const HeadSetup head = loadHead(scene);
+    Vec3f n;
+    const HeadPose start = head.motion->sample(0.0);
+    EXPECT_NEAR(start.collider->signedDistance({0.5f, 0.f, 0.f}, &n), -0.05f, 1e-4f) << "the cube's centre";
+    EXPECT_NEAR(start.collider->signedDistance({0.58f, 0.f, 0.f}, &n), 0.03f, 1e-4f);
+    EXPECT_GT(n.x(), 0.999f);
+    const HeadPose later = head.motion->sample(1.0);  // frame 25: moved up 0.2 m
+    EXPECT_NEAR(later.collider->signedDistance({0.5f, 0.2f, 0.f}), -0.05f, 1e-4f);
+    EXPECT_NEAR(later.collider->signedDistance({0.5f, 0.28f, 0.f}), 0.03f, 1e-4f);
+    EXPECT_LT(later.collider->signedDistance({0.f, 0.f, 0.f}), 0.f) << "the head's own collider is still there";
+}
+
+// A skinned body (here the head file's own meshes), played by its own clip: at a nodding pose the
+// collider's surface is the deformed mesh (posed here independently through
+// the same file), not the rest mesh.
+TEST(CollisionWorld, SkinnedBodyColliderFollowsItsSkin) {
+    TempDir dir;
+    const std::string glb = sourcePath("scenes/assets/head.glb").string();
+    writeFile(dir / "s.yaml", "fps: 25\nhead:\n  file: " + glb +
+                                  "\n  clip: none\n  collider: {method: none}\n  colliders:\n"
+                                  "    - {type: skinned, clip: nod_shake_turn}\n");  // the head's own file
+    try {
+        loadHead(Scene::load(dir / "s.yaml", {"head.colliders[0].meshes=Tail"}));
+        ADD_FAILURE() << "a mesh the file does not have is an error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("head.colliders[0].meshes"), std::string::npos) << e.what();
+    }
+    const Scene scene = Scene::load(dir / "s.yaml");
+    const HeadSetup head = loadHead(scene);
+    HeadImportSettings import;
+    import.file = glb;
+    auto rig = std::make_shared<const HeadRig>(importHead(import));
+    HeadAnimationSettings play;
+    play.clip = 0;
+    play.collider = ColliderMethod::None;
+    const AnimatedHead body(rig, play);
+    const double t = 0.375;  // the first nod at its deepest: 20° down
+    TriangleMesh skin = body.sample(t).mesh;
+    skin.computeNormals();
+    TriangleMesh rest = body.rest();
+    rest.computeNormals();
+    const auto collider = head.motion->sample(t).collider;
+    // Reference: the exact closest-triangle distance of the deformed mesh
+    // (Embree BVH, angle-weighted pseudonormals; sim/mesh_collider.h).
+    const MeshCollider exact(skin);
+    float worst = 0.f;
+    size_t moved = 0, checked = 0;
+    for (size_t v = 0; v < skin.positions.size(); v += 23) {
+        const Vec3f& p = skin.positions[v];
+        const Vec3f& n = skin.normals[v];
+        for (float offset : {0.003f, 0.001f, -0.001f, -0.002f}) {
+            const Vec3f q = p + offset * n;
+            worst = std::max(worst, std::abs(collider->signedDistance(q) - exact.signedDistance(q)));
+        }
+        // The same offset from the rest pose is off the skin where the nod moved it.
+        const Vec3f r = rest.positions[v] + 0.003f * rest.normals[v];
+        if (std::abs(collider->signedDistance(r) - exact.signedDistance(r)) < 1e-4f &&
+            std::abs(exact.signedDistance(r) - 0.003f) > 0.002f)
+            ++moved;
+        ++checked;
+    }
+    EXPECT_LE(worst, 1e-4f) << "within 3 mm of the deformed skin, inside and out, Bullet's distance is the exact one";
+    EXPECT_GT(moved, checked / 4) << "the collider is the deformed mesh, not the rest mesh";
+}

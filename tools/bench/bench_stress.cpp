@@ -1,0 +1,207 @@
+// B-sim-stress (docs/benchmarks.md): scenes/stress.yaml — the default head's
+// "stress" clip (tips back 70° in 0.25 s and forward, turns 180° in 0.3 s,
+// cuts at 2 s), hair rooted everywhere (head.scalp.method all), 300 guides,
+// 30 000 followers, shoulders as a Bullet capsule. Runs the shot simulation
+// frame by frame and reports steps/s (simulation only, measurements
+// excluded), the worst segment stretch of guides and of followers against
+// their lengths on the first frame, the deepest free vertex inside any
+// collider (the pose's composite collider: head + Bullet world) after any
+// frame, pinned vertices and NaN.
+//
+//   bench_stress [--scene scenes/stress.yaml] [--threads 2] [--set key=value ...]
+//
+// --colliders: B-sim head-only (BENCHMARKS.md: sphere r = 0.1 m spinning
+// 90°/s, 0.25 m guides of 24 vertices, 20 warm-up + 250 timed steps) with
+// the head as the exact analytic sphere, as a distance grid (the head's fast
+// path, sim/level_set.h) and as a btSphereShape queried through the Bullet
+// collision world (sim/collision_world.h), in one run.
+//
+//   bench_stress --colliders [--guides 94,845] [--threads 2]
+#include "pipeline/scene.h"
+#include "pipeline/shot_simulation.h"
+#include "sim/collision_world.h"
+#include "sim/fibonacci.h"
+#include "sim/guides.h"
+#include "sim/mesh_collider.h"
+
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+using namespace hp;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// Worst |segment / rest - 1| over strands [begin, end) of `f`, `rest` the
+/// segment lengths of the first frame (same layout).
+double worstStretch(const StrandFrame& f, const std::vector<float>& rest, size_t begin, size_t end) {
+    double worst = 0;
+    for (size_t s = begin; s < end; ++s)
+        for (uint32_t i = f.first(s); i + 1 < f.offsets[s + 1]; ++i)
+            worst = std::max(worst, std::abs(double((f.positions[i + 1] - f.positions[i]).norm()) / rest[i] - 1.0));
+    return worst;
+}
+
+std::vector<float> segmentLengths(const StrandFrame& f) {
+    std::vector<float> out(f.positions.size(), 1.f);
+    for (size_t s = 0; s < f.strandCount(); ++s)
+        for (uint32_t i = f.first(s); i + 1 < f.offsets[s + 1]; ++i) out[i] = (f.positions[i + 1] - f.positions[i]).norm();
+    return out;
+}
+
+int stress(const std::string& path, const std::vector<std::string>& overrides) {
+    const Scene scene = Scene::load(path, overrides);
+    const std::vector<int>& frames = scene.frames("frames");
+    const double fps = scene.number("fps");
+    Clock::time_point t = Clock::now();
+    ShotSimulation sim(scene, fps, frames.front());
+    std::printf("B-sim-stress: %s, %zu guides, %zu followers, frames %d-%d at %g fps; set-up %.1f s\n", path.c_str(),
+                sim.guideCount(), sim.followerCount(), frames.front(), frames.back(), fps, since(t));
+    const std::vector<float> rest = segmentLengths(sim.advanceTo(frames.front()));
+    const size_t guides = sim.guideCount();
+    double simSeconds = 0, guideWorst = 0, followerWorst = 0, depthWorst = 0;
+    int guideFrame = 0, followerFrame = 0, depthFrame = 0, resets = 0;
+    size_t steps = 0, nan = 0;
+    for (int frame : frames) {
+        if (frame == frames.front()) continue;
+        t = Clock::now();
+        const StrandFrame& f = sim.advanceTo(frame);
+        simSeconds += since(t);
+        steps += sim.stats().guides.steps;
+        resets += sim.stats().guides.reset ? 1 : 0;
+        const double g = worstStretch(f, rest, 0, guides), fo = worstStretch(f, rest, guides, f.strandCount());
+        if (g > guideWorst) guideWorst = g, guideFrame = frame;
+        if (fo > followerWorst) followerWorst = fo, followerFrame = frame;
+        std::atomic<size_t> bad{0};
+        std::vector<float> depth(f.strandCount(), 0.f);
+        const Collider* collider = sim.pose().collider.get();
+        tbb::parallel_for(size_t(0), f.strandCount(), [&](size_t s) {
+            for (uint32_t i = f.first(s); i < f.offsets[s + 1]; ++i) {
+                if (!f.positions[i].allFinite()) ++bad;
+                else if (i > f.first(s) && collider)
+                    depth[s] = std::max(depth[s], -collider->signedDistance(f.positions[i]));
+            }
+        });
+        nan += bad;
+        const float d = *std::max_element(depth.begin(), depth.end());
+        if (d > depthWorst) depthWorst = d, depthFrame = frame;
+    }
+    std::printf("| steps/s | worst stretch guides (frame) | worst stretch followers (frame) | worst depth mm (frame) "
+                "| pinned | NaN | cuts |\n|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::printf("| %.1f | %.2e (%d) | %.2e (%d) | %.3f (%d) | n/a (rope does not pin) | %zu | %d |\n",
+                double(steps) / simSeconds, guideWorst, guideFrame, followerWorst, followerFrame, depthWorst * 1e3,
+                depthFrame, nan, resets);
+    return 0;
+}
+
+/// Steps/s of B-sim with the head's collider made by `collider(pose)`.
+template <typename MakeCollider>
+double headOnly(size_t count, MakeCollider&& collider, GuideStats& stats) {
+    const float radius = 0.1f;
+    SpinningSphere head(radius, 90.f);
+    const std::vector<Vec3f> dirs = fibonacciCap(count);
+    auto posed = [&](double time, std::vector<SurfaceFrame>& roots) {
+        HeadPose p = head.sample(time);
+        p.collider = collider(p);
+        roots.resize(dirs.size());
+        for (size_t i = 0; i < dirs.size(); ++i) {
+            const Vec3f n = p.transform.linear() * dirs[i];
+            roots[i] = {p.transform * (radius * dirs[i]), n, n.unitOrthogonal()};
+        }
+        return p;
+    };
+    GuideSolver solver{GuideSettings{}};
+    std::vector<SurfaceFrame> roots;
+    HeadPose p = posed(0.0, roots);
+    solver.initialize(roots, p);
+    Clock::time_point start;
+    for (int k = 1; k <= 270; ++k) {
+        if (k == 21) start = Clock::now();
+        p = posed(solver.nextTime(), roots);
+        const GuideStats& s = solver.step(roots, p);
+        if (k == 21) stats = s;
+        else if (k > 21) stats.accumulate(s);
+    }
+    return 250.0 / since(start);
+}
+
+int colliders(const std::vector<size_t>& counts) {
+    const std::shared_ptr<const LevelSet> grid =
+        std::make_shared<LevelSet>(makeSphereMesh(Vec3f::Zero(), 0.1f, 64, 128), LevelSetSettings{});
+    ColliderShape ball;
+    ball.kind = ColliderShape::Kind::Sphere;
+    ball.radius = 0.1f;
+    const CollisionWorld world({ball});
+    std::printf("B-sim head-only (sphere r=0.1 m, 90 deg/s, rope, 250 timed steps): the head's collider\n\n"
+                "| guides | collider | steps/s | max stretch | max penetration mm |\n|---:|---|---:|---:|---:|\n");
+    for (size_t n : counts) {
+        auto row = [&](const char* name, double sps, const GuideStats& s) {
+            std::printf("| %zu | %s | %.0f | %.2e | %.3f |\n", n, name, sps, s.maxLengthError, s.maxPenetration * 1e3);
+        };
+        GuideStats s;
+        double sps = headOnly(n, [](const HeadPose& p) {
+            return std::make_shared<SphereCollider>(Vec3f(p.transform.translation()), 0.1f);
+        }, s);
+        row("analytic sphere (B-sim's own)", sps, s);
+        sps = headOnly(n, [&](const HeadPose& p) { return std::make_shared<LevelSetCollider>(grid, p.transform); }, s);
+        row("distance grid (fast path, 2 mm voxels)", sps, s);
+        sps = headOnly(n, [&](const HeadPose& p) { return world.posed({p.transform}); }, s);
+        row("Bullet world: btSphereShape, GJK/EPA", sps, s);
+    }
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::string scenePath = "scenes/stress.yaml";
+    std::vector<std::string> overrides;
+    std::vector<size_t> counts{94, 845};
+    int threads = 2;
+    bool colliderMode = false;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto next = [&]() -> std::string {
+            if (i + 1 >= argc) {
+                std::fprintf(stderr, "bench_stress: %s needs a value\n", a.c_str());
+                std::exit(1);
+            }
+            return argv[++i];
+        };
+        if (a == "--scene") scenePath = next();
+        else if (a == "--set") overrides.push_back(next());
+        else if (a == "--threads") threads = std::stoi(next());
+        else if (a == "--colliders") colliderMode = true;
+        else if (a == "--guides") {
+            counts.clear();
+            const std::string list = next();
+            for (size_t at = 0; at < list.size();) {
+                const size_t comma = std::min(list.find(',', at), list.size());
+                counts.push_back(std::stoul(list.substr(at, comma - at)));
+                at = comma + 1;
+            }
+        } else {
+            std::fprintf(stderr, "bench_stress: unknown option %s\n", a.c_str());
+            return 1;
+        }
+    }
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    std::printf("threads: %d\n", threads);
+    try {
+        return colliderMode ? colliders(counts) : stress(scenePath, overrides);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_stress: %s\n", e.what());
+        return 1;
+    }
+}
