@@ -3,6 +3,8 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 namespace hp {
 
@@ -12,5 +14,9 @@ namespace hp {
 /// stream is checked after close(), because buffered bytes reach the disk
 /// only at the flush, so a full disk often shows there and nowhere else.
 void writeFileChecked(const std::filesystem::path& path, const void* data, size_t size);
+
+/// Reads a whole file. Throws AssetError naming `path`: "cannot open <what>"
+/// or "cannot read <what>".
+std::vector<char> readFileBytes(const std::filesystem::path& path, const std::string& what);
 
 }  // namespace hp

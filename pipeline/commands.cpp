@@ -6,6 +6,7 @@
 #include "pipeline/curly_settings.h"
 #include "pipeline/frame_jobs.h"
 #include "pipeline/frame_range.h"
+#include "pipeline/groom_import.h"
 #include "pipeline/hair_source.h"
 #include "pipeline/head_setup.h"
 #include "pipeline/output.h"
@@ -205,7 +206,11 @@ CommandSpec validateCommandSpec() {
         makeView(ctx.scene);             // checks across render keys
         makeDisplaySettings(ctx.scene);  // the OCIO config loads; its display and view exist
         checkCameraKeys(ctx.scene);
-        if (sceneHasHead(ctx.scene)) loadHead(ctx.scene);  // mesh, clip and scalp selections
+        if (sceneHasHead(ctx.scene)) {
+            const HeadSetup head = loadHead(ctx.scene);  // mesh, clip and scalp selections
+            if (sceneHasGroomFile(ctx.scene))  // the groom file read, bound and resampled
+                importGroom(ctx.scene, head, int(ctx.scene.integer("hair.guides.segments")) + 1);
+        }
         if (usesCurlyWetModel(ctx.scene)) curlyWetSettings(ctx.scene).validate();  // across hair.curly/wet keys
         std::cout << ctx.scene.name() << ": ok\n";
         return int(kExitOk);

@@ -78,6 +78,18 @@ class HairFrameSource final : public FrameSource {
   private:
     /// Makes sim_ able to advance to `frame`: starts it, or jumps ahead to the
     /// latest checkpoint that has its cached strands beside it.
+    /// Starts the simulation at the shot's first frame (settling the groom
+    /// through the cache beside the strand cache).
+    std::unique_ptr<ShotSimulation> start() const {
+        SettleCache settle;
+        if (scene_.flag("cache.enabled")) {
+            const fs::path p = scene_.text("cache.settled_groom");
+            settle.file = p.is_absolute() ? p : shot_.outputDir / p;
+            settle.reuse = !shot_.force;
+        }
+        return std::make_unique<ShotSimulation>(scene_, shot_.fps, first_, settle);
+    }
+
     void simulateTo(int frame) {
         if (sim_ && sim_->frame() > frame) sim_.reset();  // frames come in order; a fresh source restarts
         const int from = sim_ ? sim_->frame() : first_;
@@ -89,7 +101,7 @@ class HairFrameSource final : public FrameSource {
                 if (!fs::is_regular_file(checkpoint, ec) || !fs::is_regular_file(strands, ec)) continue;
                 try {
                     const StrandFrame cached = readStrandCache(strands);
-                    if (!sim_) sim_ = std::make_unique<ShotSimulation>(scene_, shot_.fps, first_);
+                    if (!sim_) sim_ = start();
                     sim_->restoreCheckpoint(checkpoint, cached);
                     logInfo("simulation: resumed from the checkpoint of frame ", c);
                     return;
@@ -99,7 +111,7 @@ class HairFrameSource final : public FrameSource {
                 }
             }
         }
-        if (!sim_) sim_ = std::make_unique<ShotSimulation>(scene_, shot_.fps, first_);
+        if (!sim_) sim_ = start();
     }
 
     const Scene& scene_;

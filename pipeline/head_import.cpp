@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <map>
 #include <system_error>
 
@@ -182,6 +183,32 @@ RigClip convertClip(const aiAnimation* a, const std::map<std::string, int>& node
     return c;
 }
 
+/// Metres per unit an FBX file declares: assimp's FBX importer copies
+/// GlobalSettings' UnitScaleFactor (centimetres per unit) into the scene
+/// metadata without applying it. 0 when absent or not a positive number.
+double declaredUnitScale(const aiScene* scene) {
+    if (!scene->mMetaData) return 0.0;
+    double cm = 0.0;
+    float cmf = 0.f;
+    int32_t cmi = 0;
+    if (!scene->mMetaData->Get("UnitScaleFactor", cm)) {
+        if (scene->mMetaData->Get("UnitScaleFactor", cmf)) cm = cmf;
+        else if (scene->mMetaData->Get("UnitScaleFactor", cmi)) cm = cmi;
+    }
+    return std::isfinite(cm) && cm > 0.0 ? cm / 100.0 : 0.0;
+}
+
+/// The up axis an FBX file declares (assimp copies GlobalSettings' UpAxis, 0 =
+/// X, 1 = Y, 2 = Z, and UpAxisSign into the metadata); 0 when absent or
+/// negative (a down axis has no up_axis equivalent).
+char declaredUpAxis(const aiScene* scene) {
+    int32_t axis = -1, sign = 1;
+    if (!scene->mMetaData || !scene->mMetaData->Get("UpAxis", axis)) return 0;
+    scene->mMetaData->Get("UpAxisSign", sign);
+    if (sign < 0 || axis < 0 || axis > 2) return 0;
+    return "xyz"[axis];
+}
+
 }  // namespace
 
 Eigen::Matrix3f upAxisRotation(UpAxis up) {
@@ -249,8 +276,19 @@ HeadRig importHead(const HeadImportSettings& settings) {
     for (unsigned i = 0; i < scene->mNumAnimations; ++i)
         rig.clips.push_back(convertClip(scene->mAnimations[i], nodeIndex, instances));
 
+    // FBX only: other importers apply their format's unit and axis themselves
+    // (Collada) or have none (glTF is metres and Y up, OBJ has no units).
+    std::string ext = settings.file.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+    const bool fbx = ext == ".fbx";
+    rig.fileUnitScale = fbx ? declaredUnitScale(scene) : 0.0;
+    rig.unitScale = settings.unitScaleGiven || rig.fileUnitScale <= 0.0 ? settings.unitScale : rig.fileUnitScale;
+    rig.fileUpAxis = fbx ? declaredUpAxis(scene) : 0;
+    UpAxis up = settings.upAxis;
+    if (!settings.upAxisGiven && rig.fileUpAxis) up = rig.fileUpAxis == 'z' ? UpAxis::Z : rig.fileUpAxis == 'x' ? UpAxis::X : UpAxis::Y;
+    rig.upAxis = up == UpAxis::Z ? 'z' : up == UpAxis::X ? 'x' : 'y';
     rig.placement = settings.placement;
-    rig.placement.linear() *= upAxisRotation(settings.upAxis) * float(settings.unitScale);
+    rig.placement.linear() *= upAxisRotation(up) * float(rig.unitScale);
     logVerbose("head: ", file, ": ", rig.meshes.size(), " meshes, ", rig.triangleCount(), " triangles, ",
                rig.boneCount(), " bones, ", rig.morphCount(), " morph targets, ", rig.clips.size(), " clips");
     return rig;

@@ -8,6 +8,12 @@
 //   identical vertices, drops points and lines, and generates smooth normals
 //   where the file has none (Fox.glb).
 // - `unitScale` multiplies asset units into metres (0.01 for centimetres).
+//   Unless the scene sets it, the file's own unit is used where assimp
+//   exposes one: an FBX file's GlobalSettings UnitScaleFactor (centimetres
+//   per unit) in the scene metadata. glTF is metres by specification, and
+//   assimp already applies a Collada file's <unit>. The same for the up
+//   axis: an FBX file's UpAxis (X, Y or Z, positive sign) unless the scene
+//   sets head.up_axis.
 // - `upAxis` names the asset's up axis; Z up is turned to Y up by a -90°
 //   rotation about X ((x, y, z) -> (x, z, -y)), X up by +90° about Z.
 // - `placement` (the scene's translate/rotate) is applied last, in metres.
@@ -33,7 +39,13 @@ struct HeadImportSettings {
     /// "Head-1", ...). Empty: every mesh.
     std::vector<std::string> meshes;
     double unitScale = 1.0;
+    /// False: the scene leaves head.unit_scale unset, so a unit the file
+    /// declares (FBX UnitScaleFactor) replaces `unitScale`.
+    bool unitScaleGiven = true;
     UpAxis upAxis = UpAxis::Y;
+    /// False: the scene leaves head.up_axis unset, so an up axis the file
+    /// declares (FBX UpAxis) replaces `upAxis`.
+    bool upAxisGiven = true;
     Affine3f placement = Affine3f::Identity();
 };
 

@@ -213,6 +213,12 @@ std::string HeadRig::summary() const {
     for (const RigMesh& m : meshes) skinned += m.skinned(), morphed += !m.morphPositions.empty();
     s << "  bones:     " << boneCount() << " (" << skinned << " skinned mesh" << (skinned == 1 ? "" : "es") << ")\n";
     s << "  morphs:    " << morphCount() << " targets on " << morphed << " mesh" << (morphed == 1 ? "" : "es") << "\n";
+    s << std::defaultfloat << std::setprecision(6) << "  unit:      " << unitScale << " m per file unit ("
+      << (fileUnitScale > 0 ? cat("the file declares ", fileUnitScale, " m") : std::string("the file declares none"))
+      << "; head.unit_scale overrides)\n" << std::fixed;
+    s << "  up axis:   " << upAxis << " ("
+      << (fileUpAxis ? std::string("the file declares ") + fileUpAxis : std::string("the file declares none"))
+      << "; head.up_axis overrides)\n";
     const Eigen::AlignedBox3f box = restMesh().bounds();
     s << std::setprecision(3) << "  bounds:    [" << box.min().transpose() << "] - [" << box.max().transpose()
       << "] m (rest pose, after unit scale and up axis)\n";

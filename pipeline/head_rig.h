@@ -94,6 +94,15 @@ struct HeadRig {
     std::vector<RigClip> clips;
     /// Asset space -> world: unit scale, up-axis conversion, static placement.
     Affine3f placement = Affine3f::Identity();
+    /// Metres per file unit the file itself declares (FBX GlobalSettings
+    /// UnitScaleFactor, centimetres per unit, / 100); 0: it declares none.
+    double fileUnitScale = 0.0;
+    /// Metres per file unit applied (head.unit_scale, or the file's own
+    /// when the scene does not set it).
+    double unitScale = 1.0;
+    /// The up axis the file declares ('x', 'y', 'z'; FBX GlobalSettings
+    /// UpAxis with a positive sign), 0: none; and the one applied.
+    char fileUpAxis = 0, upAxis = 'y';
 
     size_t vertexCount() const;
     size_t triangleCount() const;

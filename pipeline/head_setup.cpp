@@ -39,16 +39,27 @@ double seconds(std::chrono::steady_clock::time_point since) {
 
 bool sceneHasHead(const Scene& scene) { return !scene.file("head.file").empty(); }
 
+UpAxis sceneUpAxis(const Scene& scene, const std::string& prefix) {
+    const std::string up = scene.text(prefix + ".up_axis");
+    return up == "z" ? UpAxis::Z : up == "x" ? UpAxis::X : UpAxis::Y;
+}
+
+Affine3f scenePlacement(const Scene& scene, const std::string& prefix) {
+    Affine3f placement = Affine3f::Identity();
+    placement.translate(scene.vec3f(prefix + ".translate"));
+    placement.linear() = eulerXYZ(scene.vec3f(prefix + ".rotate"));
+    return placement;
+}
+
 HeadImportSettings headImportSettings(const Scene& scene) {
     HeadImportSettings s;
     s.file = scene.file("head.file");
     s.meshes = splitList(scene.text("head.meshes"));
     s.unitScale = scene.number("head.unit_scale");
-    const std::string up = scene.text("head.up_axis");
-    s.upAxis = up == "z" ? UpAxis::Z : up == "x" ? UpAxis::X : UpAxis::Y;
-    s.placement = Affine3f::Identity();
-    s.placement.translate(scene.vec3f("head.translate"));
-    s.placement.linear() = eulerXYZ(scene.vec3f("head.rotate"));
+    s.unitScaleGiven = scene.given("head.unit_scale");
+    s.upAxis = sceneUpAxis(scene, "head");
+    s.upAxisGiven = scene.given("head.up_axis");
+    s.placement = scenePlacement(scene, "head");
     return s;
 }
 
@@ -256,6 +267,16 @@ void warnIfNotClosed(const TriangleMesh& mesh, const std::string& colliderMethod
                    "collider's inside/outside is wrong near them; make the winding consistent");
 }
 
+/// A head is some 0.15-0.3 m tall; bounds beyond 1 m or under 5 cm are a
+/// unit the file did not declare (or declared wrongly).
+void warnIfImplausibleSize(const TriangleMesh& rest, const HeadRig& rig) {
+    const float size = rest.bounds().sizes().maxCoeff();
+    if (size > 1.f || size < 0.05f)
+        logWarning("head: ", rig.file, " measures ", size, " m across at rest (", rig.unitScale,
+                   " m per file unit), implausible for a head: set head.unit_scale to the file's metres per unit "
+                   "(0.01 for centimetres, 0.001 for millimetres)");
+}
+
 }  // namespace
 
 HeadSetup loadHead(const Scene& scene) {
@@ -269,7 +290,18 @@ HeadSetup loadHead(const Scene& scene) {
     }
     auto motion = std::make_shared<AnimatedHead>(h.rig, headAnimationSettings(scene, *h.rig));
     h.rest = motion->rest();
-    const ScalpSettings scalp = scalpSettings(scene);
+    ScalpSettings scalp = scalpSettings(scene);
+    h.scalpGiven = scene.text("head.scalp.method") != "auto";
+    if (!h.scalpGiven) {
+        std::string why;
+        scalp = defaultScalp(*h.rig, h.rest, why);
+        // An imported groom binds to every triangle; the scalp then only
+        // places procedural followers, not worth a line.
+        if (scene.file("hair.groom.file").empty())
+            logInfo("head: hair grows on ", why, "; choose another scalp with head.scalp.method (material, "
+                "vertex_color, texture, region, or all for every triangle)");
+    }
+    h.scalpUsed = scalp;
     try {
         h.scalp = selectScalp(*h.rig, h.rest, scalp);
     } catch (const AssetError&) {
@@ -286,20 +318,21 @@ HeadSetup loadHead(const Scene& scene) {
                    cat("the scalp (", scalpTriangles, scalpTriangles == 1 ? " triangle" : " triangles",
                        ") has zero area in ", h.rig->file, ": only degenerate triangles, no hair can grow"));
     warnIfNotClosed(h.rest, scene.text("head.collider.method"), h.rig->file);
+    warnIfImplausibleSize(h.rest, *h.rig);
     logVerbose("head: ", h.rest.triangleCount(), " triangles, ", scalpTriangles, " on the scalp (",
                surfaceArea(h.rest, h.scalp) * 1e4, " cm²), set up in ", seconds(start), " s");
     return h;
 }
 
-RootSettings rootSettings(const Scene& scene, size_t count, uint64_t seed) {
+RootSettings rootSettings(const Scene& scene, const HeadSetup& head, size_t count, uint64_t seed) {
     RootSettings r;
     r.count = count;
     r.seed = seed;
     r.method = scene.text("hair.roots.method") == "blue-noise" ? RootMethod::BlueNoise : RootMethod::Fibonacci;
-    if (scene.text("head.scalp.method") == "region") {
+    if (head.scalpUsed.method == ScalpMethod::Region) {
         // The seed's partial sphere: the lattice shares the cap's centre and pole.
-        r.center = scene.vec3f("head.scalp.center");
-        r.axis = scene.vec3f("head.scalp.axis").normalized();
+        r.center = head.scalpUsed.center;
+        r.axis = head.scalpUsed.axis.normalized();
     }
     return r;
 }
@@ -310,9 +343,9 @@ GroomRoots placeGroomRoots(const Scene& scene, const HeadSetup& head) {
     GroomRoots g;
     // Independent placements: the followers' stream differs from the guides'.
     g.guides = placeRoots(head.rest, head.scalp,
-                          rootSettings(scene, size_t(scene.integer("hair.guides.count")), seed * 2 + 0));
+                          rootSettings(scene, head, size_t(scene.integer("hair.guides.count")), seed * 2 + 0));
     g.followers = placeRoots(head.rest, head.scalp,
-                             rootSettings(scene, size_t(scene.integer("hair.followers.count")), seed * 2 + 1));
+                             rootSettings(scene, head, size_t(scene.integer("hair.followers.count")), seed * 2 + 1));
     logVerbose("roots: ", g.guides.size(), " guides, ", g.followers.size(), " followers (",
                scene.text("hair.roots.method"), ") in ", seconds(start), " s");
     return g;

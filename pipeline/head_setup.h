@@ -16,6 +16,11 @@ namespace hp {
 /// True when the scene names a head file (head.file).
 bool sceneHasHead(const Scene& scene);
 
+/// `<prefix>.up_axis` (head, hair.groom).
+UpAxis sceneUpAxis(const Scene& scene, const std::string& prefix);
+/// `<prefix>.translate` after `<prefix>.rotate` (X, then Y, then Z), metres.
+Affine3f scenePlacement(const Scene& scene, const std::string& prefix);
+
 /// head.file, head.meshes, head.unit_scale, head.up_axis, head.translate, head.rotate.
 HeadImportSettings headImportSettings(const Scene& scene);
 /// head.clip*, head.loop, head.rest_time, head.animate.*, head.collider.* (`rig` resolves the clip name).
@@ -33,6 +38,8 @@ struct HeadSetup {
     std::shared_ptr<const AnimatedHead> motion;
     TriangleMesh rest;           ///< rest pose (motion->rest()); every pose has its topology
     std::vector<uint8_t> scalp;  ///< per triangle of `rest`: 1 = grows hair
+    ScalpSettings scalpUsed;     ///< the selection that made `scalp` (head.scalp.method auto resolved)
+    bool scalpGiven = false;     ///< the scene chose the scalp (head.scalp.method other than auto)
 };
 
 /// @brief Imports and sets up the scene's head (throws SceneError at the
@@ -42,7 +49,7 @@ HeadSetup loadHead(const Scene& scene);
 
 /// Root placement settings of hair.roots.method for `count` roots; the
 /// Fibonacci lattice is centred on the scalp region when the scalp is one.
-RootSettings rootSettings(const Scene& scene, size_t count, uint64_t seed);
+RootSettings rootSettings(const Scene& scene, const HeadSetup& head, size_t count, uint64_t seed);
 
 struct GroomRoots {
     std::vector<SurfacePoint> guides;     ///< hair.guides.count roots

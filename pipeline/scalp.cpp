@@ -2,8 +2,10 @@
 
 #include "core/errors.h"
 #include "render/image_io.h"
+#include "sim/roots.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 
 namespace hp {
@@ -37,6 +39,47 @@ std::string describe(ScalpMethod m) {
 }
 
 }  // namespace
+
+ScalpSettings defaultScalp(const HeadRig& rig, const TriangleMesh& rest, std::string& why) {
+    ScalpSettings s;
+    std::vector<uint32_t> used;  // materials some mesh uses
+    for (const RigMesh& m : rig.meshes)
+        if (m.material < rig.materials.size() && std::find(used.begin(), used.end(), m.material) == used.end())
+            used.push_back(m.material);
+    for (uint32_t m : used) {
+        std::string lower = rig.materials[m];
+        std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+        if (lower.find("scalp") != std::string::npos || lower.find("hair") != std::string::npos)
+            s.materials.push_back(rig.materials[m]);
+    }
+    if (!s.materials.empty()) {
+        s.method = ScalpMethod::Material;
+        std::string names;
+        for (const std::string& n : s.materials) names += (names.empty() ? "'" : ", '") + n + "'";
+        why = cat("the material ", names, " of ", rig.file);
+        return s;
+    }
+    // The cranium: the part of the mesh within one head width of its top
+    // (a neck or shoulders below do not pull the sphere down).
+    Eigen::AlignedBox3f box;
+    for (const Vec3f& p : rest.positions) box.extend(p);
+    const Vec3f size = box.sizes();
+    const float width = std::max(size.x(), size.z());
+    std::vector<Vec3f> top;
+    for (const Vec3f& p : rest.positions)
+        if (p.y() >= box.max().y() - 0.5f * width) top.push_back(p);
+    Vec3f center;
+    float radius = 0.f;
+    if (!fitSphere(top, center, radius) || !(radius > 0.25f * width && radius < 1.5f * width))
+        center = Vec3f(box.center().x(), box.max().y() - 0.5f * width, box.center().z());
+    s.method = ScalpMethod::Region;
+    s.center = center;
+    s.axis = Vec3f(0.f, 1.f, -0.45f).normalized();
+    s.angleDegrees = 72.f;
+    why = cat("a cap over the top and back of the head (region: centre ", show(center), ", axis ", show(s.axis),
+              ", 72 deg; ", rig.file, " has no material named *scalp* or *hair*)");
+    return s;
+}
 
 std::vector<uint8_t> selectScalp(const HeadRig& rig, const TriangleMesh& rest, const ScalpSettings& s) {
     const size_t nt = rest.triangles.size();

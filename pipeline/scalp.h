@@ -28,6 +28,15 @@ struct ScalpSettings {
     float angleDegrees = 90.f;
 };
 
+/// @brief The scalp used when the scene names none (head.scalp.method:
+/// auto): the materials whose name contains "scalp" or "hair" (any case) if
+/// the file has one, else a cap over the top and back of the head: a sphere
+/// fitted to the upper part of the mesh (the cranium, found from the up axis
+/// +Y and the bounds), its pole tilted 24° toward the back (-Z, glTF's
+/// behind), 72° wide, as the default scene's partial sphere. Face, chin and
+/// neck lie outside it. `why` receives a sentence saying what was chosen.
+ScalpSettings defaultScalp(const HeadRig& rig, const TriangleMesh& rest, std::string& why);
+
 /// @brief Per-triangle scalp mask (1 = scalp) of `rest` (the rig's rest
 /// mesh, whose triangles follow HeadRig::meshes). The texture mask is read
 /// through OpenImageIO (AssetError naming the file); uv (0, 0) is the

@@ -17,6 +17,9 @@ void addCacheKeys(SchemaBuilder& b) {
               "Simulation statistics per frame (JSON): length error, penetration, energy, ms per step.")
         .flag("cache.checkpoints", true, "Write solver checkpoints next to the cache so a simulation can resume.")
         .text("cache.checkpoint", "cache/checkpoint.####.bin", "Checkpoint files, relative to the output folder.")
+        .text("cache.settled_groom", "cache/settled_groom.bin",
+              "The settled groom (hair.groom.settle), relative to the output folder: reruns and frame chunks "
+              "reuse it when the inputs that determine it (groom, first pose, solver settings) are unchanged.")
         .text("cache.usd", "",
               "Also export each frame's strands as USD BasisCurves (.usda), e.g. usd/hair.####.usda; "
               "empty: no USD.");

@@ -67,8 +67,9 @@ void addHeadKeys(SchemaBuilder& b) {
         .curve("head.colliders[].move_y", 0, -1e6, 1e6, "m", "Keyed motion along Y.")
         .curve("head.colliders[].move_z", 0, -1e6, 1e6, "m", "Keyed motion along Z.");
     b.section("head.scalp", "Which triangles of the rest mesh grow hair.")
-        .choice("head.scalp.method", "all", {"all", "material", "vertex_color", "texture", "region"},
-                "all: every triangle; material: triangles of the named materials; vertex_color: the corners' "
+        .choice("head.scalp.method", "auto", {"auto", "all", "material", "vertex_color", "texture", "region"},
+                "auto: the materials whose name contains 'scalp' or 'hair', else a cap over the top and back of "
+                "the head fitted to the mesh (never face, chin or neck; stderr says which); all: every triangle; material: triangles of the named materials; vertex_color: the corners' "
                 "mean channel value at least the threshold; texture: the mask image, read through the uvs, at "
                 "least the threshold; region: a spherical cap (centre, axis, angle), as the seed's partial sphere.")
         .text("head.scalp.materials", "", "material: comma-separated material names.")

@@ -85,7 +85,26 @@ void addGroomKeys(SchemaBuilder& b) {
                 "turning toward hair.groom.direction, laid over the head.")
         .number("hair.groom.droop", 0.85, 0, 1, "",
                 "Combed: how far strands turn toward the comb direction (1: the tips point along it).")
-        .vec3("hair.groom.direction", 0, -1, 0, "", "Combed: the world direction hair is combed toward.");
+        .vec3("hair.groom.direction", 0, -1, 0, "", "Combed: the world direction hair is combed toward.")
+        .number("hair.groom.settle", 5, 0, 60, "s",
+                "Procedural grooms: before the first frame, simulate the groom on the first frame's pose held "
+                "still (gravity, collisions) until its kinetic energy is below 1e-6 J or this much time has "
+                "passed, and take that shape as the rest shape, so hair lies on the head from frame 1. Cached "
+                "in cache.settled_groom. 0: no settling.")
+        .number("hair.groom.settle_stiffness", 0.001, 0, 1, "",
+                "Settling: the bend and limit springs scaled by this, so the groom drapes under gravity onto the "
+                "head (1: the solver's own stiffness, which holds a drawn shape almost rigidly).")
+        .file("hair.groom.file", "",
+              "The user's own groom: OBJ polylines (.obj), Cem Yuksel's .hair, or the .usda BasisCurves "
+              "export-usd writes. Each strand is bound to the nearest scalp triangle and resampled to "
+              "hair.guides.segments + 1 points; with more strands than hair.guides.count, guides are chosen "
+              "among them and the others become followers keeping their own shape. Empty: a procedural groom.")
+        .number("hair.groom.unit_scale", 1, 1e-9, 1e9, "", "Groom file: metres per file unit (0.01 for centimetres).")
+        .choice("hair.groom.up_axis", "y", {"y", "z", "x"}, "Groom file: its up axis, turned to Y up as head.up_axis.")
+        .vec3("hair.groom.translate", 0, 0, 0, "m", "Groom file: translation after unit scale and up axis.")
+        .vec3("hair.groom.rotate", 0, 0, 0, "deg", "Groom file: rotation about X, then Y, then Z (before translate).")
+        .number("hair.groom.max_root_distance", 0.01, 0, 10, "m",
+                "Groom file: a strand whose first point is further than this from the scalp is reported and dropped.");
 }
 
 }  // namespace hp

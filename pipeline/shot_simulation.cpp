@@ -3,6 +3,7 @@
 #include "core/log.h"
 #include "pipeline/curly_settings.h"
 #include "pipeline/follower_settings.h"
+#include "pipeline/groom_import.h"
 #include "pipeline/sim_settings.h"
 #include "sim/curly_wet.h"
 #include "sim/followers.h"
@@ -133,17 +134,18 @@ class CurlyWetModel final : public GuideModel {
 };
 
 /// Rest shapes of the guides in their own root frames (x = tangent,
-/// y = normal, z = tangent × normal), from the guides as written at t0.
+/// y = normal, z = tangent × normal: the followers' frame, sim/followers.h),
+/// from the guides as written at t0. (The frame's z once was normal ×
+/// tangent, a mirror image: a guide's rest shape with any sideways part then
+/// read as a rotation away from rest, and the followers turned by it.)
 RestShapes restShapes(const StrandFrame& guides, const std::vector<SurfaceFrame>& roots) {
     RestShapes shapes;
     std::vector<Vec3f> local;
     for (size_t g = 0; g < roots.size(); ++g) {
-        const SurfaceFrame& r = roots[g];
-        Eigen::Matrix3f toWorld;
-        toWorld << r.tangent, r.normal, r.bitangent();
+        const Eigen::Matrix3f toWorld = rootAxes(roots[g]);
         const uint32_t first = guides.first(g), n = guides.vertexCount(g);
         local.resize(n);
-        for (uint32_t v = 0; v < n; ++v) local[v] = toWorld.transpose() * (guides.positions[first + v] - r.position);
+        for (uint32_t v = 0; v < n; ++v) local[v] = toWorld.transpose() * (guides.positions[first + v] - roots[g].position);
         shapes.add(local.data(), n);
     }
     return shapes;
@@ -164,6 +166,10 @@ std::string SimFrameStats::json() const {
       << ", \"follower_ms\": " << followerMs << ", \"follower_projected\": " << followerProjected
       << ", \"frame_ms\": " << totalMs << ", \"strands\": " << strands << ", \"vertices\": " << vertices;
     if (saturation >= 0) o << ", \"saturation\": " << saturation;
+    if (settleSeconds >= 0)
+        o << ", \"settle\": {\"seconds\": " << settleSeconds << ", \"kinetic_energy\": " << settleEnergy
+          << ", \"at_rest\": " << (settleConverged ? "true" : "false") << ", \"cached\": "
+          << (settleCached ? "true" : "false") << "}";
     o << ", \"guides\": {\"max_length_error\": " << guides.maxLengthError
       << ", \"mean_length_error\": " << guides.meanLengthError << ", \"penetration_count\": " << guides.penetrationCount
       << ", \"max_penetration\": " << guides.maxPenetration << "}";
@@ -175,18 +181,28 @@ std::string SimFrameStats::json() const {
     return o.str();
 }
 
-ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame)
+ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame, const SettleCache& settleCache)
     : scene_(scene), fps_(fps), frame_(startFrame) {
     if (!sceneHasHead(scene)) scene.fail("head.file", "the shot has hair but no head: set head.file");
     head_ = loadHead(scene);
-    roots_ = placeGroomRoots(scene, head_);
-    if (roots_.guides.empty()) scene.fail("hair.guides.count", "the groom needs at least one guide");
-    if (usesCurlyWetModel(scene)) {
-        CurlyWetSettings settings = curlyWetSettings(scene);
-        settings.timeStep = frameAlignedStep(fps, settings.timeStep);
-        model_ = std::make_unique<CurlyWetModel>(scene, settings);
+    std::unique_ptr<ImportedGroom> imported;
+    if (sceneHasGroomFile(scene)) {
+        if (usesCurlyWetModel(scene))
+            scene.fail("hair.groom.file", "an imported groom needs the rigid-chain model (the curly-wet model grooms "
+                                          "its own helices)");
+        imported = std::make_unique<ImportedGroom>(importGroom(scene, head_, guideSettings(scene).segments + 1));
+        roots_ = imported->roots;
     } else {
-        GuideSettings settings = guideSettings(scene);
+        roots_ = placeGroomRoots(scene, head_);
+    }
+    if (roots_.guides.empty()) scene.fail("hair.guides.count", "the groom needs at least one guide");
+    GuideSettings settings;
+    if (usesCurlyWetModel(scene)) {
+        CurlyWetSettings curly = curlyWetSettings(scene);
+        curly.timeStep = frameAlignedStep(fps, curly.timeStep);
+        model_ = std::make_unique<CurlyWetModel>(scene, curly);
+    } else {
+        settings = guideSettings(scene);
         settings.timeStep = frameAlignedStep(fps, settings.timeStep);
         model_ = std::make_unique<RigidChainModel>(settings);
     }
@@ -194,20 +210,7 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame)
     const double t0 = startFrame / fps;
     pose_ = head_.motion->sample(t0);
     evaluateRoots(pose_.mesh, roots_.guides, guideFrames_);
-    if (!usesCurlyWetModel(scene) && scene.text("hair.groom.style") == "combed") {
-        const GuideSettings gs = guideSettings(scene);
-        GroomSettings groom;
-        groom.style = GroomStyle::Combed;
-        groom.segments = gs.segments;
-        groom.length = gs.length;
-        groom.droop = float(scene.number("hair.groom.droop"));
-        groom.direction = scene.vec3f("hair.groom.direction");
-        groom.clearance = 2.f * gs.collisionRadius;
-        const auto strands = groomStrands(guideFrames_, groom, pose_.collider.get());
-        model_->initialize(guideFrames_, pose_, &strands);
-    } else {
-        model_->initialize(guideFrames_, pose_, nullptr);
-    }
+    initializeGuides(settings, imported.get(), settleCache);
 
     // Followers learn the guides' rest shapes from the guides at t0.
     StrandFrame rest;
@@ -221,6 +224,9 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame)
     float length = 0.f;
     for (uint32_t v = 1; v < rest.vertexCount(0); ++v) length += (rest.positions[v] - rest.positions[v - 1]).norm();
     groom.followerLengths = {length};
+    if (imported) groom.followerShapes = std::move(imported->followerShapes);
+    if (groom.followerShapes.count() == 0 && (imported || settleRan_))
+        groom.followerShapes = nearestGuideShapes(rest, guideFrames_, followerFrames_);
     applyGroomModifiers(groom, groomModifiers(scene));  // rest shapes of clumped, wavy, frizzy followers
     FollowerSettings followerOptions = followerSettings(scene);
     if (usesCurlyWetModel(scene)) {
@@ -232,6 +238,56 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame)
     logInfo("simulation: ", model_->guideCount(), " guides (", model_->name(), "), ", followers_->followerCount(),
             " followers, from frame ", startFrame);
     produceFrame(t0);
+    stats_.settleSeconds = settleRan_ ? settled_.seconds : -1;
+    stats_.settleEnergy = settled_.kineticEnergy;
+    stats_.settleConverged = settled_.converged;
+    stats_.settleCached = settled_.fromCache;
+}
+
+void ShotSimulation::initializeGuides(const GuideSettings& settings, const ImportedGroom* imported,
+                                      const SettleCache& settleCache) {
+    if (usesCurlyWetModel(scene_)) {
+        model_->initialize(guideFrames_, pose_, nullptr);  // the curly model grooms its own helices
+        return;
+    }
+    std::vector<std::vector<Vec3f>> strands;
+    bool shaped = false;
+    auto combed = [&](float droop, const Vec3f& direction) {
+        GroomSettings groom;
+        groom.style = GroomStyle::Combed;
+        groom.segments = settings.segments;
+        groom.length = settings.length;
+        groom.droop = droop;
+        groom.direction = direction;
+        groom.clearance = 2.f * settings.collisionRadius;
+        return groomStrands(guideFrames_, groom, pose_.collider.get());
+    };
+    if (imported) {
+        // The user's groom, as drawn: its shape is the rest shape.
+        strands = strandsAt(imported->guideShapes, guideFrames_);
+        shaped = true;
+    } else if (scene_.text("hair.groom.style") == "combed") {
+        strands = combed(float(scene_.number("hair.groom.droop")), scene_.vec3f("hair.groom.direction"));
+        shaped = true;
+    }
+    const double settle = scene_.number("hair.groom.settle");
+    if (!imported && settle > 0 && !shaped) {
+        // A straight strand on the crown stands exactly against gravity, a
+        // balance it never leaves: tilt the straight groom a little toward
+        // the back (-Z, the default scalp's side) before it settles.
+        strands = combed(0.2f, Vec3f(0.f, 0.f, -1.f));
+        shaped = true;
+    }
+    if (!imported && settle > 0) {
+        SettledGroom s = settleGroom(settings, guideFrames_, pose_, shaped ? &strands : nullptr, settle,
+                                     float(scene_.number("hair.groom.settle_stiffness")), settleCache,
+                                     settleSceneKeys(scene_));
+        strands = std::move(s.strands);
+        shaped = true;
+        settled_ = std::move(s);
+        settleRan_ = true;
+    }
+    model_->initialize(guideFrames_, pose_, shaped ? &strands : nullptr);
 }
 
 ShotSimulation::~ShotSimulation() = default;

@@ -12,6 +12,7 @@
 // does not depend on the step size.
 #pragma once
 
+#include "pipeline/groom_settle.h"
 #include "pipeline/head_setup.h"
 #include "pipeline/scene.h"
 #include "sim/guides.h"
@@ -45,6 +46,10 @@ struct SimFrameStats {
     double totalMs = 0;            ///< the whole frame
     size_t strands = 0, vertices = 0;
     double saturation = -1;        ///< curly-wet: mean saturation; -1 otherwise
+    /// The groom's settling (first frame of a run only): seconds simulated
+    /// (-1: none), final kinetic energy, whether it came to rest.
+    double settleSeconds = -1, settleEnergy = 0;
+    bool settleConverged = false, settleCached = false;
     /// One JSON object (a line of the run's statistics): the guides' figures
     /// at the top level (as before) and again under "guides", the followers'
     /// under "followers".
@@ -55,10 +60,11 @@ class GuideModel;  // the guide solver behind one interface (shot_simulation.cpp
 
 class ShotSimulation {
   public:
-    /// Loads the head, places the roots, builds the guide model and the
-    /// followers, and initialises everything at `startFrame`. Throws
-    /// SceneError/AssetError for bad scene settings or assets.
-    ShotSimulation(const Scene& scene, double fps, int startFrame);
+    /// Loads the head, places the roots (or binds hair.groom.file), settles a
+    /// procedural groom (hair.groom.settle, through `settleCache`), builds
+    /// the guide model and the followers, and initialises everything at
+    /// `startFrame`. Throws SceneError/AssetError for bad scene settings or assets.
+    ShotSimulation(const Scene& scene, double fps, int startFrame, const SettleCache& settleCache = {});
     ~ShotSimulation();
 
     /// Advances to `frame` (>= frame()) and returns all strands there (guides
@@ -85,6 +91,9 @@ class ShotSimulation {
 
   private:
     void produceFrame(double time);
+    /// The guides' rest shape at t0: imported, combed or straight, settled.
+    void initializeGuides(const GuideSettings& settings, const struct ImportedGroom* imported,
+                          const SettleCache& settleCache);
 
     const Scene& scene_;
     double fps_;
@@ -100,6 +109,8 @@ class ShotSimulation {
     GuideStats pending_;  ///< steps since the last output frame
     double pendingHeadMs_ = 0;
     size_t pendingSteps_ = 0;
+    SettledGroom settled_;  ///< the settling's report (strands moved into the model)
+    bool settleRan_ = false;
 };
 
 }  // namespace hp

@@ -98,14 +98,7 @@ void writeStrandCache(const std::filesystem::path& path, const StrandFrame& fram
 }
 
 StrandFrame readStrandCache(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary | std::ios::ate);
-    if (!in) throw AssetError(path.string(), "cannot open strand cache");
-    const std::streamoff size = in.tellg();
-    std::vector<char> data(size_t(std::max<std::streamoff>(size, 0)));
-    in.seekg(0);
-    in.read(data.data(), std::streamsize(data.size()));
-    if (!in) throw AssetError(path.string(), "cannot read strand cache");
-    return parseStrandCache(data, path.string());
+    return parseStrandCache(readFileBytes(path, "strand cache"), path.string());
 }
 
 StrandFrame parseStrandCache(const std::vector<char>& data, const std::string& name) {

@@ -17,6 +17,9 @@ set(_hp_slow_tests
   test_sim_guards:SimGuards.LongViolentRunStaysBoundedAndFinite  # 10^4+ steps
   test_rod:Rod.HeavyElasticaTipMatchesShootingWithinTwoPercentOfLength  # 10 runs of 6 s settling
   test_resources:Resources.ResidentMemoryDoesNotGrowOverThirtyFrames  # 30 frames
+  test_groom:Units.FbxInCentimetresIsReadInMetresAndInfoSaysSo  # two hairpipe runs
+  test_groom:Settle.ConvergesLiesOnTheHeadHoldsStillAndIsReusedByteForByte  # three settles
+  test_groom:GroomImport.ExportedUsdaImportsBackAsTheCachedFrame  # sim + export-usd runs
   test_render_parity:RenderParity.ThreePointRigAndSkinMatch    # 5 reference renders
   test_scene_cut:SceneCut.NoVertexInsideAnyColliderOnTheCutFrameAndAfter  # 60 solver steps, two formulations
   test_scene_cut:SceneCut.InfoListsTheCutsOfTheClip             # three head imports

@@ -7,6 +7,7 @@
 #define HP_FUZZ_TARGET(name) static int fuzz_##name
 #include "tools/fuzz/fuzz_asset.cpp"
 #include "tools/fuzz/fuzz_frame_range.cpp"
+#include "tools/fuzz/fuzz_groom_hair.cpp"
 #include "tools/fuzz/fuzz_scene.cpp"
 #include "tools/fuzz/fuzz_strand_cache.cpp"
 
@@ -46,6 +47,8 @@ TEST(FuzzRegressions, FrameRangeInputs) { EXPECT_GE(replay("frame_range", fuzz_f
 TEST(FuzzRegressions, SceneInputs) { EXPECT_GE(replay("scene", fuzz_scene), 1u); }
 
 TEST(FuzzRegressions, AssetInputs) { EXPECT_GE(replay("asset", fuzz_asset), 1u); }
+
+TEST(FuzzRegressions, GroomHairInputs) { EXPECT_GE(replay("groom_hair", fuzz_groom_hair), 1u); }
 
 // The entry points themselves must tell a bad input from a good one, or the
 // replay above proves nothing: a valid cache decodes, a property violation

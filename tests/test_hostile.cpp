@@ -57,8 +57,10 @@ size_t filesUnder(const fs::path& dir) {
 }
 
 /// A small simulated shot around `head` (a file name in the test folder).
+/// These meshes are not head-shaped, so every triangle is scalp (the
+/// default, a cap over the top and back of a head, may select none).
 std::string shotWithHead(const std::string& head, const std::string& extra = "") {
-    return "frames: 1-2\nhead: {file: " + head + "}\nhair:\n  guides: {count: 6, segments: 4}\n"
+    return "frames: 1-2\nhead: {file: " + head + ", scalp: {method: all}}\nhair:\n  guides: {count: 6, segments: 4}\n"
            "  followers: {count: 10}\n" + extra;
 }
 
@@ -264,7 +266,7 @@ TEST(Hostile, ZeroLengthClip) {
     // A glTF whose only clip has a single key at t = 0: duration 0. Looping
     // it must not divide by zero; the head holds its keyed pose.
     writeFile(dir / "still.gltf", "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0,\"name\":\"Head\"}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],\"buffers\":[{\"byteLength\":52,\"uri\":\"data:application/octet-stream;base64,AAAAAM3MzD0AAAAAzczMPQAAAAAAAAAAAAAAAAAAAADNzMw9AAAAAAAAAAAK1yM8AAAAAA==\"}],\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":4},{\"buffer\":0,\"byteOffset\":40,\"byteLength\":12}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[0.1,0.1,0.1]},{\"bufferView\":1,\"componentType\":5126,\"count\":1,\"type\":\"SCALAR\",\"min\":[0],\"max\":[0]},{\"bufferView\":2,\"componentType\":5126,\"count\":1,\"type\":\"VEC3\"}],\"animations\":[{\"name\":\"still\",\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}],\"samplers\":[{\"input\":1,\"output\":2,\"interpolation\":\"LINEAR\"}]}]}");
-    writeFile(dir / "s.yaml", "frames: 1-3\nhead: {file: still.gltf, loop: true}\n"
+    writeFile(dir / "s.yaml", "frames: 1-3\nhead: {file: still.gltf, loop: true, scalp: {method: all}}\n"
                               "hair:\n  guides: {count: 6, segments: 4}\n  followers: {count: 10}\n");
     const ProcessResult info = runHairpipe("info s.yaml", dir.path());
     EXPECT_NE(info.output.find("0: still, 0.00 s"), std::string::npos) << info.output;
