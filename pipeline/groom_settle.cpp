@@ -44,8 +44,12 @@ std::string settleSceneKeys(const Scene& scene) {
     std::istringstream in(scene.dump());
     std::string out;
     for (std::string line; std::getline(in, line);) {
-        if (line.rfind("simulation.", 0) != 0 && line.rfind("hair.guides.", 0) != 0 && line.rfind("hair.groom.", 0) != 0)
-            continue;
+        // Everything the settled shape depends on: the solver, the guides, the
+        // groom, and the rod's material and radius (mass and stiffness).
+        const bool relevant = line.rfind("simulation.", 0) == 0 || line.rfind("hair.guides.", 0) == 0 ||
+                              line.rfind("hair.groom.", 0) == 0 || line.rfind("hair.material.", 0) == 0 ||
+                              line.rfind("hair.radius.", 0) == 0;
+        if (!relevant) continue;
         const size_t comment = line.find("    # default");
         out += line.substr(0, comment) + "\n";
     }

@@ -46,9 +46,6 @@ void addSimKeys(SchemaBuilder& b) {
         .number("simulation.bend_damping", 0, 0, 1e3, "N·m·s/rad", "Rigid only: damping of the joint springs.")
         .flag("simulation.preload", true,
               "Pre-load the joint springs so the rest shape is an equilibrium under gravity at the first frame.")
-        .number("simulation.settle", 0, 0, 60, "s",
-                "Rod: the guides first fall onto the still head for this long (drag ≥ 10/s); the settled shape "
-                "becomes the groom (pre-loaded with simulation.preload). 0: start from the groom as combed.")
         .flag("simulation.head_collision", true,
               "Project vertices out of the head's signed distance (with friction) after every Bullet step.")
         .flag("simulation.strand_collision", false,

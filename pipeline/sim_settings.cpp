@@ -26,7 +26,6 @@ GuideSettings guideSettings(const Scene& scene) {
     s.density = float(scene.number("hair.material.density"));
     s.hairsPerGuide = float(scene.number("hair.material.hairs_per_guide"));
     s.rodSubsteps = int(scene.integer("simulation.rod_substeps"));
-    s.settleTime = float(scene.number("simulation.settle"));
     s.preload = scene.flag("simulation.preload");
     s.headCollision = scene.flag("simulation.head_collision");
     s.strandCollision = scene.flag("simulation.strand_collision");

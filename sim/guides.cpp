@@ -51,7 +51,6 @@ void GuideSettings::validate() const {
     check(density > 0.f && hairsPerGuide > 0.f, "density and hairs per guide must be positive");
     check(formulation != GuideFormulation::Rod || rootRadius > 0.f, "the rod needs a fibre radius (root radius) > 0");
     check(rodSubsteps >= 1, "rod substeps must be ≥ 1");
-    check(settleTime >= 0.f, "settle time must be ≥ 0");
     check(friction >= 0.f, "friction must be ≥ 0");
     check(bendLimit > 0.f && bendLimit < 180.f, "bend limit must be in (0, 180) degrees");
     check(twistLimit > 0.f && twistLimit < 90.f, "twist limit must be in (0, 90) degrees");
@@ -182,32 +181,6 @@ struct GuideSolver::Impl {
     }
 
     GuideStats measure(const Collider* collider) const;
-
-    /// Lets the guides fall onto the still head at its start pose for
-    /// settings.settleTime (with drag of at least 10/s so they come to
-    /// rest), then makes the settled shape the rest shape (the groom): rod
-    /// formulation only, whose rest data are the directions and lengths.
-    void settle(const HeadPose& head) {
-        GuideSettings& s = set.settings;
-        const float drag = s.damping;
-        s.damping = std::max(drag, 10.f);
-        guides::SubstepContext ctx;
-        ctx.h = s.timeStep / float(s.substeps);
-        ctx.head.collider = head.collider.get();
-        ctx.headTransform = head.transform;
-        ctx.headCollision = s.headCollision;
-        const int steps = int(std::ceil(s.settleTime / ctx.h));
-        for (int k = 0; k < steps; ++k) forGroups([&](guides::GuideGroup& grp) { grp.substep(ctx); });
-        s.damping = drag;
-        for (size_t g = 0; g < set.count; ++g) {
-            const Mat3f Rt = set.rootRot1[g].toRotationMatrix().transpose();
-            for (int j = 0; j < set.segments; ++j)
-                set.groomDir[set.segment(g, j)] =
-                    (Rt * (set.x[set.vertex(g, j + 1)] - set.x[set.vertex(g, j)])).normalized();
-            set.resetGuides(g, g + 1);  // exactly the settled shape (lengths restored), at rest
-        }
-        ++set.version;
-    }
 };
 
 GuideSolver::GuideSolver(const GuideSettings& settings) : impl_(std::make_unique<Impl>()) {
@@ -312,9 +285,7 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
         m.contacts = std::make_unique<guides::StrandContacts>(set);
 
     ++set.version;
-    const bool settled = s.settleTime > 0.f && s.formulation == GuideFormulation::Rod;
-    if (settled) m.settle(head);
-    if (s.preload || settled) {  // a rod group also re-derives its rest curvatures here
+    if (s.preload) {
         guides::SubstepContext ctx;
         ctx.h = s.timeStep / float(s.substeps);
         ctx.headTransform = head.transform;

@@ -73,7 +73,6 @@ struct GuideSettings {
     float friction = 0.2f;          ///< Coulomb friction against the head and between strands
     Vec3f gravity = Vec3f(0.f, -9.81f, 0.f);  ///< m/s²
     bool preload = true;            ///< pre-load the springs so the rest shape holds under gravity at t0
-    float settleTime = 0.f;         ///< rod: s of falling onto the still head before t0; the result is the groom
 
     // Joint limits (seed: ±30° about the bending axes, ±10° twist, soft).
     float bendLimit = 30.f;         ///< deg
