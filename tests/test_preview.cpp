@@ -4,6 +4,7 @@
 // voxelization along the same light rays, generated hair grows where asked,
 // and frames are bit-identical across runs.
 #include "gl_support.h"
+#include "kajiya_kay_oracle.h"
 #include "test_support.h"
 
 #include "core/errors.h"
@@ -75,16 +76,26 @@ TEST(Preview, ShadersCompileAndLink) {
     HP_REQUIRE_GL();
     // Every program (per-vertex shading) is built by the constructor; per-fragment
     // shading and a second strand patch size are built on first use.
+    // Each program must not only link but draw: a strand across the middle
+    // of the frame covers the centre pixel and leaves the corners empty.
     PreviewSettings s;
     PreviewRenderer renderer(s);
-    s.shadePerFragment = true;
-    renderer.setSettings(s);
     StrandFrame f;
     addLine(f, Vec3f(-0.1f, 0.f, 0.f), Vec3f(0.1f, 0.f, 0.f), 0.001f, 5);
     const View v = testView(64, 48);
     PreviewFrame frame;
     frame.strands = &f;
-    EXPECT_NO_THROW(renderer.draw(v, frame));
+    for (bool perFragment : {false, true}) {
+        s.shadePerFragment = perFragment;
+        renderer.setSettings(s);
+        const Image img = renderer.render(v, frame);
+        const Vec2f centre = project(v, Vec3f::Zero());
+        // Sub-pixel hair: its alpha is its true width in pixels (about 0.07 here).
+        EXPECT_GT(img.at(int(centre.x()), int(centre.y()), 3), 0.02f) << (perFragment ? "per fragment" : "per vertex");
+        EXPECT_GT(img.at(int(centre.x()), int(centre.y()), 0), 0.f) << "the strand is lit";
+        EXPECT_EQ(img.at(0, 0, 3), 0.f);
+        EXPECT_EQ(img.at(63, 47, 3), 0.f);
+    }
     EXPECT_FALSE(renderer.stats().renderer.empty());
 }
 
@@ -166,7 +177,7 @@ TEST(Preview, KajiyaKayMatchesCpuReference) {
                 const Vec3f n = (view - view.dot(tangent) * tangent).normalized();
                 Vec3f radiance;
                 const Vec3f l = v.lights[0].toLight(p, &radiance, nullptr);
-                const Vec3f expected = kajiyaKay(v.hair, tangent, n, l, view).cwiseProduct(radiance);
+                const Vec3f expected = test::seedKajiyaKay(v.hair, tangent, n, l, view).cwiseProduct(radiance);
                 for (int c = 0; c < 3; ++c)
                     EXPECT_NEAR(img.at(x, y, c), expected[c], 0.01f * expected[c] + 1e-4f)
                         << "channel " << c << " at t=" << t << (perFragment ? " per fragment" : " per vertex")
