@@ -4,9 +4,12 @@
 // and no free vertex is more than 1 mm inside any collider, on 1 and 2
 // threads, with the same strands on both.
 //
-// DISABLED until the rod formulation (issue 18) lands: the rope formulation
-// stretches nape strands 3.3% where the tipping head pinches them against
-// the neck (frames 12-14; depth stays below 0.7 mm). Run it with
+// With the rod formulation every segment stays within 1% on every frame
+// (the rope stretched nape strands 3.3% where the tipping head pinches them
+// against the neck, frames 12-14). The depth limit is not met yet: during and
+// after the 180° turn (frames 29-46) a few vertices end up to 1.74 mm inside
+// (guides and followers measured together), so that check is its own
+// DISABLED test; run it with
 //   build/tests/test_stress_clip --gtest_also_run_disabled_tests
 #include "pipeline/scene.h"
 #include "pipeline/shot_simulation.h"
@@ -25,13 +28,13 @@ namespace {
 
 /// Every frame's strands of the stress clip on `threads` threads, after
 /// checking the limits on each.
-std::vector<StrandFrame> runStress(int threads) {
+std::vector<StrandFrame> runStress(int threads, float depthLimit) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     const Scene scene = Scene::load(sourcePath("scenes/stress.yaml"), {"hair.followers.count=3000"});
     const std::vector<int>& frames = scene.frames("frames");
     ShotSimulation sim(scene, scene.number("fps"), frames.front());
     std::vector<StrandFrame> out{sim.advanceTo(frames.front())};
-    const StrandFrame& rest = out.front();
+    const StrandFrame rest = out.front();  // a copy: `out` grows below
     for (int frame : frames) {
         if (frame == frames.front()) continue;
         const StrandFrame& f = sim.advanceTo(frame);
@@ -44,7 +47,7 @@ std::vector<StrandFrame> runStress(int threads) {
                 depth = std::max(depth, -sim.pose().collider->signedDistance(f.positions[i + 1]));
             }
         EXPECT_LE(stretch, 0.01f) << "frame " << frame << ", " << threads << " threads";
-        EXPECT_LE(depth, 1e-3f) << "frame " << frame << ", " << threads << " threads";
+        if (depthLimit > 0.f) EXPECT_LE(depth, depthLimit) << "frame " << frame << ", " << threads << " threads";
         out.push_back(f);
     }
     return out;
@@ -52,8 +55,12 @@ std::vector<StrandFrame> runStress(int threads) {
 
 }  // namespace
 
-TEST(StressClip, DISABLED_NoStretchNoPenetrationAfterAnyFrameOnOneAndTwoThreads) {
-    const std::vector<StrandFrame> one = runStress(1), two = runStress(2);
+TEST(StressClip, NoStretchAfterAnyFrameOnOneAndTwoThreads) {
+    const std::vector<StrandFrame> one = runStress(1, 0.f), two = runStress(2, 0.f);
     ASSERT_EQ(one.size(), two.size());
     for (size_t k = 0; k < one.size(); ++k) EXPECT_EQ(one[k].positions, two[k].positions) << "frame index " << k;
+}
+
+TEST(StressClip, DISABLED_NoVertexDeeperThanAMillimetreAfterAnyFrame) {
+    runStress(1, 1e-3f);
 }
