@@ -19,9 +19,10 @@
 // of the guides"): the direct banded solve is exact per linearisation, so
 // the static elastica comes out within 0.3% of L at 0.01 s steps; one XPBD
 // step per 0.02 s is unstable (a hanging chain's tip oscillation grows), two
-// are the default; a 23-segment strand costs ~10 µs of CPU per XPBD step,
-// about 3× the rope's step. Gauss-Seidel XPBD (cheaper per sweep, softer than
-// its EI when under-converged) was not measured.
+// are the default; a 23-segment strand costs ~9.5 µs of CPU per XPBD step
+// (B-sim, 845 guides, loaded machine), about 2× the rope's step.
+// Gauss-Seidel XPBD (cheaper per sweep, softer than its EI when
+// under-converged) was not measured.
 #include "sim/guide_group.h"
 #include "sim/rod_kernels.h"
 
@@ -105,15 +106,27 @@ void RodGroup::substep(const SubstepContext& ctx) {
     const int k = std::max(1, s.rodSubsteps);
     const float h = ctx.h / float(k);
     const float alpha0 = ctx.alpha - ctx.h / s.timeStep;
-    for (size_t g = begin_; g < end_; ++g) {
-        const rod::RodStrand strandData = strand(g);
-        Vec3f* x = &set_.x[set_.vertex(g, 0)];
-        Vec3f* v = &set_.v[set_.vertex(g, 0)];
+    // Guides in batches of rod::kLanes (their banded solves share SIMD
+    // lanes; each guide's result is that of a lone step).
+    for (size_t g0 = begin_; g0 < end_; g0 += rod::kLanes) {
+        const int count = int(std::min<size_t>(rod::kLanes, end_ - g0));
+        rod::RodStrand strands[rod::kLanes];
+        rod::RodStepTarget targets[rod::kLanes];
+        for (int l = 0; l < count; ++l) {
+            const size_t g = g0 + size_t(l);
+            strands[l] = strand(g);
+            targets[l].strand = &strands[l];
+            targets[l].x = &set_.x[set_.vertex(g, 0)];
+            targets[l].v = &set_.v[set_.vertex(g, 0)];
+        }
         for (int i = 0; i < k; ++i) {
             const float a = alpha0 + (ctx.alpha - alpha0) * float(i + 1) / float(k);
-            pinned_ += size_t(rod::rodStep(strandData, x, v, set_.rootPosition(g, a),
-                                           set_.rootRotation(g, a).toRotationMatrix(), s.gravity, h, s.damping,
-                                           s.friction, head, s.collisionRadius, scratch_));
+            for (int l = 0; l < count; ++l) {
+                targets[l].rootPos = set_.rootPosition(g0 + size_t(l), a);
+                targets[l].rootFrame = set_.rootRotation(g0 + size_t(l), a).toRotationMatrix();
+            }
+            pinned_ += size_t(rod::rodSteps(targets, count, s.gravity, h, s.damping, s.friction, head,
+                                            s.collisionRadius, scratch_));
         }
     }
 }

@@ -37,31 +37,56 @@ void forJoints(const RodStrand& s, const Vec3f* x, const Mat3f& R, F&& f) {
     }
 }
 
-/// Banded LDLᵀ in place: band[i·(B+1) + k] holds A(i, i-k) on entry, L(i, i-k)
-/// (k > 0) on exit; invD receives 1/D(i). Then solves L D Lᵀ z = rhs in place.
-///   D_i = A_ii - Σ_m L_im² D_m,  L_ij = (A_ij - Σ_m L_im D_m L_jm) / D_j.
+/// First column of row i's envelope: a bend row of joint j shares vertex
+/// j-1 with the rows of joint j-2 (first column 3(j-2)); a stretch row
+/// (vertices j, j+1) meets joint j-1 at the earliest (3(j-1)). LDLᵀ fills
+/// only inside this envelope, so the factorization skips the zeros of the
+/// band (the same sums, without the terms that are exactly zero).
+inline int envelopeStart(int i) {
+    const int j = i / 3;
+    return std::max(0, i - 3 * j == 2 ? 3 * j - 3 : 3 * j - 6);
+}
+
+/// Banded LDLᵀ in place for kLanes independent systems of the same size,
+/// interleaved lane by lane (lane l of A(i, i-k) at band[(i·(B+1) + k)·kLanes
+/// + l]; rhs and invD likewise), so that the lanes' dependency chains run
+/// side by side in SIMD registers. Per lane: L(i, i-k) (k > 0) replaces
+/// A(i, i-k), invD receives 1/D(i), then L D Lᵀ z = rhs is solved in place:
+///   D_i = A_ii - Σ_m L_im² D_m,  L_ij = (A_ij - Σ_m L_im D_m L_jm) / D_j,
+/// the sums over the envelope (envelopeStart).
 void bandedSolve(double* band, double* invD, double* rhs, int n) {
-    const int W = kBand + 1;
-    auto at = [&](int i, int j) -> double& { return band[i * W + (i - j)]; };
-    double t[kBand];  // t[m - lo] = L_im·D_m of the current row
+    constexpr int W = kBand + 1, L = kLanes;
+    double t[kBand][L];  // t[m - lo] = L_im·D_m of the current row
     for (int i = 0; i < n; ++i) {
-        const int lo = std::max(0, i - kBand);
-        double d = at(i, i);
+        const int lo = envelopeStart(i);
+        double* Li = band + size_t(i) * W * L;
+        double d[L];
+        for (int l = 0; l < L; ++l) d[l] = Li[l];
         for (int j = lo; j < i; ++j) {
-            double sum = at(i, j);
-            for (int m = std::max(lo, j - kBand); m < j; ++m) sum -= t[m - lo] * at(j, m);
-            t[j - lo] = sum;
-            const double lij = sum * invD[j];
-            at(i, j) = lij;
-            d -= sum * lij;
+            const double* Lj = band + size_t(j) * W * L;
+            double sum[L];
+            for (int l = 0; l < L; ++l) sum[l] = Li[(i - j) * L + l];
+            for (int m = std::max(lo, envelopeStart(j)); m < j; ++m)
+                for (int l = 0; l < L; ++l) sum[l] -= t[m - lo][l] * Lj[(j - m) * L + l];
+            for (int l = 0; l < L; ++l) {
+                t[j - lo][l] = sum[l];
+                const double lij = sum[l] * invD[j * L + l];
+                Li[(i - j) * L + l] = lij;
+                d[l] -= sum[l] * lij;
+            }
         }
-        invD[i] = 1.0 / d;
+        for (int l = 0; l < L; ++l) invD[i * L + l] = 1.0 / d[l];
     }
-    for (int i = 0; i < n; ++i)
-        for (int m = std::max(0, i - kBand); m < i; ++m) rhs[i] -= at(i, m) * rhs[m];
-    for (int i = 0; i < n; ++i) rhs[i] *= invD[i];
+    for (int i = 0; i < n; ++i) {
+        const double* Li = band + size_t(i) * W * L;
+        for (int m = envelopeStart(i); m < i; ++m)
+            for (int l = 0; l < L; ++l) rhs[i * L + l] -= Li[(i - m) * L + l] * rhs[m * L + l];
+    }
+    for (int i = 0; i < n * L; ++i) rhs[i] *= invD[i];
     for (int i = n - 1; i >= 0; --i)
-        for (int k = i + 1; k <= std::min(n - 1, i + kBand); ++k) rhs[i] -= at(k, i) * rhs[k];
+        for (int k = i + 1; k <= std::min(n - 1, i + kBand); ++k)
+            if (envelopeStart(k) <= i)
+                for (int l = 0; l < L; ++l) rhs[i * L + l] -= band[(size_t(k) * W + size_t(k - i)) * L + l] * rhs[k * L + l];
 }
 
 /// One mass-weighted Newton step on the stretch constraints alone,
@@ -198,41 +223,43 @@ void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gr
     }
 }
 
-int rodStep(const RodStrand& s, Vec3f* x, Vec3f* v, const Vec3f& rootPos, const Mat3f& rootFrame,
-            const Vec3f& gravity, float h, float drag, float friction, const strand::HeadQuery* head, float radius,
-            RodScratch& sc) {
-    const int n = s.vertices, S = n - 1, N = 3 * S, W = kBand + 1;
-    sc.grad.assign(size_t(N) * 3, Vec3f::Zero());
-    sc.band.assign(size_t(N) * W, 0.0);
-    sc.rhs.assign(size_t(N), 0.0);
-    sc.invD.resize(size_t(N));
-    sc.a.resize(size_t(n) * 2);
-    Vec3f* y = sc.a.data();  // predicted / solved positions
-    Vec3f* old = y + n;      // the step's start, for velocities and pinning
-    for (int i = 0; i < n; ++i) old[i] = x[i];
-    y[0] = rootPos;
-    for (int i = 1; i < n; ++i) y[i] = x[i] + h * v[i] + (h * h) * gravity;
+namespace {
+
+/// Steps 1–2 of rodStep up to the solve, for one strand in lane `lane`:
+/// predicts y (old: the step's start), writes the constraint gradients
+/// (9 per joint: rows a, b, stretch × slots j-1, j, j+1) and the lane's
+/// system A = J W Jᵀ + α̃ and right-hand side -C(y).
+void assemble(const RodStepTarget& t, const Vec3f& gravity, float h, int lane, Vec3f* y, Vec3f* old, Vec3f* grad,
+              double* band, double* rhs) {
+    const RodStrand& s = *t.strand;
+    const int n = s.vertices, S = n - 1;
+    constexpr int W = kBand + 1;
+    auto A = [&](int r, int k) -> double& { return band[(size_t(r) * W + size_t(k)) * kLanes + size_t(lane)]; };
+    auto b = [&](int r) -> double& { return rhs[size_t(r) * kLanes + size_t(lane)]; };
+    for (int i = 0; i < n; ++i) old[i] = t.x[i];
+    y[0] = t.rootPos;
+    for (int i = 1; i < n; ++i) y[i] = t.x[i] + h * t.v[i] + (h * h) * gravity;
 
     // Constraint rows and gradients at y.
     const bool bend = s.bendStiffness > 0;
-    forJoints(s, y, rootFrame, [&](int j, const Vec3f& u, float ulen, const Vec3f& e, const Vec3f& a, bool ghost) {
-        Vec3f* g = &sc.grad[size_t(3 * j) * 3];
+    forJoints(s, y, t.rootFrame, [&](int j, const Vec3f& u, float ulen, const Vec3f& e, const Vec3f& a, bool ghost) {
+        Vec3f* g = &grad[size_t(3 * j) * 3];
         if (bend) {
             Vec3f gb[2][3];
             const Vec2f C = bendConstraint(u, ulen, e, a, s.restCurvature[j], ghost, gb);
             for (int k = 0; k < 2; ++k) {
                 for (int slot = 0; slot < 3; ++slot) g[k * 3 + slot] = gb[k][slot];
-                sc.rhs[3 * j + k] = -C[k];
-                sc.band[(3 * j + k) * W] = voronoi(s, j) / (s.bendStiffness * double(h) * h);  // α̃
+                b(3 * j + k) = -C[k];
+                A(3 * j + k, 0) = voronoi(s, j) / (s.bendStiffness * double(h) * h);  // α̃
             }
         } else {
-            for (int k = 0; k < 2; ++k) sc.band[(3 * j + k) * W] = 1.0;  // inert rows: Δλ = 0
+            for (int k = 0; k < 2; ++k) A(3 * j + k, 0) = 1.0;  // inert rows: Δλ = 0
         }
         const float len = e.norm();
         const Vec3f d = e / len;
         g[6 + 1] = -d;
         g[6 + 2] = d;
-        sc.rhs[3 * j + 2] = -(len - s.restLength[j]);
+        b(3 * j + 2) = -(len - s.restLength[j]);
     });
     // A = J W Jᵀ (+ α̃ already on the diagonal), lower band, vertex by
     // vertex: the rows touching free vertex v are the bend rows of joints
@@ -247,27 +274,33 @@ int rodStep(const RodStrand& s, Vec3f* x, Vec3f* v, const Vec3f& rootPos, const 
             const int kinds = j <= vtx ? 3 : 2;  // joint v+1's stretch row does not touch v
             for (int k = 0; k < kinds; ++k) {
                 rows[count] = 3 * j + k;
-                grads[count++] = &sc.grad[size_t(3 * j + k) * 3 + size_t(slot)];
+                grads[count++] = &grad[size_t(3 * j + k) * 3 + size_t(slot)];
             }
         }
         const float w = s.invMass[vtx];
-        for (int a = 0; a < count; ++a) {
-            double* row = &sc.band[size_t(rows[a]) * W];
-            const Vec3f ga = w * *grads[a];
-            for (int b = 0; b <= a; ++b) row[rows[a] - rows[b]] += double(ga.dot(*grads[b]));
+        for (int p = 0; p < count; ++p) {
+            const Vec3f ga = w * *grads[p];
+            for (int q = 0; q <= p; ++q) A(rows[p], rows[p] - rows[q]) += double(ga.dot(*grads[q]));
         }
     }
-    bandedSolve(sc.band.data(), sc.invD.data(), sc.rhs.data(), N);
+}
+
+/// Steps 2 (the update y += W Jᵀ Δλ, Δλ in lane `lane` of rhs) to 4 of
+/// rodStep for one strand. Returns its pinned vertices.
+int finish(const RodStepTarget& t, int lane, const double* rhs, const Vec3f* grad, Vec3f* y, const Vec3f* old,
+           float h, float drag, float friction, const strand::HeadQuery* head, float radius, RodScratch& sc) {
+    const RodStrand& s = *t.strand;
+    const int n = s.vertices, N = 3 * (n - 1);
     for (int r = 0; r < N; ++r) {
         const int jr = r / 3;
-        const float dl = float(sc.rhs[r]);
+        const float dl = float(rhs[size_t(r) * kLanes + size_t(lane)]);
         for (int slot = 0; slot < 3; ++slot) {
             const int vtx = jr - 1 + slot;
-            if (vtx >= 1) y[vtx] += (s.invMass[vtx] * dl) * sc.grad[size_t(r) * 3 + size_t(slot)];
+            if (vtx >= 1) y[vtx] += (s.invMass[vtx] * dl) * grad[size_t(r) * 3 + size_t(slot)];
         }
     }
 
-    stretchSolve(y, s.invMass, s.restLength, n, sc.invD.data(), sc.rhs.data(), &sc.grad[0]);
+    stretchSolve(y, s.invMass, s.restLength, n, sc.diag.data(), sc.lambda.data(), sc.dir.data());
 
     // Exact lengths and head clearance, root to tip; pinning where both cannot hold.
     const float damp = strand::dampingFactor(drag, h);
@@ -302,10 +335,50 @@ int rodStep(const RodStrand& s, Vec3f* x, Vec3f* v, const Vec3f& rootPos, const 
             if (contact.active) vel = strand::contactFriction(vel, head->surfaceVelocity(y[i], h), contact, friction, h);
             vel *= damp;
         }
-        x[i] = y[i];
-        v[i] = vel;
+        t.x[i] = y[i];
+        t.v[i] = vel;
     }
     return pinned;
+}
+
+}  // namespace
+
+int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, float h, float drag, float friction,
+             const strand::HeadQuery* head, float radius, RodScratch& sc) {
+    const int n = targets[0].strand->vertices, N = 3 * (n - 1);
+    const size_t gradPerLane = size_t(N) * 3, posPerLane = size_t(n) * 2;
+    sc.grad.assign(gradPerLane * kLanes, Vec3f::Zero());
+    sc.band.assign(size_t(N) * (kBand + 1) * kLanes, 0.0);
+    sc.rhs.assign(size_t(N) * kLanes, 0.0);
+    sc.invD.resize(size_t(N) * kLanes);
+    sc.a.resize(posPerLane * kLanes);
+    sc.diag.resize(size_t(n));
+    sc.lambda.resize(size_t(n));
+    sc.dir.resize(size_t(n));
+    for (int l = 0; l < kLanes; ++l) {
+        if (l < count) {
+            Vec3f* y = &sc.a[posPerLane * size_t(l)];
+            assemble(targets[l], gravity, h, l, y, y + n, &sc.grad[gradPerLane * size_t(l)], sc.band.data(),
+                     sc.rhs.data());
+        } else {
+            for (int r = 0; r < N; ++r) sc.band[size_t(r) * (kBand + 1) * kLanes + size_t(l)] = 1.0;  // idle lane: I z = 0
+        }
+    }
+    bandedSolve(sc.band.data(), sc.invD.data(), sc.rhs.data(), N);
+    int pinned = 0;
+    for (int l = 0; l < count; ++l) {
+        Vec3f* y = &sc.a[posPerLane * size_t(l)];
+        pinned += finish(targets[l], l, sc.rhs.data(), &sc.grad[gradPerLane * size_t(l)], y, y + n, h, drag,
+                         friction, head, radius, sc);
+    }
+    return pinned;
+}
+
+int rodStep(const RodStrand& s, Vec3f* x, Vec3f* v, const Vec3f& rootPos, const Mat3f& rootFrame,
+            const Vec3f& gravity, float h, float drag, float friction, const strand::HeadQuery* head, float radius,
+            RodScratch& sc) {
+    const RodStepTarget t{&s, x, v, rootPos, rootFrame};
+    return rodSteps(&t, 1, gravity, h, drag, friction, head, radius, sc);
 }
 
 double bendEnergy(const RodStrand& s, const Vec3f* x, const Mat3f& rootFrame) {
