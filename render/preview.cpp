@@ -86,7 +86,7 @@ struct PreviewRenderer::Impl {
         present = GlProgram("present", {{ShaderStage::Vertex, "fullscreen.vert"}, {ShaderStage::Fragment, "present.frag"}});
 
         strands.create();
-        compileHairPrograms(std::min(strands.maxPatchVertices, 26));  // 24-vertex strands (BENCHMARKS.md)
+        compileHairPrograms(std::min(strands.maxPatchVertices, 26));  // 24-vertex strands (docs/benchmarks.md)
         headBuffers.create();
         glCreateBuffers(1, &cameraUbo);
         glNamedBufferStorage(cameraUbo, sizeof(FrameUniforms), nullptr, GL_DYNAMIC_STORAGE_BIT);

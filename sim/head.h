@@ -92,7 +92,7 @@ class HeadMotion {
 /// A UV sphere mesh (used by tests, benchmarks and the procedural demo head).
 TriangleMesh makeSphereMesh(const Vec3f& centre, float radius, int rings, int sectors);
 
-/// The benchmark head of BENCHMARKS.md: a sphere spinning about +Y at a
+/// The benchmark head of docs/benchmarks.md: a sphere spinning about +Y at a
 /// constant rate, with an exact sphere collider.
 class SpinningSphere final : public HeadMotion {
   public:

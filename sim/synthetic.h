@@ -13,7 +13,7 @@ struct SyntheticHairSettings {
     int vertices = 24;            ///< per strand (23 segments)
     float length = 0.25f;         ///< metres
     float headRadius = 0.1f;      ///< sphere head centred at the origin
-    float capMinCosine = 0.f;     ///< 0 = upper hemisphere (BENCHMARKS.md)
+    float capMinCosine = 0.f;     ///< 0 = upper hemisphere (docs/benchmarks.md)
     float rootRadius = 0.00004f;  ///< 0.04 mm
     float tipRadius = 0.00001f;   ///< 0.01 mm
     float droop = 1.f;            ///< 0 = straight along the normal, 1 = hangs down by the tip

@@ -1,6 +1,6 @@
 // @brief A procedural groom on the benchmark sphere head and a deterministic
 // guide motion, for follower tests and the B-follow benchmark when no guide
-// solver runs (BENCHMARKS.md: sphere r = 0.1 m spinning 90°/s about +Y,
+// solver runs (docs/benchmarks.md: sphere r = 0.1 m spinning 90°/s about +Y,
 // guides and followers on independent Fibonacci lattices over the upper
 // hemisphere, 0.25 m, 24 vertices).
 //

@@ -1,9 +1,9 @@
-// B-follow (BENCHMARKS.md): milliseconds per follower update for the seed's
+// B-follow (docs/benchmarks.md): milliseconds per follower update for the seed's
 // case (94 guides, 751 followers) and 845 guides with 10k, 100k and 400k
 // followers × 24 vertices, modes varied / cluster / interpolate, on 1 and 2
 // threads; medians of 3 runs with their spread.
 //
-// Guides: BENCHMARKS.md asks for the 845 guides of B-sim after its 250 steps.
+// Guides: docs/benchmarks.md asks for the 845 guides of B-sim after its 250 steps.
 // The guide solver is not on this branch, so a GuideSource drives them with
 // sim/synthetic_groom.h's deterministic motion (drooping, swaying guides on the
 // sphere r = 0.1 m spinning 90°/s about +Y) from t = (20 + 250) × 0.02 s on.

@@ -1,4 +1,4 @@
-// Benchmark of the GL preview (BENCHMARKS.md "B-render", preview part):
+// Benchmark of the GL preview (docs/benchmarks.md "B-render", preview part):
 // milliseconds per 1920x1080 frame with shadows on (voxel grid + shadow
 // map) and 4x MSAA, camera (0, 0.05, 0.9) looking at the origin, vertical
 // FOV 40 deg, one directional light (-1, -1, -1) of intensity 3, black

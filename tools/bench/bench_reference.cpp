@@ -1,4 +1,4 @@
-// B-render, reference part (BENCHMARKS.md): seconds per 1920×1080 frame at
+// B-render, reference part (docs/benchmarks.md): seconds per 1920×1080 frame at
 // 16 spp of the Embree reference, physical mode (4 bounces) and Kajiya-Kay,
 // for 10k and 100k strands × 24 vertices with shadows; Embree scene memory
 // (device memory monitor) and peak RSS.
@@ -91,7 +91,7 @@ int main(int argc, char** argv) {
     }
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
 
-    // BENCHMARKS.md B-render camera and light.
+    // docs/benchmarks.md B-render camera and light.
     View view;
     view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
     view.camera.target = Vec3f::Zero();

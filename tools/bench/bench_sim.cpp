@@ -1,4 +1,4 @@
-// B-sim (BENCHMARKS.md): guide simulation on a sphere head.
+// B-sim (docs/benchmarks.md): guide simulation on a sphere head.
 //
 // Head: sphere r = 0.1 m at the origin spinning about +Y at 90°/s for the
 // whole run. Guides: N = 94 and 845, roots on a Fibonacci lattice over the

@@ -11,7 +11,7 @@
 //
 //   bench_stress [--scene scenes/stress.yaml] [--threads 2] [--set key=value ...]
 //
-// --colliders: B-sim head-only (BENCHMARKS.md: sphere r = 0.1 m spinning
+// --colliders: B-sim head-only (docs/benchmarks.md: sphere r = 0.1 m spinning
 // 90°/s, 0.25 m guides of 24 vertices, 20 warm-up + 250 timed steps) with
 // the head as the exact analytic sphere, as a distance grid (the head's fast
 // path, sim/level_set.h) and as a btSphereShape queried through the Bullet

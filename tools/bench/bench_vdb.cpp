@@ -1,4 +1,4 @@
-// B-vdb (BENCHMARKS.md): voxelize the ~100k strands of B-render and write
+// B-vdb (docs/benchmarks.md): voxelize the ~100k strands of B-render and write
 // one VDB frame, at 1 mm and 0.5 mm voxels, on 2 threads and 1.
 //
 // Until the simulation is integrated, the strands come from
