@@ -129,9 +129,18 @@ TEST(ShotSimulation, CurlyWetModelRunsThroughTheDriver) {
     const Scene scene = Scene::load(test::sourcePath("scenes/curly_wet.yaml"),
                                     {"hair.guides.count=20", "hair.followers.count=100"});
     ShotSimulation sim(scene, scene.number("fps"), scene.frames("frames").front());
-    const int last = scene.frames("frames").back();
-    const StrandFrame& f = sim.advanceTo(std::min(last, scene.frames("frames").front() + 12));
+    const StrandFrame& f = sim.advanceTo(13);
     EXPECT_NO_THROW(f.validate());
     EXPECT_EQ(f.guideCount, 20u);
-    EXPECT_GE(sim.stats().saturation, 0.0);
+    // The scene's saturation curve is [[1, 0], [24, 0], [40, 1], ...] over
+    // frames, times a root-to-tip profile (0.4 at the root, 1 at the tip):
+    // the driver must hand the solver σ = curve(frame) · profile.
+    EXPECT_EQ(sim.stats().saturation, 0.0) << "dry until frame 24";
+    sim.advanceTo(32);
+    const double half = sim.stats().saturation;
+    sim.advanceTo(40);
+    const double soaked = sim.stats().saturation;
+    EXPECT_GT(soaked, 0.4) << "the profile is at least 0.4 (the root) everywhere";
+    EXPECT_LT(soaked, 1.0) << "and below 1 except at the tip";
+    EXPECT_NEAR(half / soaked, 0.5, 0.01) << "frame 32 is halfway up the curve";
 }
