@@ -90,6 +90,7 @@ TEST(SimGuards, LongViolentRunStaysBoundedAndFinite) {
 
 TEST(SimGuards, VelocityClampHoldsSpeedsToTheLimit) {
     const std::vector<Vec3f> dirs = fibonacciCap(8);
+    std::vector<Vec3f> last;  // positions after the last step of the latest run
     auto run = [&](float limit, size_t& clamped) {
         GuideSettings s;
         s.maxSpeed = limit;
@@ -105,14 +106,22 @@ TEST(SimGuards, VelocityClampHoldsSpeedsToTheLimit) {
             solver.write(f);
             peak = std::max(peak, maxSpeed(f));
         }
+        last = f.positions;
         return peak;
     };
     size_t clamped = 0;
     const float free = run(0.f, clamped);
+    const std::vector<Vec3f> unclamped = last;
     EXPECT_EQ(clamped, 0u);
     ASSERT_GT(free, 2.f) << "the shaking must exceed the limit for the test to mean anything";
+    // A limit the motion never reaches must change nothing at all: the guard
+    // only acts on what is faster than it.
+    EXPECT_EQ(run(2.f * free, clamped), free);
+    EXPECT_EQ(clamped, 0u);
+    EXPECT_EQ(last, unclamped);
     EXPECT_LE(run(2.f, clamped), 2.f * (1.f + 1e-5f));
     EXPECT_GT(clamped, 0u);
+    EXPECT_NE(last, unclamped) << "a limit the motion exceeds changes the motion";
 }
 
 TEST(SimGuards, NonFiniteRootIsReportedWithItsGuide) {
