@@ -60,7 +60,7 @@ float maxSegmentError(const StrandFrame& f, float rest) {
 }  // namespace
 
 TEST(Guides, LengthErrorBelowATenthOfAPercent) {
-    GuideSettings s;  // the default (rope) formulation
+    GuideSettings s;  // the default (rod) formulation
     GuideSolver solver(s);
     const float rest = s.length / float(s.segments);
     runSphere(solver, fibonacciCap(24), 360.f, 150, [&](const GuideStats& st, const HeadPose&, int k) {
