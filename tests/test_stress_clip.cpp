@@ -7,8 +7,8 @@
 // With the rod formulation every segment stays within 1% on every frame
 // (the rope stretched nape strands 3.3% where the tipping head pinches them
 // against the neck, frames 12-14). The depth limit is not met yet: during and
-// after the 180° turn (frames 29-46) a few vertices end up to 1.74 mm inside
-// (guides and followers measured together), so that check is its own
+// after the 180° turn (frames 29-46) a few follower vertices end up to
+// 1.74 mm inside (the guides stay outside), so that check is its own
 // DISABLED test; run it with
 //   build/tests/test_stress_clip --gtest_also_run_disabled_tests
 #include "pipeline/scene.h"
