@@ -1,10 +1,9 @@
 // Image comparison: the metrics (render/compare.h, flip.h, ssim.h), the
 // per-frame files and tables (pipeline/compare_job.h), `hairpipe compare`,
-// the compare stage of `hairpipe run`, and the HTML report in headless Chromium.
+// the compare stage of `hairpipe run`, and the HTML report in headless Chromium
+// (the tables and the report's labels: test_compare_report.cpp).
 #include "core/errors.h"
 #include "pipeline/compare_job.h"
-#include "pipeline/compare_report.h"
-#include "pipeline/scene.h"
 #include "pipeline/compare_table.h"
 #include "pipeline/path_template.h"
 #include "render/colormap.h"
@@ -357,26 +356,6 @@ TEST(CompareFiles, FramesInBothSequences) {
     EXPECT_FALSE(matchFrame("x.####.exr", "y.0012.exr", &frame));
 }
 
-TEST(CompareFiles, ThresholdsAndTables) {
-    FrameMetrics m;
-    m.flip = 0.3, m.ssim = 0.7, m.psnr = 20, m.rmse = 0.1;
-    EXPECT_TRUE(checkThresholds(m, {}).empty()) << "the defaults are no limits";
-    const auto f = checkThresholds(m, {0.25, 30, 0.8, 0.05});
-    ASSERT_EQ(f.size(), 4u);
-    EXPECT_EQ(f[0], "FLIP 0.3 > 0.25");
-    EXPECT_EQ(f[1], "PSNR 20 dB < 30 dB");
-    FrameRecord ok, bad;
-    ok.frame = 1, ok.compared = true, ok.metrics = m;
-    bad.frame = 2, bad.error = "b.0002.exr: no such file", bad.a = "a,0002.exr";
-    const std::string csv = metricsCsv({ok, bad});
-    EXPECT_NE(csv.find("\n1,,,pass,0,0.1,20,0,0.7,0.3,\n"), std::string::npos) << csv;
-    EXPECT_NE(csv.find("\n2,\"a,0002.exr\",,error,,,,,,,b.0002.exr: no such file\n"), std::string::npos) << csv;
-    const CompareSummary s = summarize({ok, bad});
-    EXPECT_EQ(s.compared, 1);
-    EXPECT_EQ(s.failed, 1);
-    EXPECT_FALSE(s.pass());
-}
-
 // ---------------------------------------------------------------- command line
 
 namespace {
@@ -600,35 +579,3 @@ TEST(CompareReport, IsSelfContainedAndRendersInHeadlessChromium) {
     EXPECT_EQ(bodyAttribute(bad, "data-status"), "error");
     EXPECT_EQ(bodyAttribute(bad, "data-broken"), "1");
 }
-
-namespace hp {
-
-TEST(CompareReport, SidesAreLabelledFromTheScene) {
-    const Scene scene = Scene::parse("reference: {mode: physical, samples: 8, kajiya_kay: {enabled: true}}\n"
-                                     "compare: {b: reference/kajiya-kay.####.exr, beside: reference/reference.####.exr}\n",
-                                     "labels.yaml", ".");
-    const CompareJob job = compareJobFromScene(scene, "/tmp/shot");
-    EXPECT_EQ(job.aLabel, "preview (OpenGL)");
-    EXPECT_EQ(job.bLabel, "reference (Embree, kajiya-kay, 8 spp)");
-    EXPECT_EQ(job.beside, "/tmp/shot/reference/reference.####.exr");
-    EXPECT_EQ(job.besideLabel, "reference (Embree, physical, 8 spp)");
-    const std::string html = compareReportHtml(job, {});
-    EXPECT_NE(html.find("A: preview (OpenGL)"), std::string::npos);
-    EXPECT_NE(html.find("beside: reference (Embree, physical, 8 spp)"), std::string::npos);
-    EXPECT_NE(html.find("measured pair"), std::string::npos);
-    EXPECT_EQ(html.find("A (reference)"), std::string::npos);
-    EXPECT_EQ(html.find("B (test)"), std::string::npos);
-    // A label the scene gives wins; an unknown sequence is named by its template.
-    const CompareJob other = compareJobFromScene(
-        Scene::parse("compare: {a: other/x.####.exr, b_label: my render}\n", "labels.yaml", "."), "/tmp/shot");
-    EXPECT_EQ(other.aLabel, "other/x.####.exr");
-    EXPECT_EQ(other.bLabel, "my render");
-    try {
-        compareJobFromScene(Scene::parse("compare: {beside: still.exr}\n", "labels.yaml", "."), "/tmp/shot");
-        FAIL() << "a beside template without a frame number must be refused";
-    } catch (const SceneError& e) {
-        EXPECT_NE(std::string(e.what()).find("compare.beside"), std::string::npos) << e.what();
-    }
-}
-
-}  // namespace hp
