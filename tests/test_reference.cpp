@@ -291,6 +291,21 @@ Scene referenceScene(const std::string& extra = "") {
                         "test.yaml", std::filesystem::current_path());
 }
 
+/// Frame 1 of a shot whose only content is the head `pose` (no strands).
+FrameData headOnlyFrame(const HeadPose& pose) {
+    FrameData data;
+    data.frame = 1;
+    data.head = &pose;
+    return data;
+}
+
+/// The head of the stage tests: a sphere of radius 0.1 m at the origin.
+HeadPose sphereHead() {
+    HeadPose pose;
+    pose.mesh = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
+    return pose;
+}
+
 }  // namespace
 
 TEST(ReferenceStage, WritesExrWithLayersAndPng) {
@@ -346,11 +361,8 @@ TEST(ReferenceStage, HeadAloneWithoutStrandsAndNothingIsAnError) {
     shot.outputDir = dir.path();
     const StagePtr stage = makeReferenceStage(referenceScene("  png: \"\"\n"), shot);
     ASSERT_EQ(stage->outputs(1).size(), 1u);  // empty png template writes no PNG
-    HeadPose pose;
-    pose.mesh = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
-    FrameData data;
-    data.frame = 1;
-    data.head = &pose;
+    const HeadPose pose = sphereHead();
+    FrameData data = headOnlyFrame(pose);
     stage->run(data);
     const Image img = readImage(stage->outputs(1)[0].string());
     EXPECT_FLOAT_EQ(img.at(32, 24, img.channelIndex("A")), 1.f);
@@ -385,11 +397,8 @@ TEST(ReferenceStage, KajiyaKayCompanionBesidePhysical) {
         makeReferenceStage(referenceScene("  mode: physical\n  png: \"\"\n  kajiya_kay: {enabled: true, png: \"\"}\n"), shot);
     ASSERT_EQ(stage->outputs(1), (std::vector<std::filesystem::path>{dir.path() / "reference/reference.0001.exr",
                                                                      dir.path() / "reference/kajiya-kay.0001.exr"}));
-    HeadPose pose;
-    pose.mesh = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
-    FrameData data;
-    data.frame = 1;
-    data.head = &pose;
+    const HeadPose pose = sphereHead();
+    FrameData data = headOnlyFrame(pose);
     stage->run(data);
     const Image physical = readImage(stage->outputs(1)[0].string());
     const Image kk = readImage(stage->outputs(1)[1].string());
