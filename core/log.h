@@ -1,7 +1,7 @@
 // Logging to stderr with three verbosity levels (-q, default, -v).
 //
 // Lines are written whole under a mutex so messages from TBB workers never
-// interleave mid-line. The progress bar (pipeline/progress.h) coordinates with
+// interleave mid-line. The progress bar (pipeline/batch/progress.h) coordinates with
 // this through clearProgressLine().
 #pragma once
 

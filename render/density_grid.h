@@ -17,7 +17,7 @@
 // (offset = x·64 + y·8 + z of the voxel within the block).
 #pragma once
 
-#include "sim/strand.h"
+#include "sim/strands/strand.h"
 
 #include <Eigen/Core>
 

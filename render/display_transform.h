@@ -18,7 +18,7 @@
 #pragma once
 
 #include "render/image_io.h"
-#include "sim/strand.h"
+#include "sim/strands/strand.h"
 
 #include <string>
 

@@ -17,8 +17,8 @@
 //   segments), so crossings of the same strand within one segment count once.
 #pragma once
 
-#include "sim/head.h"
-#include "sim/strand.h"
+#include "sim/strands/head.h"
+#include "sim/strands/strand.h"
 
 #include <cstdint>
 #include <memory>

@@ -7,7 +7,7 @@
 // which hair type.
 #pragma once
 
-#include "sim/head.h"
+#include "sim/strands/head.h"
 
 #include <cstdint>
 #include <vector>

@@ -28,7 +28,7 @@
 // reciprocal either.)
 #pragma once
 
-#include "sim/strand.h"
+#include "sim/strands/strand.h"
 
 namespace hp {
 

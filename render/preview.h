@@ -47,8 +47,8 @@
 #include "render/image_io.h"
 #include "render/light_grid.h"
 #include "render/view.h"
-#include "sim/head.h"
-#include "sim/strand.h"
+#include "sim/strands/head.h"
+#include "sim/strands/strand.h"
 
 #include <memory>
 #include <string>

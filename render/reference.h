@@ -22,8 +22,8 @@
 #include "render/hair_bsdf.h"
 #include "render/image_io.h"
 #include "render/view.h"
-#include "sim/head.h"
-#include "sim/strand.h"
+#include "sim/strands/head.h"
+#include "sim/strands/strand.h"
 
 #include <cstdint>
 #include <functional>

@@ -2,7 +2,7 @@
 // reference, so both render the same shot with the same parameters.
 #pragma once
 
-#include "sim/strand.h"
+#include "sim/strands/strand.h"
 
 #include <Eigen/Geometry>
 

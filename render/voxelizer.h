@@ -17,7 +17,7 @@
 #pragma once
 
 #include "render/density_grid.h"
-#include "sim/strand.h"
+#include "sim/strands/strand.h"
 
 namespace hp {
 

@@ -1,7 +1,7 @@
 // Helpers shared by the follower tests.
 #pragma once
 
-#include "sim/head.h"
+#include "sim/strands/head.h"
 
 namespace hp::test {
 

@@ -5,8 +5,8 @@
 // chain's first mode in closed form (Bessel J0), the energy balance.
 #pragma once
 
-#include "sim/guides.h"
-#include "sim/rod_kernels.h"
+#include "sim/guides/guides.h"
+#include "sim/guides/rod_kernels.h"
 
 #include <algorithm>
 #include <cmath>

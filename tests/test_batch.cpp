@@ -3,7 +3,7 @@
 // whole-shot USD export, stale temporaries.
 #include "batch_support.h"
 #include "core/errors.h"
-#include "pipeline/output.h"
+#include "pipeline/batch/output.h"
 
 #include <gtest/gtest.h>
 

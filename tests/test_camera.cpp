@@ -1,4 +1,4 @@
-// Camera auto (render/camera_framing.h, pipeline/camera_track.h): for the
+// Camera auto (render/camera_framing.h, pipeline/stages/camera_track.h): for the
 // project's head, a sphere-and-neck head built here and the Fox asset, the
 // framed camera keeps the whole head and the hair's bounds inside the frame
 // on every frame. The checks project, with the camera's own view and
@@ -10,11 +10,11 @@
 #include "test_support.h"
 #include "batch_support.h"
 
-#include "pipeline/camera_track.h"
-#include "pipeline/head_setup.h"
-#include "pipeline/scene.h"
-#include "pipeline/stages.h"
-#include "pipeline/view_settings.h"
+#include "pipeline/stages/camera_track.h"
+#include "pipeline/head/head_setup.h"
+#include "pipeline/scene/scene.h"
+#include "pipeline/stages/stages.h"
+#include "pipeline/scene/view_settings.h"
 #include "render/image_io.h"
 
 #include <cmath>

@@ -1,8 +1,8 @@
 // Exact mesh queries, the signed distance grid and the head colliders
-// (sim/mesh_query.h, sim/level_set.h, sim/mesh_collider.h).
-#include "sim/level_set.h"
-#include "sim/mesh_collider.h"
-#include "sim/mesh_query.h"
+// (sim/collision/mesh_query.h, sim/collision/level_set.h, sim/collision/mesh_collider.h).
+#include "sim/collision/level_set.h"
+#include "sim/collision/mesh_collider.h"
+#include "sim/collision/mesh_query.h"
 
 #include <gtest/gtest.h>
 

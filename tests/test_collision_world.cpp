@@ -1,13 +1,13 @@
-// Colliders beside the head (sim/collision_world.h): Bullet primitives and a
+// Colliders beside the head (sim/collision/collision_world.h): Bullet primitives and a
 // mesh prop in one collision world, joined to the head's collider; hair
 // lies on them. Distances are checked against the geometry computed here.
-#include "pipeline/head_import.h"
-#include "pipeline/head_setup.h"
-#include "pipeline/scene.h"
-#include "sim/collision_world.h"
-#include "sim/fibonacci.h"
-#include "sim/guides.h"
-#include "sim/mesh_collider.h"
+#include "pipeline/head/head_import.h"
+#include "pipeline/head/head_setup.h"
+#include "pipeline/scene/scene.h"
+#include "sim/collision/collision_world.h"
+#include "sim/strands/fibonacci.h"
+#include "sim/guides/guides.h"
+#include "sim/collision/mesh_collider.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -193,7 +193,7 @@ TEST(CollisionWorld, SkinnedBodyColliderFollowsItsSkin) {
     rest.computeNormals();
     const auto collider = head.motion->sample(t).collider;
     // Reference: the exact closest-triangle distance of the deformed mesh
-    // (Embree BVH, angle-weighted pseudonormals; sim/mesh_collider.h).
+    // (Embree BVH, angle-weighted pseudonormals; sim/collision/mesh_collider.h).
     const MeshCollider exact(skin);
     float worst = 0.f;
     size_t moved = 0, checked = 0;

@@ -1,11 +1,11 @@
 // Image comparison: the metrics (render/compare.h, flip.h, ssim.h), the
-// per-frame files and tables (pipeline/compare_job.h), `hairpipe compare`,
+// per-frame files and tables (pipeline/compare/compare_job.h), `hairpipe compare`,
 // the compare stage of `hairpipe run`, and the HTML report in headless Chromium
 // (the tables and the report's labels: test_compare_report.cpp).
 #include "core/errors.h"
-#include "pipeline/compare_job.h"
-#include "pipeline/compare_table.h"
-#include "pipeline/path_template.h"
+#include "pipeline/compare/compare_job.h"
+#include "pipeline/compare/compare_table.h"
+#include "pipeline/batch/path_template.h"
 #include "render/colormap.h"
 #include "render/compare.h"
 #include "render/image_io.h"

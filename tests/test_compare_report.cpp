@@ -1,12 +1,12 @@
-// What the compare stage reports: the pass/fail tables (pipeline/compare_table.h)
+// What the compare stage reports: the pass/fail tables (pipeline/compare/compare_table.h)
 // and the labels of the report's sides, taken from the scene
-// (pipeline/compare_job.h, pipeline/compare_report.h). The metrics, files and
+// (pipeline/compare/compare_job.h, pipeline/compare/compare_report.h). The metrics, files and
 // command line are in test_compare.cpp.
 #include "core/errors.h"
-#include "pipeline/compare_job.h"
-#include "pipeline/compare_report.h"
-#include "pipeline/compare_table.h"
-#include "pipeline/scene.h"
+#include "pipeline/compare/compare_job.h"
+#include "pipeline/compare/compare_report.h"
+#include "pipeline/compare/compare_table.h"
+#include "pipeline/scene/scene.h"
 
 #include <gtest/gtest.h>
 

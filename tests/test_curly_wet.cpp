@@ -1,13 +1,13 @@
-// The curly/wet guide solver (sim/curly_wet.h) in Bullet worlds: curls that
+// The curly/wet guide solver (sim/curly/curly_wet.h) in Bullet worlds: curls that
 // survive a bouncing head, dry hair unaffected by the wet machinery, cohesion
 // that clumps wet strands only, adhesion that holds wet hair to the head,
 // stability under fast rotation, and thread-count independence.
 #include "core/errors.h"
-#include "pipeline/curly_settings.h"
-#include "pipeline/scene.h"
-#include "sim/curly_wet.h"
-#include "sim/fibonacci.h"
-#include "sim/head.h"
+#include "pipeline/scene/curly_settings.h"
+#include "pipeline/scene/scene.h"
+#include "sim/curly/curly_wet.h"
+#include "sim/strands/fibonacci.h"
+#include "sim/strands/head.h"
 
 #include "test_support.h"
 
@@ -455,7 +455,7 @@ TEST(CurlyWet, BadInputIsAClearError) {
 }
 
 
-// ---- Scene keys (pipeline/curly_settings.h) ----------------------------------------
+// ---- Scene keys (pipeline/scene/curly_settings.h) ----------------------------------------
 
 TEST(CurlyWetScene, KeysMapOntoTheSettings) {
     const Scene scene = Scene::parse(R"(fps: 25

@@ -1,7 +1,7 @@
-// Follower kernels (sim/follower_kernels.h): Algorithm 1's curves, the
+// Follower kernels (sim/followers/follower_kernels.h): Algorithm 1's curves, the
 // per-segment random values, and the slerp by arc with polynomial sin/cos
 // against double-precision references.
-#include "sim/follower_kernels.h"
+#include "sim/followers/follower_kernels.h"
 
 #include <gtest/gtest.h>
 

@@ -1,14 +1,14 @@
-// Follower neighbour selection (sim/follower_neighbours.h, sim/followers.h):
+// Follower neighbour selection (sim/followers/follower_neighbours.h, sim/followers/followers.h):
 // the grid search against brute force, the two nearest guide roots in order,
 // and the shape-similarity rule; and the scene keys that choose them
-// (pipeline/follower_settings.h).
+// (pipeline/scene/follower_settings.h).
 #include "core/errors.h"
 #include "follower_support.h"
-#include "pipeline/follower_settings.h"
-#include "pipeline/scene.h"
-#include "sim/follower_neighbours.h"
-#include "sim/followers.h"
-#include "sim/synthetic_groom.h"
+#include "pipeline/scene/follower_settings.h"
+#include "pipeline/scene/scene.h"
+#include "sim/followers/follower_neighbours.h"
+#include "sim/followers/followers.h"
+#include "sim/strands/synthetic_groom.h"
 
 #include <gtest/gtest.h>
 

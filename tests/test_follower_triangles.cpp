@@ -1,9 +1,9 @@
 // Barycentric followers (FollowerMode::Barycentric): the guide-root
-// triangulation (sim/follower_triangles.h) and the three-guide blend.
-#include "sim/follower_metrics.h"
-#include "sim/follower_triangles.h"
-#include "sim/followers.h"
-#include "sim/synthetic_groom.h"
+// triangulation (sim/followers/follower_triangles.h) and the three-guide blend.
+#include "sim/followers/follower_metrics.h"
+#include "sim/followers/follower_triangles.h"
+#include "sim/followers/followers.h"
+#include "sim/strands/synthetic_groom.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>

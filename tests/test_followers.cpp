@@ -1,12 +1,12 @@
-// Follower strands (sim/followers.h): the three modes against shapes
+// Follower strands (sim/followers/followers.h): the three modes against shapes
 // computed independently (neighbour selection: test_follower_neighbours.cpp), thread and lane independence,
 // lengths, velocities and head collision (kernels: test_follower_kernels.cpp).
 #include "core/errors.h"
 #include "follower_support.h"
-#include "sim/follower_kernels.h"
-#include "sim/follower_neighbours.h"
-#include "sim/followers.h"
-#include "sim/synthetic_groom.h"
+#include "sim/followers/follower_kernels.h"
+#include "sim/followers/follower_neighbours.h"
+#include "sim/followers/followers.h"
+#include "sim/strands/synthetic_groom.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>

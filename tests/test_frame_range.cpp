@@ -1,6 +1,6 @@
 #include "core/errors.h"
-#include "pipeline/frame_range.h"
-#include "pipeline/path_template.h"
+#include "pipeline/batch/frame_range.h"
+#include "pipeline/batch/path_template.h"
 
 #include <gtest/gtest.h>
 

@@ -1,13 +1,13 @@
 // Grooms: the default scalp, units declared by the file, settled procedural
 // grooms and the user's own groom imported from OBJ, .hair and .usda.
-#include "pipeline/groom_file.h"
-#include "pipeline/groom_import.h"
-#include "pipeline/head_import.h"
-#include "pipeline/scene.h"
-#include "pipeline/shot_simulation.h"
-#include "pipeline/strand_cache.h"
-#include "pipeline/usd_export.h"
-#include "sim/mesh_query.h"
+#include "pipeline/groom/groom_file.h"
+#include "pipeline/groom/groom_import.h"
+#include "pipeline/head/head_import.h"
+#include "pipeline/scene/scene.h"
+#include "pipeline/stages/shot_simulation.h"
+#include "pipeline/batch/strand_cache.h"
+#include "pipeline/stages/usd_export.h"
+#include "sim/collision/mesh_query.h"
 #include "test_support.h"
 
 #include <assimp/Exporter.hpp>
@@ -124,7 +124,7 @@ TEST(DefaultScalp, ProjectHeadUsesItsScalpMaterialAndNoFaceOrNeck) {
     const HeadSetup head = loadHead(s);
     ASSERT_EQ(head.scalpUsed.method, ScalpMethod::Material);
     ASSERT_EQ(head.scalpUsed.materials, std::vector<std::string>{"scalp"});
-    // Face and neck measured from the mesh: the skull (pipeline/default_head.cpp)
+    // Face and neck measured from the mesh: the skull (pipeline/head/default_head.cpp)
     // ends 0.077 m below the origin, and the neck goes on below it to the base.
     const Eigen::AlignedBox3f box = head.rest.bounds();
     const float top = box.max().y(), height = box.sizes().y();

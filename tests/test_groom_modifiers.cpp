@@ -1,13 +1,13 @@
-// Groom modifiers (sim/groom_modifiers.h), the neighbour-angle figure
-// (sim/follower_metrics.h) and the followers' statistics: length error and
-// penetration when the head pushes a follower (sim/followers.h).
+// Groom modifiers (sim/strands/groom_modifiers.h), the neighbour-angle figure
+// (sim/followers/follower_metrics.h) and the followers' statistics: length error and
+// penetration when the head pushes a follower (sim/followers/followers.h).
 #include "core/errors.h"
-#include "pipeline/follower_settings.h"
-#include "pipeline/shot_simulation.h"
-#include "sim/follower_metrics.h"
-#include "sim/followers.h"
-#include "sim/groom_modifiers.h"
-#include "sim/synthetic_groom.h"
+#include "pipeline/scene/follower_settings.h"
+#include "pipeline/stages/shot_simulation.h"
+#include "sim/followers/follower_metrics.h"
+#include "sim/followers/followers.h"
+#include "sim/strands/groom_modifiers.h"
+#include "sim/strands/synthetic_groom.h"
 
 #include <gtest/gtest.h>
 

@@ -1,11 +1,11 @@
-// The guide solver (sim/guides.h) in both formulations, and the scene mapping
-// (pipeline/sim_settings.h). Falling chains are chaotic, so the tests assert
+// The guide solver (sim/guides/guides.h) in both formulations, and the scene mapping
+// (pipeline/scene/sim_settings.h). Falling chains are chaotic, so the tests assert
 // stable quantities — lengths, limits, clearance, energy — not trajectories.
 #include "core/errors.h"
-#include "pipeline/scene.h"
-#include "pipeline/sim_settings.h"
-#include "sim/fibonacci.h"
-#include "sim/guides.h"
+#include "pipeline/scene/scene.h"
+#include "pipeline/scene/sim_settings.h"
+#include "sim/strands/fibonacci.h"
+#include "sim/guides/guides.h"
 
 #include <gtest/gtest.h>
 

@@ -1,12 +1,12 @@
-// Head import through assimp and its animation (pipeline/head_import.h,
-// pipeline/head_rig.h, pipeline/animated_head.h) on the shared third-party
+// Head import through assimp and its animation (pipeline/head/head_import.h,
+// pipeline/head/head_rig.h, pipeline/head/animated_head.h) on the shared third-party
 // assets and the project's default head.
-#include "pipeline/animated_head.h"
-#include "pipeline/default_head.h"
-#include "pipeline/head_import.h"
+#include "pipeline/head/animated_head.h"
+#include "pipeline/head/default_head.h"
+#include "pipeline/head/head_import.h"
 #include "render/image_io.h"
-#include "sim/mesh_query.h"
-#include "sim/roots.h"
+#include "sim/collision/mesh_query.h"
+#include "sim/strands/roots.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>

@@ -1,11 +1,11 @@
-// The head as a scene sets it up (pipeline/head_setup.h, pipeline/scalp.h,
-// pipeline/head_source.h): scalp selection, groom roots, scene errors, the
+// The head as a scene sets it up (pipeline/head/head_setup.h, pipeline/head/scalp.h,
+// pipeline/stages/head_source.h): scalp selection, groom roots, scene errors, the
 // frame source, `hairpipe info`, and the committed default head asset.
-#include "pipeline/default_head.h"
-#include "pipeline/head_setup.h"
-#include "pipeline/head_source.h"
+#include "pipeline/head/default_head.h"
+#include "pipeline/head/head_setup.h"
+#include "pipeline/stages/head_source.h"
 #include "render/image_io.h"
-#include "sim/mesh_collider.h"
+#include "sim/collision/mesh_collider.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>

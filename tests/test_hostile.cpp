@@ -5,8 +5,8 @@
 // Under the sanitizer build a memory error exits 86, so "exit 1" also means
 // "no crash".
 #include "core/errors.h"
-#include "pipeline/scene.h"
-#include "pipeline/strand_cache.h"
+#include "pipeline/scene/scene.h"
+#include "pipeline/batch/strand_cache.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 #include "core/errors.h"
-#include "pipeline/output.h"
-#include "pipeline/shot.h"
+#include "pipeline/batch/output.h"
+#include "pipeline/stages/shot.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>

@@ -10,7 +10,7 @@
 #include "core/errors.h"
 #include "render/gl_context.h"
 #include "render/preview.h"
-#include "sim/synthetic.h"
+#include "sim/strands/synthetic.h"
 
 #include <cmath>
 #include <cstdlib>

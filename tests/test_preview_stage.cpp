@@ -2,12 +2,12 @@
 // and errors, and `hairpipe view` in a scripted run under Xvfb.
 #include "test_support.h"
 
-#include "pipeline/preview_settings.h"
-#include "pipeline/scene.h"
-#include "pipeline/stages.h"
+#include "pipeline/scene/preview_settings.h"
+#include "pipeline/scene/scene.h"
+#include "pipeline/stages/stages.h"
 #include "render/gl_context.h"
 #include "render/image_io.h"
-#include "sim/synthetic.h"
+#include "sim/strands/synthetic.h"
 
 #include <chrono>
 #include <csignal>

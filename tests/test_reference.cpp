@@ -6,11 +6,11 @@
 #include "test_support.h"
 
 #include "core/errors.h"
-#include "pipeline/scene.h"
-#include "pipeline/stages.h"
+#include "pipeline/scene/scene.h"
+#include "pipeline/stages/stages.h"
 #include "render/embree_scene.h"
 #include "render/reference.h"
-#include "sim/synthetic.h"
+#include "sim/strands/synthetic.h"
 
 #include <tbb/task_arena.h>
 

@@ -12,7 +12,7 @@
 #include "render/gl_context.h"
 #include "render/preview.h"
 #include "render/reference.h"
-#include "sim/synthetic.h"
+#include "sim/strands/synthetic.h"
 
 #include <cstdlib>
 #include <iostream>

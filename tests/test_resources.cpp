@@ -2,8 +2,8 @@
 // frame. The shot is run in-process one frame at a time through the real
 // scheduler (runFrames) with the simulation + strand-cache and VDB stages, and
 // the resident set is sampled from /proc/self/statm.
-#include "pipeline/scene.h"
-#include "pipeline/shot.h"
+#include "pipeline/scene/scene.h"
+#include "pipeline/stages/shot.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>

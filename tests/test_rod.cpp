@@ -1,4 +1,4 @@
-// The rod formulation (sim/rod_kernels.h, sim/rod_group.cpp) against the
+// The rod formulation (sim/guides/rod_kernels.h, sim/guides/rod_group.cpp) against the
 // references tests/rod_cases.h computes: heavy elastica by shooting, the
 // hanging chain's Bessel mode, energy balance; pre-load and sag.
 #include "rod_cases.h"

@@ -1,8 +1,8 @@
-// Hair root placement on a scalp (sim/roots.h).
+// Hair root placement on a scalp (sim/strands/roots.h).
 #include "core/errors.h"
-#include "sim/fibonacci.h"
-#include "sim/mesh_query.h"
-#include "sim/roots.h"
+#include "sim/strands/fibonacci.h"
+#include "sim/collision/mesh_query.h"
+#include "sim/strands/roots.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>

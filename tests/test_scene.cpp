@@ -1,5 +1,5 @@
-#include "pipeline/scene.h"
-#include "pipeline/schema.h"
+#include "pipeline/scene/scene.h"
+#include "pipeline/scene/schema.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -159,7 +159,7 @@ TEST(Schema, ReferencePageIsUpToDate) {
         << "docs/scene-reference.md is stale: regenerate it with 'hairpipe help scene > docs/scene-reference.md'";
 }
 
-#include "pipeline/view_settings.h"
+#include "pipeline/scene/view_settings.h"
 #include "render/hair_bsdf.h"
 
 TEST(SceneLists, DefaultListAndItemDefaults) {

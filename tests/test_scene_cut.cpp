@@ -1,13 +1,13 @@
-// Scene cuts (sim/scene_cut.h): a step whose head or root jump exceeds
+// Scene cuts (sim/solver/scene_cut.h): a step whose head or root jump exceeds
 // simulation.cut_distance / cut_angle restarts every guide in its rest shape
 // on the new pose, placed outside every collider before the frame is
 // written; `hairpipe info` lists the cuts of a clip.
 #include "batch_support.h"
-#include "pipeline/scene.h"
-#include "pipeline/shot_simulation.h"
-#include "sim/fibonacci.h"
-#include "sim/guides.h"
-#include "sim/scene_cut.h"
+#include "pipeline/scene/scene.h"
+#include "pipeline/stages/shot_simulation.h"
+#include "sim/strands/fibonacci.h"
+#include "sim/guides/guides.h"
+#include "sim/solver/scene_cut.h"
 
 #include <gtest/gtest.h>
 

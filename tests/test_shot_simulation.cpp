@@ -1,8 +1,8 @@
 // The whole sequential part of a shot on the project's animated head: the
 // head clip drives the guide solver, followers are rebuilt every frame.
-#include "pipeline/scene.h"
-#include "pipeline/shot_simulation.h"
-#include "sim/mesh_collider.h"
+#include "pipeline/scene/scene.h"
+#include "pipeline/stages/shot_simulation.h"
+#include "sim/collision/mesh_collider.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>

@@ -2,10 +2,10 @@
 // finite and energy-bounded without help; the velocity clamp holds speeds to
 // GuideSettings::maxSpeed; a non-finite value is reported with the guide it
 // appeared in (ShotSimulation turns that into a FrameError naming the frame).
-#include "pipeline/scene.h"
-#include "pipeline/sim_settings.h"
-#include "sim/fibonacci.h"
-#include "sim/guides.h"
+#include "pipeline/scene/scene.h"
+#include "pipeline/scene/sim_settings.h"
+#include "sim/strands/fibonacci.h"
+#include "sim/guides/guides.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 #include "core/errors.h"
-#include "sim/head.h"
-#include "sim/strand.h"
+#include "sim/strands/head.h"
+#include "sim/strands/strand.h"
 
 #include <gtest/gtest.h>
 
@@ -79,7 +79,7 @@ TEST(Head, SpinningSphereTurnsAtItsRate) {
     EXPECT_LT(p0.collider->signedDistance(Vec3f(0, 0.05f, 0)), 0.f);
 }
 
-#include "sim/fibonacci.h"
+#include "sim/strands/fibonacci.h"
 
 TEST(Fibonacci, CapHoldsExactlyCountPointsInside) {
     for (size_t n : {1u, 94u, 845u, 10000u}) {
@@ -112,7 +112,7 @@ TEST(Fibonacci, CapAroundAnotherAxis) {
     for (const Vec3f& p : pts) EXPECT_GE(p.z(), 0.5f - 1e-5f);
 }
 
-#include "sim/synthetic.h"
+#include "sim/strands/synthetic.h"
 
 TEST(SyntheticHair, StrandsHaveTheRequestedShape) {
     SyntheticHairSettings s;

@@ -1,7 +1,7 @@
 #include "core/errors.h"
-#include "pipeline/strand_cache.h"
-#include "pipeline/usd_export.h"
-#include "sim/synthetic.h"
+#include "pipeline/batch/strand_cache.h"
+#include "pipeline/stages/usd_export.h"
+#include "sim/strands/synthetic.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>

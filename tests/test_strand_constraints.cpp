@@ -1,5 +1,5 @@
-// The guide solver's kernels (sim/strand_constraints.h), without a physics world.
-#include "sim/strand_constraints.h"
+// The guide solver's kernels (sim/guides/strand_constraints.h), without a physics world.
+#include "sim/guides/strand_constraints.h"
 
 #include <gtest/gtest.h>
 

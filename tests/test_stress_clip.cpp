@@ -11,8 +11,8 @@
 // 1.74 mm inside (the guides stay outside), so that check is its own
 // DISABLED test; run it with
 //   build/tests/test_stress_clip --gtest_also_run_disabled_tests
-#include "pipeline/scene.h"
-#include "pipeline/shot_simulation.h"
+#include "pipeline/scene/scene.h"
+#include "pipeline/stages/shot_simulation.h"
 #include "test_support.h"
 
 #include <tbb/global_control.h>

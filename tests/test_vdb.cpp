@@ -1,13 +1,13 @@
 // OpenVDB export: round trips through openvdb::io::File (grid names, class,
 // transform, metadata, values), deterministic bytes, empty frames, and the
 // "vdb" stage and command (atomic writes, failed frames, exit codes).
-#include "pipeline/output.h"
-#include "pipeline/scene.h"
-#include "pipeline/shot.h"
-#include "pipeline/stages.h"
+#include "pipeline/batch/output.h"
+#include "pipeline/scene/scene.h"
+#include "pipeline/stages/shot.h"
+#include "pipeline/stages/stages.h"
 #include "render/vdb_writer.h"
 #include "render/voxelizer.h"
-#include "sim/synthetic.h"
+#include "sim/strands/synthetic.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>

@@ -3,7 +3,7 @@
 // thread-count invariance and error messages.
 #include "core/errors.h"
 #include "render/voxelizer.h"
-#include "sim/synthetic.h"
+#include "sim/strands/synthetic.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>

@@ -1,9 +1,9 @@
-// Pure kernels of the curly/wet strand model (sim/curly_kernels.h,
-// sim/wet_forces.h, sim/curly_dynamics.h): each checked against its equation,
+// Pure kernels of the curly/wet strand model (sim/curly/curly_kernels.h,
+// sim/curly/wet_forces.h, sim/curly/curly_dynamics.h): each checked against its equation,
 // a closed form or a brute-force reference, without a physics world.
-#include "sim/curly_dynamics.h"
-#include "sim/curly_kernels.h"
-#include "sim/wet_forces.h"
+#include "sim/curly/curly_dynamics.h"
+#include "sim/curly/curly_kernels.h"
+#include "sim/curly/wet_forces.h"
 
 #include <gtest/gtest.h>
 

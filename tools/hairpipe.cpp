@@ -2,7 +2,7 @@
 // this file only maps errors to exit codes (0 ok, 1 usage/scene/asset error,
 // 2 some frame failed).
 #include "core/log.h"
-#include "pipeline/cli.h"
+#include "pipeline/cli/cli.h"
 
 #include <exception>
 #include <string>

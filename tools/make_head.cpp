@@ -1,4 +1,4 @@
-// make_head: writes the project's default animated head (pipeline/default_head.h)
+// make_head: writes the project's default animated head (pipeline/head/default_head.h)
 // as a binary glTF through assimp's exporter. scenes/assets/head.glb is its
 // output with the default options; tests check the committed file still
 // matches.
@@ -7,9 +7,9 @@
 //   make_head OUT.glb --sphere RADIUS    a static UV sphere, the seed's and
 //                                        the benchmarks' head (scenes/assets/sphere.glb)
 #include "core/errors.h"
-#include "pipeline/default_head.h"
-#include "pipeline/output.h"
-#include "sim/head.h"
+#include "pipeline/head/default_head.h"
+#include "pipeline/batch/output.h"
+#include "sim/strands/head.h"
 
 #include <assimp/Exporter.hpp>
 #include <assimp/material.h>

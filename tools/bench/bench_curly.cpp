@@ -12,9 +12,9 @@
 //   bench_curly                      the full matrix (94 and 845 guides, all
 //                                    modes, 1 and 2 threads)
 //   bench_curly --guides 94 --mode cohesion --threads 2 --runs 1
-#include "sim/curly_wet.h"
-#include "sim/fibonacci.h"
-#include "sim/head.h"
+#include "sim/curly/curly_wet.h"
+#include "sim/strands/fibonacci.h"
+#include "sim/strands/head.h"
 
 #include <tbb/global_control.h>
 

@@ -5,7 +5,7 @@
 //
 // Guides: docs/benchmarks.md asks for the 845 guides of B-sim after its 250 steps.
 // The guide solver is not on this branch, so a GuideSource drives them with
-// sim/synthetic_groom.h's deterministic motion (drooping, swaying guides on the
+// sim/strands/synthetic_groom.h's deterministic motion (drooping, swaying guides on the
 // sphere r = 0.1 m spinning 90°/s about +Y) from t = (20 + 250) × 0.02 s on.
 // To time against real guides, replace makeSyntheticSource by a source that
 // steps the solver (or reads its frames) — only GuideSource::next changes.
@@ -15,13 +15,13 @@
 //        [--angle] [--length-variation X] [--clump X] [--clumps N]
 //        [--wave M] [--wave-length M] [--curl X] [--frizz M]
 // --angle adds a column: the median angle between mid-strand tangents of
-// root-neighbouring followers (sim/follower_metrics.h) after the last step;
-// the modifier options apply sim/groom_modifiers.h to the groom first.
+// root-neighbouring followers (sim/followers/follower_metrics.h) after the last step;
+// the modifier options apply sim/strands/groom_modifiers.h to the groom first.
 #include "core/errors.h"
-#include "sim/follower_metrics.h"
-#include "sim/followers.h"
-#include "sim/groom_modifiers.h"
-#include "sim/synthetic_groom.h"
+#include "sim/followers/follower_metrics.h"
+#include "sim/followers/followers.h"
+#include "sim/strands/groom_modifiers.h"
+#include "sim/strands/synthetic_groom.h"
 
 #include <tbb/task_arena.h>
 

@@ -7,11 +7,11 @@
 //  3. Root placement: guides and 10k / 100k / 400k followers, both methods.
 //  4. The default scene's head for a shot: load, grid, 24 frames, groom roots.
 // Usage: bench_head [--quick]   (run from the repository root for part 4)
-#include "pipeline/animated_head.h"
-#include "pipeline/default_head.h"
-#include "pipeline/head_setup.h"
-#include "pipeline/scalp.h"
-#include "sim/roots.h"
+#include "pipeline/head/animated_head.h"
+#include "pipeline/head/default_head.h"
+#include "pipeline/head/head_setup.h"
+#include "pipeline/head/scalp.h"
+#include "sim/strands/roots.h"
 
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>

@@ -13,8 +13,8 @@
 //                   [--repeat 1] [--threads 2] [--out DIR] [--no-head] [--no-shadows]
 //                   [--melanin 1.3] [--shadow-roulette 0.03125 (0: off)] [--seed 1]
 #include "render/reference.h"
-#include "sim/head.h"
-#include "sim/synthetic.h"
+#include "sim/strands/head.h"
+#include "sim/strands/synthetic.h"
 
 #include <tbb/global_control.h>
 

@@ -13,8 +13,8 @@
 //             [--threads 1,2] [--runs 3] [--warmup 20] [--steps 250]
 //             [--substeps 1] [--iterations 20] [--rod-substeps 2] [--per-world 16] [--rate 90]
 //             [--preload on|off]
-#include "sim/fibonacci.h"
-#include "sim/guides.h"
+#include "sim/strands/fibonacci.h"
+#include "sim/guides/guides.h"
 
 #include <algorithm>
 #include <chrono>

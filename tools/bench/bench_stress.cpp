@@ -14,16 +14,16 @@
 // --colliders: B-sim head-only (docs/benchmarks.md: sphere r = 0.1 m spinning
 // 90°/s, 0.25 m guides of 24 vertices, 20 warm-up + 250 timed steps) with
 // the head as the exact analytic sphere, as a distance grid (the head's fast
-// path, sim/level_set.h) and as a btSphereShape queried through the Bullet
-// collision world (sim/collision_world.h), in one run.
+// path, sim/collision/level_set.h) and as a btSphereShape queried through the Bullet
+// collision world (sim/collision/collision_world.h), in one run.
 //
 //   bench_stress --colliders [--guides 94,845] [--threads 2]
-#include "pipeline/scene.h"
-#include "pipeline/shot_simulation.h"
-#include "sim/collision_world.h"
-#include "sim/fibonacci.h"
-#include "sim/guides.h"
-#include "sim/mesh_collider.h"
+#include "pipeline/scene/scene.h"
+#include "pipeline/stages/shot_simulation.h"
+#include "sim/collision/collision_world.h"
+#include "sim/strands/fibonacci.h"
+#include "sim/guides/guides.h"
+#include "sim/collision/mesh_collider.h"
 
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>

@@ -2,7 +2,7 @@
 // one VDB frame, at 1 mm and 0.5 mm voxels, on 2 threads and 1.
 //
 // Until the simulation is integrated, the strands come from
-// makeSyntheticHair (sim/synthetic.h): 100,000 strands × 24 vertices on the
+// makeSyntheticHair (sim/strands/synthetic.h): 100,000 strands × 24 vertices on the
 // r = 0.1 m sphere's upper hemisphere, 0.25 m long, root radius 0.04 mm
 // tapering to 0.01 mm — the B-render geometry without simulated shapes.
 //
@@ -19,7 +19,7 @@
 //                                  the whole-sequence time, and files to check in a DCC)
 #include "render/vdb_writer.h"
 #include "render/voxelizer.h"
-#include "sim/synthetic.h"
+#include "sim/strands/synthetic.h"
 
 #include <Eigen/Geometry>
 #include <tbb/global_control.h>

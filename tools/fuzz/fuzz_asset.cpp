@@ -1,4 +1,4 @@
-// libFuzzer target: head import through assimp (pipeline/head_import.h) and
+// libFuzzer target: head import through assimp (pipeline/head/head_import.h) and
 // posing the imported rig. The bytes are written to a file whose extension
 // follows the content (glTF binary magic -> .glb, '{' -> .gltf, "solid" ->
 // .stl, '<' -> .dae, else .obj), because importHead reads files, like the
@@ -8,7 +8,7 @@
 #include "tools/fuzz/fuzz_target.h"
 
 #include "core/errors.h"
-#include "pipeline/head_import.h"
+#include "pipeline/head/head_import.h"
 
 #include <unistd.h>
 

@@ -1,10 +1,10 @@
-// libFuzzer target: the --frames / <stage>.frames grammar (pipeline/frame_range.h).
+// libFuzzer target: the --frames / <stage>.frames grammar (pipeline/batch/frame_range.h).
 // Any input must either parse into a sorted unique list that formats and
 // re-parses to itself, or throw UsageError; anything else is a bug.
 #include "tools/fuzz/fuzz_target.h"
 
 #include "core/errors.h"
-#include "pipeline/frame_range.h"
+#include "pipeline/batch/frame_range.h"
 
 #include <string>
 #include <vector>

@@ -1,4 +1,4 @@
-// libFuzzer target: the .hair groom reader (pipeline/groom_file.h,
+// libFuzzer target: the .hair groom reader (pipeline/groom/groom_file.h,
 // parseHairFile + checkCurves). Any bytes must decode into curves whose
 // offsets index their points, or throw AssetError; a declared count the
 // bytes cannot hold must be refused before anything is allocated for it
@@ -6,7 +6,7 @@
 #include "tools/fuzz/fuzz_target.h"
 
 #include "core/errors.h"
-#include "pipeline/groom_file.h"
+#include "pipeline/groom/groom_file.h"
 
 #include <vector>
 

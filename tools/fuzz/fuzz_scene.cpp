@@ -1,5 +1,5 @@
 // libFuzzer target: scene YAML through the schema walk and the load-time
-// budget checks Scene::parse runs (pipeline/scene.h, pipeline/scene_budget.h). Every input must
+// budget checks Scene::parse runs (pipeline/scene/scene.h, pipeline/scene/scene_budget.h). Every input must
 // load or throw one of hairpipe's errors (SceneError/AssetError): a crash, a
 // sanitizer report or another exception type (a YAML::Exception leaking out)
 // is a bug. The scene's folder does not exist, so File keys fail cleanly
@@ -7,7 +7,7 @@
 #include "tools/fuzz/fuzz_target.h"
 
 #include "core/errors.h"
-#include "pipeline/scene.h"
+#include "pipeline/scene/scene.h"
 
 #include <string>
 

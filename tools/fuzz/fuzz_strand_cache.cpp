@@ -1,4 +1,4 @@
-// libFuzzer target: the strand-cache reader (pipeline/strand_cache.h). Any
+// libFuzzer target: the strand-cache reader (pipeline/batch/strand_cache.h). Any
 // bytes must decode into a frame that passes StrandFrame::validate() or throw
 // AssetError.
 //
@@ -10,7 +10,7 @@
 #include "tools/fuzz/fuzz_target.h"
 
 #include "core/errors.h"
-#include "pipeline/strand_cache.h"
+#include "pipeline/batch/strand_cache.h"
 
 #include <zlib.h>
 

@@ -1,0 +1,99 @@
+// The imported head as the simulation sees it: a HeadMotion that poses the
+// rig at any shot time and hands out the deformed mesh, the head's rigid
+// motion and a collider.
+#pragma once
+
+#include "pipeline/head/head_rig.h"
+#include "sim/collision/collision_world.h"
+#include "sim/collision/level_set.h"
+#include "sim/collision/mesh_collider.h"
+
+#include <functional>
+#include <memory>
+#include <mutex>
+
+namespace hp {
+
+/// How HeadPose::collider is made per frame.
+enum class ColliderMethod {
+    Rigid,     ///< the rest pose's distance grid moved by the rigid transform (built once, ~100 ns a query)
+    PerFrame,  ///< a distance grid of each frame's deformed mesh (exact for skinned necks, costs a build per frame)
+    Exact,     ///< closest-triangle queries on the deformed mesh (~1 µs a query, a BVH built per frame)
+    None,      ///< no collider
+};
+
+class AnimatedHead;
+
+/// One collider beside the head (scene key head.colliders[]): a Bullet
+/// shape placed at each time by `place` (local -> world, or local -> the
+/// head's rest frame when it follows the head's rigid motion).
+struct ExtraCollider {
+    ColliderShape shape;
+    bool followsHead = false;
+    std::function<Eigen::Isometry3f(double)> place;
+    /// Skinned mesh: its own file's animation, sampled at the shot time
+    /// for the vertices of each pose (shape.kind SkinnedMesh).
+    std::shared_ptr<const AnimatedHead> skin;
+};
+
+struct HeadAnimationSettings {
+    int clip = -1;            ///< index in HeadRig::clips; -1: the rest pose (a static head)
+    double clipOffset = 0.0;  ///< clip time = shot time · clipSpeed + clipOffset
+    double clipSpeed = 1.0;
+    bool loop = false;        ///< wrap the clip time into [0, duration) instead of holding the last pose
+    double restTime = 0.0;    ///< shot time of the pose the hair is grown on
+    /// Extra rigid motion at a shot time (the scene's head.animate keys),
+    /// applied after the rig; empty: none.
+    std::function<Eigen::Isometry3f(double)> motion;
+    ColliderMethod collider = ColliderMethod::Rigid;
+    LevelSetSettings levelSet;
+    /// Colliders beside the head; the pose's collider joins them to the
+    /// head's (CompositeCollider). Empty: the head's collider alone.
+    std::vector<ExtraCollider> colliders;
+};
+
+/// @brief A posed, animated head. sample() is thread-safe and deterministic.
+class AnimatedHead final : public HeadMotion {
+  public:
+    AnimatedHead(std::shared_ptr<const HeadRig> rig, HeadAnimationSettings settings);
+
+    /// The head at shot time `time` (seconds): deformed world mesh (rest
+    /// topology), rigid transform rest -> now (least-squares fit of the fit
+    /// vertices, exact for rigid and node animation), collider.
+    HeadPose sample(double time) const override;
+
+    /// The rest pose (roots are placed on it; its topology is every pose's).
+    const TriangleMesh& rest() const { return rest_; }
+    const HeadRig& rig() const { return *rig_; }
+    const HeadAnimationSettings& settings() const { return settings_; }
+    /// Clip time (seconds) at a shot time.
+    double clipTime(double time) const;
+
+    /// Fits the rigid transform to the vertices of these triangles (the
+    /// scalp) only; default: all vertices. Call before sampling.
+    void setFitTriangles(const std::vector<uint8_t>& mask);
+
+    /// The rest pose's distance grid and exact collider (built on first use).
+    std::shared_ptr<const LevelSet> restLevelSet() const;
+    std::shared_ptr<const MeshCollider> restCollider() const;
+
+  private:
+    TriangleMesh posed(double time) const;
+
+    std::shared_ptr<const HeadRig> rig_;
+    HeadAnimationSettings settings_;
+    TriangleMesh rest_;
+    std::vector<uint32_t> weld_;       ///< rest-pose vertex weld, shared by per-frame colliders
+    std::vector<uint32_t> fitVertices_;
+    mutable std::once_flag gridOnce_;
+    mutable std::shared_ptr<const LevelSet> grid_;
+    mutable std::shared_ptr<const MeshCollider> restExact_;
+    std::shared_ptr<const CollisionWorld> world_;  ///< settings_.colliders in Bullet; null when none
+};
+
+/// @brief Least-squares rigid transform (Kabsch / Umeyama without scale)
+/// taking `from[i]` to `to[i]` for the listed indices (all when empty).
+Eigen::Isometry3f fitRigidTransform(const std::vector<Vec3f>& from, const std::vector<Vec3f>& to,
+                                    const std::vector<uint32_t>& indices = {});
+
+}  // namespace hp

@@ -1,0 +1,41 @@
+#include "pipeline/head/clip_cuts.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hp {
+
+std::vector<ClipCut> findClipCuts(const Scene& scene, const HeadSetup& head, double startTime, double endTime,
+                                  double step) {
+    // Only the mesh and the rigid fit are needed: no collider is built.
+    HeadAnimationSettings settings = head.motion->settings();
+    settings.collider = ColliderMethod::None;
+    AnimatedHead motion(head.rig, settings);
+    motion.setFitTriangles(head.scalp);
+    std::vector<uint32_t> scalpVertices;
+    {
+        std::vector<uint8_t> used(head.rest.positions.size(), 0);
+        for (size_t t = 0; t < head.scalp.size(); ++t)
+            if (head.scalp[t])
+                for (uint32_t v : head.rest.triangles[t]) used[v] = 1;
+        for (uint32_t v = 0; v < used.size(); ++v)
+            if (used[v]) scalpVertices.push_back(v);
+    }
+    const float maxDistance = float(scene.number("simulation.cut_distance"));
+    const float maxAngle = float(scene.number("simulation.cut_angle"));
+    std::vector<ClipCut> cuts;
+    HeadPose previous = motion.sample(startTime);
+    const long steps = std::lround((endTime - startTime) / step);
+    for (long k = 1; k <= steps; ++k) {
+        HeadPose pose = motion.sample(startTime + double(k) * step);
+        float rootMove = 0.f;
+        for (uint32_t v : scalpVertices)
+            rootMove = std::max(rootMove, (pose.mesh.positions[v] - previous.mesh.positions[v]).norm());
+        const StepJump jump = stepJump(previous.transform, pose.transform, rootMove);
+        if (isCut(jump, maxDistance, maxAngle)) cuts.push_back({pose.time, jump});
+        previous = std::move(pose);
+    }
+    return cuts;
+}
+
+}  // namespace hp

@@ -1,0 +1,28 @@
+// The scene cuts of a shot's clip, found without simulating: the same test
+// the guide solver applies at each step (sim/solver/scene_cut.h), on the head's
+// rigid motion and its scalp vertices. `hairpipe info` lists them.
+#pragma once
+
+#include "pipeline/head/head_setup.h"
+#include "pipeline/scene/scene.h"
+#include "sim/solver/scene_cut.h"
+
+#include <vector>
+
+namespace hp {
+
+/// @brief One step of the shot that is a scene cut.
+struct ClipCut {
+    double time = 0.0;  ///< shot time at the end of the step (the first time of the new shot), s
+    StepJump jump;      ///< what moved over the step
+};
+
+/// @brief Steps the shot's head from `startTime` to `endTime` at `step`
+/// seconds (the simulation's frame-aligned step) and returns every step
+/// whose jump exceeds simulation.cut_distance / cut_angle. The root move is
+/// measured on the scalp's vertices (a root moves no farther than the
+/// corners of its triangle).
+std::vector<ClipCut> findClipCuts(const Scene& scene, const HeadSetup& head, double startTime, double endTime,
+                                  double step);
+
+}  // namespace hp

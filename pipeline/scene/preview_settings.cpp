@@ -1,0 +1,77 @@
+#include "pipeline/scene/preview_settings.h"
+
+namespace hp {
+
+PreviewSettings makePreviewSettings(const Scene& s) {
+    PreviewSettings p;
+    p.msaa = int(s.integer("preview.msaa"));
+    p.supersample = int(s.integer("preview.supersample"));
+    p.shadePerFragment = s.text("preview.shading") == "fragment";
+    p.minPixelWidth = float(s.number("preview.min_pixel_width"));
+    p.blend = s.text("preview.transparency") == "weighted" ? HairBlend::Weighted : HairBlend::Sorted;
+    p.blendDepthScale = float(s.number("preview.blend_depth_scale"));
+    p.drawHead = s.flag("preview.head");
+    p.curve = s.text("preview.tessellation.curve") == "b-spline" ? CurveType::BSpline : CurveType::CatmullRom;
+    p.tessellationLevel = int(s.integer("preview.tessellation.level"));
+    p.tessellationPixels = float(s.number("preview.tessellation.pixels"));
+
+    PreviewShadowSettings& sh = p.shadow;
+    sh.light = int(s.integer("preview.shadow.light"));
+    const size_t lights = s.count("render.lights");
+    if (sh.light >= 0 && size_t(sh.light) >= lights)
+        s.fail("preview.shadow.light",
+               cat("names light ", sh.light, " but render.lights has ", lights, " (use -1 for no shadows)"));
+    sh.voxels = s.flag("preview.shadow.voxels");
+    sh.mode = s.text("preview.shadow.voxel_mode") == "binary" ? VoxelMode::Binary : VoxelMode::Additive;
+    sh.splat = s.text("preview.shadow.splat") == "trilinear" ? VoxelSplat::Trilinear : VoxelSplat::Nearest;
+    if (sh.mode == VoxelMode::Binary && sh.splat == VoxelSplat::Trilinear)
+        s.fail("preview.shadow.splat",
+               "trilinear splatting spreads fractions of a fragment, which only adds up with voxel_mode: additive "
+               "(seed 004 compares nearest/binary, nearest/additive and trilinear/additive)");
+    sh.sumAlongLight = s.flag("preview.shadow.sum");
+    sh.resolution = int(s.integer("preview.shadow.resolution"));
+    sh.filter = s.flag("preview.shadow.filter");
+    sh.weight = s.text("preview.shadow.weight") == "fragments" ? VoxelWeight::Fragments : VoxelWeight::Crossings;
+    sh.alpha = float(s.number("preview.shadow.alpha"));
+    sh.shadowMap = s.flag("preview.shadow.map");
+    sh.shadowMapSize = int(s.integer("preview.shadow.map_size"));
+    sh.pcfRadius = int(s.integer("preview.shadow.pcf_radius"));
+
+    GeneratedHairSettings& g = p.generated;
+    g.enabled = s.flag("preview.generated.enabled");
+    g.innerLevel = int(s.integer("preview.generated.inner_level"));
+    g.outerLevel = int(s.integer("preview.generated.outer_level"));
+    g.gravity = s.vec3f("preview.generated.gravity");
+    g.wind = s.vec3f("preview.generated.wind");
+    g.gust = float(s.number("preview.generated.gust"));
+    g.gustFrequency = float(s.number("preview.generated.gust_frequency"));
+    g.gustWavelength = float(s.number("preview.generated.gust_wavelength"));
+    for (size_t i = 0; i < s.count("preview.generated.types"); ++i) {
+        const std::string k = cat("preview.generated.types[", i, "].");
+        HairType t;
+        t.color = s.vec3f(k + "color");
+        t.segments = int(s.integer(k + "segments"));
+        t.segmentLength = float(s.number(k + "segment_length"));
+        t.forceWeight = float(s.number(k + "force_weight"));
+        t.rootRadius = float(s.number(k + "root_radius"));
+        t.tipRadius = float(s.number(k + "tip_radius"));
+        g.types.push_back(t);
+    }
+    for (size_t i = 0; i < s.count("preview.generated.regions"); ++i) {
+        const std::string k = cat("preview.generated.regions[", i, "].");
+        HairRegion r;
+        const std::string& shape = s.text(k + "shape");
+        r.shape = shape == "all" ? HairRegion::Shape::All : shape == "mask" ? HairRegion::Shape::Mask
+                                                                            : HairRegion::Shape::Cap;
+        r.type = int(s.integer(k + "type"));
+        if (size_t(r.type) >= g.types.size())
+            s.fail(k + "type", cat("names hair type ", r.type, " but preview.generated.types has ", g.types.size()));
+        r.axis = s.vec3f(k + "axis");
+        if (r.shape == HairRegion::Shape::Cap && r.axis.norm() < 1e-6f) s.fail(k + "axis", "must be non-zero");
+        r.angle = float(s.number(k + "angle"));
+        g.regions.push_back(r);
+    }
+    return p;
+}
+
+}  // namespace hp

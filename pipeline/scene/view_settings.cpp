@@ -1,0 +1,99 @@
+#include "pipeline/scene/view_settings.h"
+
+#include "core/errors.h"
+#include "render/hair_bsdf.h"
+
+namespace hp {
+
+View makeView(const Scene& s) {
+    View v;
+    Camera& c = v.camera;
+    c.position = s.vec3f("render.camera.position");
+    c.target = s.vec3f("render.camera.target");
+    c.up = s.vec3f("render.camera.up");
+    c.fovY = float(s.number("render.camera.fov"));
+    c.width = int(s.integer("render.camera.width"));
+    c.height = int(s.integer("render.camera.height"));
+    c.nearClip = float(s.number("render.camera.near"));
+    c.farClip = float(s.number("render.camera.far"));
+    if ((c.target - c.position).norm() < 1e-6f) s.fail("render.camera.target", "must differ from the camera position");
+    if ((c.target - c.position).normalized().cross(c.up).norm() < 1e-4f)
+        s.fail("render.camera.up", "must not be parallel to the viewing direction");
+    if (c.farClip <= c.nearClip) s.fail("render.camera.far", "must be greater than render.camera.near");
+
+    v.lights.clear();
+    for (size_t i = 0; i < s.count("render.lights"); ++i) {
+        const std::string k = cat("render.lights[", i, "].");
+        Light l;
+        l.type = s.text(k + "type") == "point" ? LightType::Point : LightType::Directional;
+        l.direction = s.vec3f(k + "direction");
+        l.position = s.vec3f(k + "position");
+        l.color = s.vec3f(k + "color");
+        l.intensity = float(s.number(k + "intensity"));
+        l.castsShadows = s.flag(k + "shadows");
+        l.cameraRelative = s.text(k + "space") == "camera";
+        if (l.type == LightType::Directional && l.direction.norm() < 1e-6f)
+            s.fail(k + "direction", "a directional light needs a non-zero direction");
+        v.lights.push_back(l);
+    }
+    v.environment = s.vec3f("render.environment");
+
+    HairMaterial& h = v.hair;
+    h.color = s.number("render.hair.melanin") >= 0 ? hairColorFromAbsorption(hairAbsorption(s), hairRoughness(s))
+                                                    : s.vec3f("render.hair.color");
+    h.specularColor = s.vec3f("render.hair.specular_color");
+    h.kd = float(s.number("render.hair.kd"));
+    h.ks = float(s.number("render.hair.ks"));
+    h.shininess = float(s.number("render.hair.shininess"));
+    h.twoLobes = s.flag("render.hair.two_lobes");
+    h.primaryShift = float(s.number("render.hair.primary_shift"));
+    h.secondaryShift = float(s.number("render.hair.secondary_shift"));
+    h.secondaryKs = float(s.number("render.hair.secondary_ks"));
+    h.secondaryShininess = float(s.number("render.hair.secondary_shininess"));
+    h.secondaryColor = s.vec3f("render.hair.secondary_color");
+    h.transmittance = float(s.number("render.hair.transmittance"));
+
+    v.head.color = s.vec3f("render.head.color");
+    v.head.ambient = float(s.number("render.head.ambient"));
+    v.head.wrap = float(s.number("render.head.wrap"));
+    v.head.specular = float(s.number("render.head.specular"));
+    v.head.shininess = float(s.number("render.head.shininess"));
+    return v;
+}
+
+float hairRoughness(const Scene& s) { return float(s.number("reference.physical.azimuthal_roughness")); }
+
+Vec3f hairAbsorption(const Scene& s) {
+    if (s.number("render.hair.melanin") >= 0)
+        return hairAbsorptionFromMelanin(float(s.number("render.hair.melanin")),
+                                         float(s.number("render.hair.pheomelanin")));
+    if (s.flag("reference.physical.use_hair_color"))
+        return hairAbsorptionFromColor(s.vec3f("render.hair.color"), hairRoughness(s));
+    return hairAbsorptionFromMelanin(float(s.number("reference.physical.melanin")),
+                                     float(s.number("reference.physical.pheomelanin")));
+}
+
+DisplaySettings makeDisplaySettings(const Scene& s) {
+    DisplaySettings d;
+    d.ocioConfig = s.file("render.ocio.config").string();
+    d.inputSpace = s.text("render.ocio.colorspace");
+    d.display = s.text("render.ocio.display");
+    d.view = s.text("render.ocio.view");
+    d.exposure = float(s.number("render.exposure"));
+    const std::string& type = s.text("render.background.type");
+    d.backdrop.kind = type == "color"      ? Backdrop::Kind::Color
+                      : type == "gradient" ? Backdrop::Kind::Gradient
+                                           : Backdrop::Kind::None;
+    d.backdrop.top = s.vec3f("render.background.color");
+    d.backdrop.bottom = s.vec3f("render.background.bottom");
+    try {
+        checkDisplaySettings(d);
+    } catch (const SceneError&) {
+        throw;
+    } catch (const Error& e) {
+        s.fail(d.ocioConfig.empty() ? "render.ocio.view" : "render.ocio.config", e.what());
+    }
+    return d;
+}
+
+}  // namespace hp

@@ -1,0 +1,121 @@
+#include "pipeline/stages/shot.h"
+
+#include "core/log.h"
+#include "pipeline/batch/progress.h"
+#include "pipeline/batch/output.h"
+#include "pipeline/stages/stages.h"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+
+namespace fs = std::filesystem;
+
+namespace hp {
+
+ShotSettings resolveShot(const Scene& scene, const RunOptions& options) {
+    ShotSettings shot;
+    shot.fps = scene.number("fps");
+    shot.seed = scene.integer("seed");
+    shot.force = options.force;
+    shot.frames = options.frames ? *options.frames : scene.frames("frames");
+    shot.requireCache = options.cacheOnly;
+    shot.wholeRunOutputs = !options.noReport;
+    fs::path out = options.outputDir;
+    if (out.empty()) {
+        const std::string& configured = scene.text("output.directory");
+        out = configured.empty() ? fs::path("out") / fs::path(scene.name()).stem() : fs::path(configured);
+        // A directory named in the scene is relative to the scene's folder.
+        if (!configured.empty() && out.is_relative()) out = scene.directory() / out;
+    }
+    shot.outputDir = fs::absolute(out).lexically_normal();
+    return shot;
+}
+
+namespace {
+
+/// Peak resident set of this process so far, MB (getrusage: ru_maxrss is KiB
+/// on Linux). Logged per stage with --verbose: the peak only grows, so the
+/// stage that raised it is the one that needed the memory (docs/hardening.md).
+double peakResidentMb() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_maxrss) / 1024.0;
+}
+
+/// A failure is logged when it happens and listed again at the end of the run.
+void recordFailure(RunReport& report, const std::string& what) {
+    report.failures.push_back(what);
+    logError(what);
+}
+
+}  // namespace
+
+RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const ShotSettings& shot) {
+    RunReport report;
+    if (stages.empty()) {
+        logWarning("nothing to do: the scene enables no output stage");
+        return report;
+    }
+    Progress progress("frames", shot.frames.size());
+    for (int frame : shot.frames) {
+        // Decide first which stages still have work, so a fully written frame
+        // costs no simulation or head evaluation when the source allows it.
+        std::vector<FrameStage*> todo;
+        for (StagePtr& stage : stages) {
+            const std::vector<std::filesystem::path> outputs = stage->outputs(frame);
+            if (outputs.empty()) continue;  // the stage skips this frame (its <stage>.frames)
+            if (!shot.force && allExist(outputs)) {
+                ++report.outputsSkipped;
+                logVerbose("frame ", frame, " ", stage->name(), ": outputs exist, skipped");
+            } else {
+                todo.push_back(stage.get());
+            }
+        }
+        const bool needsData = std::any_of(todo.begin(), todo.end(), [](FrameStage* s) { return s->needsFrameData(); });
+        FrameData data;
+        data.frame = frame;
+        data.time = frame / shot.fps;
+        bool sourceFailed = false;
+        if (needsData) {
+            try {
+                data = source.get(frame);
+                for (const std::string& failure : data.failures) recordFailure(report, cat("frame ", frame, ": ", failure));
+                logVerbose("frame ", frame, " data (simulation or cache): peak RSS ", int(peakResidentMb()), " MB");
+            } catch (const FrameError& e) {
+                // Without the frame's data no data stage can run; later frames may still work.
+                recordFailure(report, cat("frame ", frame, ": ", e.what()));
+                sourceFailed = true;
+            }
+            // Any other error (a scene key, an unreadable head, a scalp that
+            // grows no hair) would fail every frame the same way: it ends the
+            // run with exit code 1, as a scene error found at load would.
+        }
+        for (FrameStage* stage : todo) {
+            if (sourceFailed && stage->needsFrameData()) continue;
+            try {
+                stage->run(data);
+                logVerbose("frame ", frame, " ", stage->name(), ": peak RSS ", int(peakResidentMb()), " MB");
+            } catch (const Error& e) {
+                recordFailure(report, cat("frame ", frame, " ", stage->name(), ": ", e.what()));
+            }
+        }
+        ++report.framesDone;
+        progress.advance(cat("frame ", frame));
+    }
+    // Whole-run outputs (reports) once every frame is done.
+    if (shot.wholeRunOutputs) finishStages(stages, shot, report);
+    return report;
+}
+
+void finishStages(std::vector<StagePtr>& stages, const ShotSettings& shot, RunReport& report) {
+    for (StagePtr& stage : stages) {
+        try {
+            stage->finish(shot);
+        } catch (const Error& e) {
+            recordFailure(report, cat(stage->name(), ": ", e.what()));
+        }
+    }
+}
+
+}  // namespace hp

@@ -1,0 +1,163 @@
+// The "reference" frame stage: renders each frame's strands and head with the
+// Embree reference renderer (render/reference.h) and writes EXR (+ PNG).
+#include "core/log.h"
+#include "pipeline/stages/camera_track.h"
+#include "pipeline/batch/output.h"
+#include "pipeline/batch/path_template.h"
+#include "pipeline/stages/stages.h"
+#include "pipeline/scene/view_settings.h"
+#include "render/reference.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <optional>
+
+namespace fs = std::filesystem;
+
+namespace hp {
+
+namespace {
+
+ReferenceSettings referenceSettings(const Scene& s, const ShotSettings& shot) {
+    ReferenceSettings r;
+    r.mode = s.text("reference.mode") == "physical" ? ReferenceMode::Physical : ReferenceMode::KajiyaKay;
+    r.samplesPerPixel = int(s.integer("reference.samples"));
+    r.bounces = int(s.integer("reference.depth"));
+    r.seed = uint64_t(shot.seed);
+    r.shadows = s.flag("reference.shadows");
+    r.shadowRouletteThreshold = float(s.number("reference.shadow_roulette"));
+    r.diffuseSpecularLayers = s.flag("reference.layers.diffuse_specular");
+    r.strandIdLayer = s.flag("reference.layers.strand_id");
+    HairFiberParams& f = r.fiber;
+    f.longitudinalRoughness = float(s.number("reference.physical.roughness"));
+    f.azimuthalRoughness = float(s.number("reference.physical.azimuthal_roughness"));
+    f.cuticleTiltDegrees = float(s.number("reference.physical.cuticle_tilt"));
+    f.ior = float(s.number("reference.physical.ior"));
+    f.sigmaA = hairAbsorption(s);
+    return r;
+}
+
+std::string checkedTemplate(const Scene& s, const std::string& key, bool required) {
+    const std::string& t = s.text(key);
+    if (t.empty()) {
+        if (required) s.fail(key, "must name the output file template");
+        return t;
+    }
+    if (!hasFrameToken(t)) s.fail(key, "needs a frame token (#### or %04d) so frames do not overwrite each other");
+    return t;
+}
+
+/// One sequence the stage writes: its shading and file templates.
+struct ReferenceOutput {
+    ReferenceSettings settings;
+    std::string exr, png;
+};
+
+class ReferenceStage final : public FrameStage {
+  public:
+    ReferenceStage(const Scene& scene, const ShotSettings& shot)
+        : shot_(shot), view_(makeView(scene)), scene_(scene), display_(makeDisplaySettings(scene)),
+          scale_(scene.number("reference.scale")), sceneName_(scene.name()) {
+        checkCameraKeys(scene);
+        sequences_.push_back({referenceSettings(scene, shot), checkedTemplate(scene, "reference.exr", true),
+                              checkedTemplate(scene, "reference.png", false)});
+        if (scene.flag("reference.kajiya_kay.enabled")) {
+            if (sequences_.front().settings.mode != ReferenceMode::Physical)
+                scene.fail("reference.kajiya_kay.enabled",
+                           "adds a Kajiya-Kay reference beside a physical one, but reference.mode is already "
+                           "kajiya-kay");
+            ReferenceOutput kk = sequences_.front();
+            kk.settings.mode = ReferenceMode::KajiyaKay;
+            kk.exr = checkedTemplate(scene, "reference.kajiya_kay.exr", true);
+            kk.png = checkedTemplate(scene, "reference.kajiya_kay.png", false);
+            if (kk.exr == sequences_.front().exr)
+                scene.fail("reference.kajiya_kay.exr", "must differ from reference.exr, or one overwrites the other");
+            sequences_.push_back(std::move(kk));
+        }
+    }
+
+    std::string name() const override { return "reference"; }
+
+    std::vector<fs::path> outputs(int frame) const override {
+        std::vector<fs::path> out;
+        for (const ReferenceOutput& s : sequences_) append(out, s, frame);
+        return out;
+    }
+
+    void run(const FrameData& data) override {
+        const TriangleMesh* head = data.head && !data.head->mesh.triangles.empty() ? &data.head->mesh : nullptr;
+        if (!data.strands && !head)
+            throw FrameError(cat("frame ", data.frame,
+                                 " has neither strands nor a head to render (no hair or head stage produced them)"));
+        if (!data.strands) logVerbose("reference: frame ", data.frame, " has no strands; rendering the head alone");
+        View view = view_;
+        view.camera = cameraAt(data.frame);
+        view.camera.width = std::max(1, int(std::lround(view.camera.width * scale_)));
+        view.camera.height = std::max(1, int(std::lround(view.camera.height * scale_)));
+        for (const ReferenceOutput& s : sequences_) render(view, s, data, head);
+    }
+
+  private:
+    void append(std::vector<fs::path>& out, const ReferenceOutput& s, int frame) const {
+        out.push_back(shot_.outputDir / expandFrame(s.exr, frame));
+        if (!s.png.empty()) out.push_back(shot_.outputDir / expandFrame(s.png, frame));
+    }
+
+    void render(const View& view, const ReferenceOutput& sequence, const FrameData& data, const TriangleMesh* head) {
+        ReferenceSettings settings = sequence.settings;
+        settings.frame = data.frame;
+        int lastDecile = 0;
+        settings.progress = [&](size_t done, size_t total) {
+            const int decile = int(10 * done / total);
+            if (decile > lastDecile) {
+                lastDecile = decile;
+                logVerbose("reference: frame ", data.frame, " ", 10 * decile, "%");
+            }
+        };
+        ReferenceStats stats;
+        const Image image = renderer_.render(view, data.strands, head, settings, &stats);
+        logVerbose("reference: frame ", data.frame, ": ", stats.strands, " strands, ", settings.samplesPerPixel,
+                   " spp, ", referenceModeName(settings.mode), ", build ", stats.buildSeconds, " s, render ",
+                   stats.renderSeconds, " s, Embree ", stats.sceneBytes / (1 << 20), " MiB");
+
+        ImageWriteOptions options;
+        options.metadata = {{"hairpipe:stage", "reference"},
+                            {"hairpipe:scene", sceneName_},
+                            {"hairpipe:frame", std::to_string(data.frame)},
+                            {"hairpipe:seed", std::to_string(shot_.seed)},
+                            {"hairpipe:mode", referenceModeName(settings.mode)},
+                            {"hairpipe:samples", std::to_string(settings.samplesPerPixel)},
+                            {"hairpipe:strands", std::to_string(stats.strands)}};
+        std::vector<fs::path> paths;
+        append(paths, sequence, data.frame);
+        for (const fs::path& path : paths)
+            writeAtomically(path, [&](const fs::path& tmp) { writeImageWithDisplay(tmp.string(), image, display_, options); });
+    }
+
+    ShotSettings shot_;
+    View view_;
+    Scene scene_;  ///< a copy: callers may pass a temporary scene
+    std::optional<CameraTrack> track_;  ///< made on the first frame: it may read the strand cache
+
+    /// The camera of `frame` (camera auto reads the clip once, on first use).
+    const Camera& cameraAt(int frame) {
+        if (!track_) track_ = makeCameraTrack(scene_, view_.camera, shot_.outputDir);
+        return track_->at(frame);
+    }
+    DisplaySettings display_;  // PNG frames only; EXRs stay linear
+    double scale_;
+    std::string sceneName_;
+    /// The scene's reference, then (reference.kajiya_kay.enabled) its Kajiya-Kay companion.
+    std::vector<ReferenceOutput> sequences_;
+    ReferenceRenderer renderer_;  // one Embree device for the whole shot
+};
+
+}  // namespace
+
+StagePtr makeReferenceStage(const Scene& scene, const ShotSettings& shot) {
+    if (!scene.flag("reference.enabled")) return nullptr;
+    return std::make_unique<ReferenceStage>(scene, shot);
+}
+
+}  // namespace hp

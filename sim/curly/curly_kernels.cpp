@@ -1,0 +1,212 @@
+#include "sim/curly/curly_kernels.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace hp::curly {
+
+float smoothingBeta(float edgeLength, float alpha) {
+    if (!(alpha > 0.f)) return 1.f;
+    return std::min(1.f, 1.f - std::exp(-edgeLength / alpha));
+}
+
+void smoothEdges(const Vec3f* lambda, size_t n, float beta, Vec3f* d) {
+    if (n < 2) return;
+    const float a = 1.f - beta;
+    const float c1 = 2.f * a, c2 = a * a, c3 = beta * beta;
+    Vec3f d1 = lambda[1] - lambda[0];  // d_{i-1}
+    Vec3f d2 = d1;                     // d_{i-2}
+    for (size_t i = 0; i + 1 < n; ++i) {
+        const Vec3f di = c1 * d1 - c2 * d2 + c3 * (lambda[i + 1] - lambda[i]);
+        d[i] = di;
+        d2 = d1;
+        d1 = di;
+    }
+}
+
+void smoothedCurve(const Vec3f* lambda, size_t n, float beta, Vec3f* out) {
+    if (n == 0) return;
+    std::vector<Vec3f> d(n > 1 ? n - 1 : 0);
+    smoothEdges(lambda, n, beta, d.data());
+    out[0] = lambda[0];
+    for (size_t i = 1; i < n; ++i) out[i] = out[i - 1] + d[i - 1];
+}
+
+namespace {
+/// Unit vector, or `fallback` for a (near) zero vector.
+inline Vec3f unitOr(const Vec3f& v, const Vec3f& fallback) {
+    const float len = v.norm();
+    return len > 1e-12f ? Vec3f(v / len) : fallback;
+}
+}  // namespace
+
+void transportFrames(const Vec3f* d, size_t edges, const Mat3f& root, Mat3f* frames) {
+    Vec3f prev = root.col(1);
+    Mat3f F = root;
+    for (size_t i = 0; i < edges; ++i) {
+        const Vec3f t = unitOr(d[i], prev);
+        F = Quatf::FromTwoVectors(prev, t).toRotationMatrix() * F;
+        frames[i] = F;
+        prev = t;
+    }
+}
+
+Mat3f rootFrame(const SurfaceFrame& frame) {
+    const Vec3f n = unitOr(frame.normal, Vec3f::UnitY());
+    Vec3f t = frame.tangent - n * n.dot(frame.tangent);
+    t = t.squaredNorm() > 1e-12f ? Vec3f(t.normalized()) : Vec3f(n.unitOrthogonal());
+    Mat3f r;
+    r.col(0) = t;
+    r.col(1) = n;
+    r.col(2) = t.cross(n);
+    return r;
+}
+
+PairForce stretchSpring(const Vec3f& e, const Vec3f& dv, float restLength, float ks, float cs) {
+    PairForce p;
+    const float len = e.norm();
+    if (!(len > 1e-12f)) return p;
+    const Vec3f u = e / len;
+    const Mat3f uu = u * u.transpose();
+    p.force = ks * (len - restLength) * u + cs * dv.dot(u) * u;
+    p.K = ks * (uu + std::max(0.f, 1.f - restLength / len) * (Mat3f::Identity() - uu));
+    p.C = cs * uu;
+    return p;
+}
+
+PairForce bendingSpring(const Vec3f& e, const Vec3f& dv, const Vec3f& target, float kb, float cb) {
+    PairForce p;
+    const Vec3f u = unitOr(e, Vec3f::Zero());
+    const Vec3f dvPerp = dv - dv.dot(u) * u;
+    p.force = kb * (e - target) + cb * dvPerp;
+    p.K = kb * Mat3f::Identity();
+    p.C = cb * (Mat3f::Identity() - u * u.transpose());
+    return p;
+}
+
+PairForce coreSpring(const Vec3f& b, float restLength, const Vec3f& nu, float kc, float cc, float tap) {
+    PairForce p;
+    const float len = b.norm();
+    if (!(len > 1e-12f)) return p;
+    const Vec3f u = b / len;
+    const Mat3f uu = u * u.transpose();
+    p.force = kc * (len - restLength) * u + cc * nu.dot(u) * u;
+    p.K = kc * tap * uu;
+    p.C = cc * tap * uu;
+    return p;
+}
+
+void solveBlockTridiagonal(Mat3f* diag, const Mat3f* upper, Vec3f* rhs, size_t n) {
+    if (n == 0) return;
+    // Forward elimination: D_i ← D_i - U_{i-1}ᵀ D_{i-1}⁻¹ U_{i-1}, r_i likewise.
+    // diag[i] ends up holding the inverse of the eliminated block.
+    diag[0] = diag[0].inverse().eval();
+    for (size_t i = 1; i < n; ++i) {
+        const Mat3f L = upper[i - 1].transpose() * diag[i - 1];
+        diag[i] -= L * upper[i - 1];
+        rhs[i] -= L * rhs[i - 1];
+        diag[i] = diag[i].inverse().eval();
+    }
+    // Back substitution: x_i = D_i⁻¹ (r_i - U_i x_{i+1}).
+    rhs[n - 1] = diag[n - 1] * rhs[n - 1];
+    for (size_t i = n - 1; i-- > 0;) rhs[i] = diag[i] * (rhs[i] - upper[i] * rhs[i + 1]);
+}
+
+size_t limitRelativeVelocity(Vec3f* v, size_t n, float maxRelative) {
+    size_t limited = 0;
+    for (size_t i = 0; i + 1 < n; ++i) {
+        const Vec3f dv = v[i + 1] - v[i];
+        const float len = dv.norm();
+        if (len <= maxRelative) continue;
+        v[i + 1] = v[i] + dv * (maxRelative / len);
+        ++limited;
+    }
+    return limited;
+}
+
+float perStepFactor(float factor, float h, float hRef) { return std::pow(factor, h / hRef); }
+
+float strainLimited(float length, float restLength, float maxStrain) {
+    return std::clamp(length, (1.f - maxStrain) * restLength, (1.f + maxStrain) * restLength);
+}
+
+Contact placeParticle(const Vec3f& parent, Vec3f& child, float length, const ObstacleQuery& head, float radius) {
+    auto place = [&] {
+        const Vec3f e = child - parent;
+        const float len = e.norm();
+        // A collapsed edge keeps its length along an arbitrary, deterministic axis.
+        child = parent + (len > 1e-12f ? Vec3f(e / len) : Vec3f::UnitY()) * length;
+    };
+    place();
+    Contact total;
+    if (!head.collider) return total;
+    const Vec3f start = child;
+    for (int iter = 0; iter < 16; ++iter) {
+        const Contact c = projectOut(head, radius, child);
+        if (!c.active) break;
+        total.active = true;
+        total.normal = c.normal;
+        place();
+    }
+    if (total.active) {
+        // A last projection guarantees the clearance; it can only cost length
+        // when the parent itself sits inside the clearance band.
+        const Contact c = projectOut(head, radius, child);
+        if (c.active) total.normal = c.normal;
+        total.push = std::max(0.f, (child - start).dot(total.normal));
+    }
+    return total;
+}
+
+void helixPoints(float radius, float pitch, float segment, size_t n, Vec3f* out) {
+    const float c = pitch / float(2.0 * M_PI);
+    const float speed = std::sqrt(radius * radius + c * c);  // arc length per unit t
+    for (size_t k = 0; k < n; ++k) {
+        const float s = float(k) * segment;
+        if (!(speed > 0.f)) {
+            out[k] = Vec3f(0.f, 0.f, s);
+            continue;
+        }
+        const float t = s / speed;
+        out[k] = Vec3f(radius * (std::cos(t) - 1.f), radius * std::sin(t), c * t);
+    }
+}
+
+namespace {
+float median(std::vector<float>& v) {
+    if (v.empty()) return 0.f;
+    const size_t mid = v.size() / 2;
+    std::nth_element(v.begin(), v.begin() + mid, v.end());
+    float m = v[mid];
+    if (v.size() % 2 == 0) m = 0.5f * (m + *std::max_element(v.begin(), v.begin() + mid));
+    return m;
+}
+}  // namespace
+
+HelixFit fitHelix(const Vec3f* p, size_t n, size_t skip) {
+    HelixFit fit;
+    if (n < 4) return fit;
+    std::vector<float> radii, pitches;
+    for (size_t i = std::max<size_t>(1, skip); i + 2 < n; ++i) {
+        const Vec3f e0 = p[i] - p[i - 1], e1 = p[i + 1] - p[i], e2 = p[i + 2] - p[i + 1];
+        Vec3f axis = (e1 - e0).cross(e2 - e1);
+        const float an = axis.norm();
+        // Straight or planar-zigzag stretches have no screw axis.
+        const float scale = (e1 - e0).norm() * (e2 - e1).norm();
+        if (!(an > 1e-3f * scale) || !(scale > 1e-20f)) continue;
+        axis /= an;
+        if (axis.dot(e1) < 0.f) axis = -axis;
+        const Vec3f u = e0 - axis.dot(e0) * axis, w = e1 - axis.dot(e1) * axis;
+        const float theta = std::atan2(u.cross(w).norm(), u.dot(w));
+        if (!(theta > 1e-4f)) continue;
+        pitches.push_back(float(2.0 * M_PI) * axis.dot(e1) / theta);
+        radii.push_back(w.norm() / (2.f * std::sin(0.5f * theta)));
+    }
+    fit.samples = radii.size();
+    fit.radius = median(radii);
+    fit.pitch = median(pitches);
+    return fit;
+}
+
+}  // namespace hp::curly

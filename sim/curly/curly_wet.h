@@ -1,0 +1,196 @@
+// Curly and wet guide strands (seed 001: Kim 2023 on Iben et al. 2013), the
+// second strand model beside the rigid-chain guides (sim/guides/guides.h), with the
+// same shape of interface so the same driver can run either.
+//
+// A guide is a chain of particles (default 24) joined by the seed's stretch,
+// bending and core springs; wet hair adds curl exaggeration, cohesion between
+// strands, adhesion to the head and saturation-dependent stiffness, all
+// driven by a per-particle saturation σ that the pipeline animates per step
+// (setSaturation). Arrangement (details in sim/curly/curly_world.cpp):
+// - the seed's forces are assembled per strand into one linearly implicit
+//   (backward Euler) step (sim/curly/curly_dynamics.h), stable at 0.02 s;
+// - Bullet does the dynamics: each guide is a btSoftBody rope in a
+//   btSoftRigidDynamicsWorld; the implicit step's result enters as node forces
+//   (addForce), Bullet integrates gravity and those forces and solves the
+//   inextensible links;
+// - head contact is the projection out of the head's signed distance with
+//   Coulomb friction after each Bullet step (Bridson et al., as the seed);
+// - strain and root-to-tip velocity limiting (Selle et al.) and the seed's
+//   velocity scales ξ, ζ follow.
+// Strands are split into fixed groups, one Bullet world each, advanced in
+// parallel with TBB; cohesion reads the previous step's positions of all
+// strands, so the result does not depend on the thread count.
+//
+// Bullet stays inside sim/*.cpp; this header is plain C++ and Eigen.
+#pragma once
+
+#include "sim/strands/head.h"
+#include "sim/strands/strand.h"
+
+#include <memory>
+#include <vector>
+
+namespace hp {
+
+/// Everything the curly/wet solver needs. Units: metres, seconds, kg,
+/// degrees for angles. Defaults are the seed's values where it gives one.
+struct CurlyWetSettings {
+    // Shape of a guide. Rest shape: a helix along the root normal (unless a
+    // groom is given to initialize), so a curly guide is curly at rest.
+    int particles = 24;             ///< particles per guide (edges = particles - 1)
+    float length = 0.25f;           ///< arc length of a guide, m
+    float curlRadius = 0.01f;       ///< rest helix radius, m (0: straight)
+    float curlPitch = 0.04f;        ///< rest helix advance per turn, m
+    float collisionRadius = 0.001f; ///< clearance kept from the head, m
+    float rootRadius = 0.00004f;    ///< render radius at the root (StrandFrame), m
+    float tipRadius = 0.00001f;     ///< render radius at the tip, m
+
+    // Time stepping.
+    float timeStep = 0.02f;         ///< one step, s
+    int substeps = 1;               ///< Bullet steps per step
+    int iterations = 8;             ///< Bullet link (inextensibility) iterations per Bullet step
+
+    // Material and springs (seed eq. 1, 4, 5).
+    float massPerLength = 0.005f;   ///< kg/m (a guide stands for a clump of hairs)
+    Vec3f gravity = Vec3f(0.f, -9.81f, 0.f);  ///< m/s²
+    bool preload = true;            ///< bending targets pre-loaded so the rest shape holds under gravity at t0
+    float stretchStiffness = 5000.f;///< ks, N/m (stiff: the implicit step keeps edges nearly inextensible)
+    float stretchDamping = 0.05f;   ///< cs, N·s/m
+    float bendStiffness = 20.f;     ///< kb, N/m
+    float bendDamping = 0.02f;      ///< cb, N·s/m
+    float bendSmoothing = 0.05f;    ///< α of the bending frames' smoothing filter, m
+    float coreStiffness = 20.f;     ///< kc, N/m
+    float coreDamping = 0.02f;      ///< cc, N·s/m
+    float coreSmoothing = 0.05f;    ///< α_c of the core curve, m
+    float maxStrain = 0.001f;       ///< strain limit |l/l̄ - 1| after each Bullet step
+    float maxRelativeVelocity = 2.f;///< root-to-tip velocity limit |v_{i+1} - v_i|, m/s
+    float friction = 0.2f;          ///< Coulomb friction against the head
+
+    // Wet effects, driven by the saturation σ_i = clamp(σ·profile(s_i), 0, 1).
+    bool wetEffects = true;         ///< false: σ is ignored (always dry)
+    float saturation = 0.f;         ///< σ of the scene until setSaturation is called
+    float saturationRoot = 1.f;     ///< profile factor at the root
+    float saturationTip = 1.f;      ///< profile factor at the tip (linear in between)
+    float helixRadius = 0.f;        ///< wet helix radius r (eq. 6), m; 0: the curl radius
+    float helixPitch = 0.f;         ///< wet helix advance per turn (2π p of eq. 6), m; 0: the curl pitch
+    float helixWeight = 100.f;      ///< w_h of eq. (9), N/m (5 kb: a wet helix unlike the rest curl wins)
+    bool cohesion = true;           ///< cohesion between wet strands (eq. 10)
+    float cohesionTightness = 0.85f;///< λ (seed: 0.85)
+    float cohesionRadius = 0.01f;   ///< kernel radius of the neighbour average, m
+    float cohesionStiffness = 1e4f; ///< pull toward the cohesive position, per unit mass, 1/s²
+    bool adhesion = true;           ///< adhesion to the head (eq. 11-12)
+    float adhesionWeight = 1300.f;  ///< ν (seed: 1300)
+    float adhesionRadius = 0.005f;  ///< h of A(r): the shell outside the head where wet hair is held, m
+    float globalStiffness = 0.999995f; ///< ξ, velocity scale per reference step (seed: 0.999995)
+    float wetStiffness = 0.9999f;   ///< γ0, ζ at σ = 1 (seed: 0.9999)
+    float dryStiffness = 1.0f;      ///< γ1, ζ at σ = 0 (seed: 1.0)
+    float stiffnessStep = 1e-4f;    ///< reference step of ξ and ζ, s: v ← v(ξζ)^(h/this)
+
+    // Scene cuts: a root or head jump beyond these in one step resets to rest.
+    float teleportDistance = 0.1f;  ///< m per step
+    float teleportAngle = 45.f;     ///< deg per step
+
+    // Parallelism: fixed groups of this many guides, one Bullet world each.
+    int strandsPerWorld = 16;
+    int threads = 0;                ///< 0 = the ambient TBB limit
+
+    /// Throws hp::Error naming the first setting out of range.
+    void validate() const;
+};
+
+/// Measurements of one step (same fields as the rigid-chain GuideStats, plus
+/// the wet ones).
+struct CurlyWetStats {
+    double maxLengthError = 0;      ///< max |edge length / rest - 1|
+    double meanLengthError = 0;     ///< mean |edge length / rest - 1|
+    size_t penetrationCount = 0;    ///< particles inside the head (signed distance < 0)
+    double maxPenetration = 0;      ///< deepest particle below the head surface, m
+    double kineticEnergy = 0;       ///< J, end of step
+    size_t nanCount = 0;            ///< non-finite positions or velocities
+    double msPerStep = 0;           ///< wall-clock milliseconds of step()
+    bool reset = false;             ///< a teleport / scene cut reset the guides this step
+    double meanSaturation = 0;      ///< mean σ over the free particles
+    double meanCohesionNeighbours = 0; ///< mean other-strand neighbours within the cohesion radius
+    size_t adhesionCount = 0;       ///< particles held by adhesion in the last Bullet step
+    /// Strand-substeps whose linearly implicit spring system was not finite:
+    /// those strands moved under gravity and constraints alone for that
+    /// substep (their seed forces were skipped). Non-zero means the settings
+    /// are too stiff for the step; the pipeline warns.
+    size_t implicitFailures = 0;
+    size_t steps = 1;               ///< steps folded in (accumulate)
+
+    /// Folds `s` into running maxima (kinetic energy, saturation: the last
+    /// value; ms: the mean).
+    void accumulate(const CurlyWetStats& s);
+};
+
+/// Drives all curly guides of a shot. Not thread-safe itself; parallel inside.
+class CurlyWetSolver {
+  public:
+    explicit CurlyWetSolver(const CurlyWetSettings& settings);
+    ~CurlyWetSolver();
+    CurlyWetSolver(const CurlyWetSolver&) = delete;
+    CurlyWetSolver& operator=(const CurlyWetSolver&) = delete;
+
+    /// Creates the guides at `head.time`: one per root frame. The rest shape
+    /// is `groom` (world-space particles at head.time, `particles` per guide)
+    /// or, when null, a helix of the curl radius and pitch along each root
+    /// normal. The head is only used for its time here.
+    void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head,
+                    const std::vector<std::vector<Vec3f>>* groom = nullptr);
+
+    /// Sets the scene's saturation σ ∈ [0, 1] for the following steps; each
+    /// particle gets σ times the root-to-tip profile. Call it per step (or per
+    /// frame) with the scene's curve evaluated at that time.
+    void setSaturation(float sigma);
+    /// Sets every particle's saturation directly (guideCount()·particles
+    /// values, guide-major, clamped to [0, 1]).
+    void setSaturation(const std::vector<float>& perParticle);
+    /// The per-particle saturations in use.
+    const std::vector<float>& saturation() const;
+
+    /// Advances one step to time() + timeStep. `roots`: the root frames at the
+    /// end of the step (same order as initialize); `head`: the head posed at
+    /// the end of the step (head.time must be time() + timeStep; its collider
+    /// may be null: no collision, no adhesion). A jump beyond the teleport
+    /// limits resets the guides to rest on the new roots.
+    const CurlyWetStats& step(const std::vector<SurfaceFrame>& roots, const HeadPose& head);
+
+    /// Writes the guides at time() into `frame` (cleared first): positions,
+    /// velocities, tapered radii, ids 0..N-1, guideCount = N.
+    void write(StrandFrame& frame) const;
+    /// Same at `time` in [time() - timeStep, time()]: positions and
+    /// velocities interpolated between the last two steps, edge lengths
+    /// restored to the interpolated lengths.
+    void write(StrandFrame& frame, double time) const;
+
+    double time() const;
+    /// End time of the next step.
+    double nextTime() const;
+    size_t guideCount() const;
+    int particlesPerGuide() const;
+
+    /// The dynamic state (positions, velocities, saturation, root targets,
+    /// time) as bytes, for checkpoints; restoreState() puts it back into a
+    /// solver initialised identically, which then continues bit for bit like
+    /// the one that saved it (a particle's whole Bullet state is its position
+    /// and velocity, reloaded every step).
+    std::vector<char> saveState() const;
+    void restoreState(const std::vector<char>& state);
+    const CurlyWetSettings& settings() const;
+    /// Statistics of the last step (all zero before the first).
+    const CurlyWetStats& lastStats() const;
+    /// Statistics of the current state without stepping.
+    CurlyWetStats measure(const Collider* collider) const;
+
+    /// Curl radius and pitch fitted to each guide (sim/curly/curly_kernels.h
+    /// fitHelix, leaving out the first `skip` edges), medians over the guides;
+    /// for tests and diagnostics. {0, 0} when no guide is curly.
+    Eigen::Vector2f measureCurl(size_t skip = 3) const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace hp

@@ -1,0 +1,242 @@
+// The curly guides' Bullet side: one btSoftRigidDynamicsWorld per group of
+// guides, each guide a btSoftBody rope whose nodes are the seed's particles.
+//
+// Division of labour per Bullet step h:
+//  1. Kernels (sim/curly/curly_dynamics.h), per strand: the seed's stretch, bending
+//     and core springs and the wet forces (curl exaggeration, cohesion toward
+//     the previous step's cohesive positions, adhesion to the head) assembled
+//     into one linearly implicit step, giving each particle's Δv. It enters
+//     Bullet as the node force m(Δv/h - g), Bullet adding gravity itself.
+//  2. Bullet (btSoftBody::predictMotion, solveConstraints): integrates
+//     (v += (g + f/m)h, x += vh) and solves the inextensible links with
+//     `iterations` mass-weighted Gauss-Seidel passes, then sets v from the
+//     positions. The root node has zero mass and moves to its kinematic target
+//     by velocity, so head motion enters the strand as real velocity.
+//  3. Kernels, root to tip: strain limiting (Selle et al.), projection out
+//     of the head's signed distance keeping the collision radius clear, then
+//     velocities from positions, Coulomb friction against the moving head,
+//     root-to-tip velocity limiting, and the seed's velocity scales ξ and ζ_i
+//     (step-size independent).
+//
+// Why this arrangement: the seed's springs are force-based, and a curl needs
+// stiff ones — as explicit forces at 0.02 s they blow up (h²k/m ≈ 150 for the
+// bending springs; explicit needs < 4), so they go through an implicit step,
+// which Bullet's soft-body solver does not offer for such springs (its links
+// and bending links are position constraints without targets that turn with
+// the strand); Bullet keeps what it does well here, integration and
+// inextensibility. Head contact goes through the signed distance
+// (as the rigid-chain guides do, and as the seed's adhesion needs anyway)
+// rather than Bullet's soft-rigid sparse SDF, whose cell size and per-step
+// garbage collection cost (STACK.md) buy nothing for a single smooth head.
+// Worlds have no broadphase pairs (collision mask 0), so a world's cost is
+// linear in its guides and worlds run in parallel.
+#include "sim/curly/curly_state.h"
+
+#include <BulletSoftBody/btDefaultSoftBodySolver.h>
+#include <BulletSoftBody/btSoftBody.h>
+#include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
+#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
+#include <btBulletDynamicsCommon.h>
+
+#include <cmath>
+
+namespace hp::curly {
+namespace {
+
+inline btVector3 bt(const Vec3f& v) { return btVector3(v.x(), v.y(), v.z()); }
+inline Vec3f ei(const btVector3& v) { return Vec3f(v.x(), v.y(), v.z()); }
+
+class BulletCurlyWorld final : public CurlyWorld {
+  public:
+    BulletCurlyWorld(CurlySet& set, size_t begin, size_t end);
+    ~BulletCurlyWorld() override;
+    GroupCounters substep(const SubstepContext& ctx) override;
+    size_t begin() const override { return begin_; }
+    size_t end() const override { return end_; }
+
+  private:
+    bool load(size_t g, const SubstepContext& ctx, size_t& adhesion);
+    void finish(size_t g, const SubstepContext& ctx);
+
+    CurlySet& set_;
+    size_t begin_, end_;
+    btSoftBodyRigidBodyCollisionConfiguration config_;
+    btCollisionDispatcher dispatcher_{&config_};
+    btDbvtBroadphase broadphase_;
+    btSequentialImpulseConstraintSolver solver_;
+    btDefaultSoftBodySolver softSolver_;
+    btSoftRigidDynamicsWorld world_{&dispatcher_, &broadphase_, &solver_, &config_, &softSolver_};
+    std::vector<btSoftBody*> bodies_;
+    // Scratch for one strand, reused (a group runs on one thread at a time).
+    StrandScratch scratch_;
+    std::vector<Vec3f> dv_, accel_, x_, v_;
+    std::vector<float> len_;
+    std::vector<Contact> contact_;
+};
+
+BulletCurlyWorld::BulletCurlyWorld(CurlySet& set, size_t begin, size_t end) : set_(set), begin_(begin), end_(end) {
+    const CurlyWetSettings& s = set.settings;
+    btSoftBodyWorldInfo& info = world_.getWorldInfo();
+    info.m_gravity = bt(s.gravity);
+    info.air_density = 0;  // no aerodynamics: damping is the seed's, step-size independent
+    info.water_density = 0;
+    world_.setGravity(bt(s.gravity));
+    const int n = set.n;
+    std::vector<btVector3> pos(n);
+    std::vector<btScalar> mass(n);
+    for (size_t g = begin; g < end; ++g) {
+        for (int i = 0; i < n; ++i) {
+            pos[i] = bt(set.x[set.particle(g, i)]);
+            mass[i] = i == 0 ? 0.f : set.mass[set.particle(g, i)];  // root: kinematic
+        }
+        // Link rest lengths are taken from the nodes at the first step, which
+        // starts from the rest shape (initialize puts every guide there).
+        auto* body = new btSoftBody(&info, n, pos.data(), mass.data());
+        for (int j = 0; j + 1 < n; ++j) body->appendLink(j, j + 1);
+        // Bullet fixes link rest lengths from the node positions at a body's
+        // first step (m_bUpdateRtCst); settle them now, from the rest shape,
+        // so a solver restored from a checkpoint before its first step keeps
+        // the rest lengths of the run that saved it.
+        body->updateConstants();
+        body->m_bUpdateRtCst = false;
+        btSoftBody::Config& cfg = body->m_cfg;
+        cfg.piterations = s.iterations;
+        cfg.viterations = 0;
+        cfg.diterations = 0;
+        cfg.kDP = 0;         // damping: the seed's springs and ξ, ζ
+        cfg.collisions = 0;  // head contact: the signed-distance projection
+        cfg.m_psequence.clear();
+        cfg.m_psequence.push_back(btSoftBody::ePSolver::Linear);
+        body->setActivationState(DISABLE_DEACTIVATION);
+        // Mask 0: the broadphase never pairs a rope with anything.
+        world_.addSoftBody(body, btBroadphaseProxy::DefaultFilter, 0);
+        bodies_.push_back(body);
+    }
+    scratch_.resize(size_t(n));
+    dv_.resize(n);
+    accel_.resize(n);
+    x_.resize(n);
+    v_.resize(n);
+    len_.resize(n);
+    contact_.resize(n);
+}
+
+BulletCurlyWorld::~BulletCurlyWorld() {
+    for (btSoftBody* b : bodies_) {
+        world_.removeSoftBody(b);
+        delete b;
+    }
+}
+
+bool BulletCurlyWorld::load(size_t g, const SubstepContext& ctx, size_t& adhesion) {
+    const CurlyWetSettings& s = set_.settings;
+    const int n = set_.n;
+    const size_t k0 = set_.particle(g, 0);
+    const Vec3f* x = &set_.x[k0];
+    const Vec3f* v = &set_.v[k0];
+    const float* sigma = set_.wet ? &set_.sigma[k0] : nullptr;
+    const Vec3f rootVel = (set_.rootPosition(g, ctx.alpha) - x[0]) / ctx.h;
+    const Mat3f R = set_.rootRotation(g, ctx.alpha).toRotationMatrix();
+
+    StrandLoads loads;
+    loads.sigma = sigma;
+    if (sigma && !set_.cohesion.empty()) loads.cohesion = &set_.cohesion[k0];
+    if (sigma && s.adhesion && ctx.head.collider) {
+        for (int i = 0; i < n; ++i) {
+            accel_[i].setZero();
+            if (i == 0 || !(sigma[i] > 0.f)) continue;
+            // Evaluated where the particle will be at the step's end if it
+            // keeps its velocity: the shell (h/2, h] is thinner than a step's
+            // travel at hair speeds, so a particle leaving the head must feel
+            // the pull in the step it crosses the shell, not after.
+            Vec3f normal;
+            const float phi = ctx.head.distance(x[i] + ctx.h * v[i], &normal);
+            accel_[i] = adhesionAcceleration(phi, normal, sigma[i], s.adhesionWeight, s.adhesionRadius);
+            if (accel_[i].squaredNorm() > 0.f) ++adhesion;
+        }
+        loads.acceleration = accel_.data();
+    }
+    const bool ok = implicitStep(x, v, size_t(n), R, rootVel, set_.rest(g), set_.coefficients, loads, ctx.h,
+                                 scratch_, dv_.data());
+
+    btSoftBody* body = bodies_[g - begin_];
+    for (int i = 0; i < n; ++i) {
+        btSoftBody::Node& node = body->m_nodes[i];
+        node.m_x = bt(x[i]);
+        node.m_v = bt(v[i]);
+        node.m_f = btVector3(0, 0, 0);
+    }
+    body->m_nodes[0].m_v = bt(rootVel);
+    if (ok) {
+        const Vec3f g0 = s.gravity;
+        for (int i = 1; i < n; ++i) {
+            const float m = set_.mass[k0 + size_t(i)];
+            body->addForce(bt(m * (dv_[i] / ctx.h - g0)), i);
+        }
+    }
+    return ok;
+}
+
+void BulletCurlyWorld::finish(size_t g, const SubstepContext& ctx) {
+    const CurlyWetSettings& s = set_.settings;
+    const float h = ctx.h;
+    const int n = set_.n;
+    const size_t k0 = set_.particle(g, 0);
+    const btSoftBody* body = bodies_[g - begin_];
+    const float* rest = &set_.edgeLength[set_.edge(g, 0)];
+    for (int i = 0; i < n; ++i) x_[i] = ei(body->m_nodes[i].m_x);
+    for (int i = 1; i < n; ++i) len_[i - 1] = strainLimited((x_[i] - x_[i - 1]).norm(), rest[i - 1], s.maxStrain);
+    x_[0] = set_.rootPosition(g, ctx.alpha);
+    // Strain limit and head clearance, root to tip, keeping the edge lengths
+    // Bullet left (within the limit); the head has the last word.
+    contact_[0] = Contact{};
+    for (int i = 1; i < n; ++i)
+        contact_[i] = placeParticle(x_[i - 1], x_[i], len_[i - 1], ctx.head, s.collisionRadius);
+    // Velocities from positions, friction, velocity limiting, ξ and ζ.
+    for (int i = 0; i < n; ++i) {
+        Vec3f vi = (x_[i] - set_.x[k0 + size_t(i)]) / h;
+        if (i > 0 && contact_[i].active)
+            vi = contactFriction(vi, ctx.head.surfaceVelocity(x_[i], h), contact_[i], s.friction, h);
+        v_[i] = vi;
+    }
+    limitRelativeVelocity(v_.data(), size_t(n), s.maxRelativeVelocity);
+    const float xi = perStepFactor(s.globalStiffness, h, s.stiffnessStep);
+    for (int i = 1; i < n; ++i) {
+        float scale = xi;
+        if (set_.wet) {
+            const float zeta = wetVelocityFactor(set_.sigma[k0 + size_t(i)], s.wetStiffness, s.dryStiffness);
+            scale *= perStepFactor(zeta, h, s.stiffnessStep);
+        }
+        v_[i] *= scale;
+    }
+    for (int i = 0; i < n; ++i) {
+        set_.x[k0 + size_t(i)] = x_[i];
+        set_.v[k0 + size_t(i)] = v_[i];
+    }
+}
+
+GroupCounters BulletCurlyWorld::substep(const SubstepContext& ctx) {
+    GroupCounters c;
+    for (size_t g = begin_; g < end_; ++g)
+        if (!load(g, ctx, c.adhesion)) ++c.failed;
+    world_.stepSimulation(ctx.h, 0, ctx.h);
+    for (size_t g = begin_; g < end_; ++g) finish(g, ctx);
+    return c;
+}
+
+}  // namespace
+
+void CurlySet::resetGuide(size_t g) {
+    const Mat3f R = rootRot1[g].toRotationMatrix();
+    for (int i = 0; i < n; ++i) {
+        const size_t k = particle(g, i);
+        x[k] = rootPos1[g] + R * restLocal[k];
+        v[k] = Vec3f::Zero();
+    }
+}
+
+std::unique_ptr<CurlyWorld> makeCurlyWorld(CurlySet& set, size_t begin, size_t end) {
+    return std::make_unique<BulletCurlyWorld>(set, begin, end);
+}
+
+}  // namespace hp::curly

@@ -1,0 +1,158 @@
+// Internal to sim/followers*.cpp and sim/followers/follower_step.cpp: the state a
+// Followers object builds once and the tables each step fills. Not for other
+// modules (include sim/followers/followers.h).
+#pragma once
+
+#include "sim/followers/follower_kernels.h"
+#include "sim/followers/followers.h"
+
+#include <Eigen/Geometry>
+
+#include <vector>
+
+namespace hp {
+
+/// Longest strand the follower tables accept (stack scratch is sized by it).
+constexpr uint32_t kMaxFollowerVertices = 256;
+
+/// Two guides read together by some followers: guide 1 leads, guide 2's
+/// rotations are turned about y into guide 1's frame by K = (twistC, twistS).
+struct GuidePair {
+    uint32_t guide1 = 0, guide2 = 0;
+    float twistC = 1.f, twistS = 0.f;
+};
+
+/// Followers sharing one segment count S. Every table is in slots: P
+/// slots (P a multiple of 8, P >= S + 1) where slot j is vertex j and
+/// segment j - 1, the segment ending at vertex j; slot 0 (the root) and the
+/// padding hold identity rotations and zero directions.
+struct FollowerClass {
+    uint32_t segments = 0;
+    uint32_t pad = 0;
+    /// Per guide, kHot rows of P slots: qw qx qy qz (rotation of the guide
+    /// segment mapped to the slot's segment), speed (m/s, the segment's
+    /// centre), rx ry rz (unit rest direction, static).
+    std::vector<float> hot;
+    /// Per guide, kCold rows of P slots, slot = vertex: x y z (world), bound
+    /// (collisionBound; +inf at the root and in the padding), vx vy vz, unused.
+    std::vector<float> cold;
+    /// Per guide and slot, a record of 8 floats rebuilt every step: A of
+    /// follower_kernels.h's (2) and 0 (followers with the guides' rest shape)
+    /// or the guide's rotation q (own rest shapes), then the vertex x y z and
+    /// its collision bound.
+    std::vector<float> guideRecords;
+    /// Guide pairs of this class's followers and, per pair and slot, a record
+    /// of 8 floats rebuilt every step: θ, then B - A and D of (2) (followers
+    /// with the guides' rest shape) or the quaternion e of (1) and 0, 0 (own
+    /// rest shapes), then Algorithm 1's d_v (guide 1's clamped speed).
+    std::vector<GuidePair> pairs;
+    std::vector<float> pairRecords;
+    std::vector<float> radii;          ///< S + 1 tapered radii
+    std::vector<float> weightedCurve;  ///< fixedOffset · d_f(j - 1) per slot, 0 at slot 0 and in the padding
+    static constexpr int kHot = 8;
+    static constexpr int kCold = 8;
+    static constexpr int kRecord = 8;
+
+    /// Guide segment read by follower segment y: the one covering the same
+    /// fraction of the strand, floor((y + 1/2) Sg / S); y itself when Sg = S.
+    static uint32_t guideSegment(uint32_t y, uint32_t followerSegments, uint32_t guideSegments) {
+        const uint32_t s = ((2 * y + 1) * guideSegments) / (2 * followerSegments);
+        return s < guideSegments ? s : guideSegments - 1;
+    }
+};
+
+/// Eight consecutive followers of one class, computed together in the 8
+/// lanes of a vector (lanes = followers). Consecutive, so the output and the
+/// per-step roots stream through memory in order; each lane reads its own
+/// guide and pair records (8 loads and a transpose per slot). The last
+/// packet of a class repeats its last follower in the unused lanes
+/// (computed, never written).
+struct alignas(32) FollowerPacket {
+    static constexpr int kLanes = 8;
+    float alignC[kLanes], alignS[kLanes];  ///< follower frame turned about its normal by φ_f
+    float scale[kLanes];    ///< segment length (1 with own rest shapes: their segments carry it)
+    float weight[kLanes];   ///< interpolation weight d1 / (d1 + d2)
+    uint32_t hash[kLanes];  ///< followerHash(seed, follower)
+    uint32_t follower[kLanes], guide1[kLanes], pair[kLanes];
+    uint32_t vertexOffset[kLanes];  ///< first output vertex, relative to the follower block
+    uint32_t count = 0, cls = 0;
+    uint32_t own = 0;  ///< offset of the packet's own rest segments: P slots × 3 × 8 lanes
+};
+
+/// Barycentric mode: the second and third guide of each lane of a packet,
+/// the weights, and the rest twists K2, K3 (about y) into guide 1's frame.
+struct alignas(32) TrianglePacket {
+    static constexpr int kLanes = FollowerPacket::kLanes;
+    uint32_t guide2[kLanes], guide3[kLanes];
+    float b1[kLanes], b2[kLanes], b3[kLanes];
+    float k2c[kLanes], k2s[kLanes], k3c[kLanes], k3s[kLanes];
+};
+
+struct Followers::Impl {
+    FollowerSettings settings;
+    size_t guides = 0, followers = 0;
+
+    // Guides (rest): segment offsets and inverse transported rest frames P_y⁻¹.
+    std::vector<uint32_t> guideSegmentOffsets{0};
+    std::vector<follower::Quat> restInverse;
+    std::vector<Eigen::Vector3f> guideRestDirs;  ///< unit, root-frame coordinates
+
+    std::vector<FollowerClass> classes;
+    std::vector<FollowerPacket> packets;  ///< all classes, class by class
+    std::vector<TrianglePacket> triangles;  ///< Barycentric mode: one per packet
+
+    // Followers, structure of arrays.
+    std::vector<FollowerNeighbours> neighbours;
+    std::vector<uint8_t> classOf;
+    std::vector<uint32_t> pairOf;          ///< index into the class's pairs
+    std::vector<float> weight;             ///< interpolation weight d1 / (d1 + d2)
+    std::vector<float> alignC, alignS;     ///< follower frame turned about its normal by φ_f
+    std::vector<float> segmentLength;      ///< followers without own rest shapes
+    /// Own rest segments (direction × length, in the aligned frame), per
+    /// packet P slots × (x, y, z) × 8 lanes; zero at slot 0 and in the padding.
+    std::vector<float> ownRestData;
+    std::vector<uint32_t> vertexOffset;    ///< follower vertex offsets, relative to the follower block
+    std::vector<uint32_t> ids;
+
+    // What the previous update wrote (finite-difference velocities).
+    const Vec3f* lastPositions = nullptr;
+    size_t lastVertexCount = 0;
+};
+
+namespace follower {
+
+/// Collision bound of a guide vertex for follower vertices near it: the
+/// signed distance is 1-Lipschitz, so a follower vertex p with
+/// |p - g|² < bound is outside the head by more than the root radius (the
+/// largest follower radius) and needs no query. bound = (clearance(g) -
+/// rootRadius)² when that is positive, -1 (never) otherwise.
+inline float collisionBound(float clearance, float rootRadius) {
+    const float clear = clearance - rootRadius;
+    return clear > 0.f ? clear * clear : -1.f;
+}
+
+/// What one step of the followers reads and writes (follower_step.cpp).
+struct StepContext {
+    const Followers::Impl* im;
+    const SurfaceFrame* roots;
+    const Collider* collider;  ///< null: no collision
+    Vec3f* positions;          ///< the follower block of the output
+    Vec3f* velocities;
+    bool difference;           ///< finite-difference velocities
+    float invDt;
+};
+
+struct Counters {
+    size_t projected = 0, queries = 0;
+    size_t inside = 0;      ///< projected vertices left inside (signed distance < 0)
+    float maxDepth = 0.f;   ///< deepest of those, m
+};
+
+/// Rebuilds the pair records [begin, end) of class `c` from its guide rows.
+void buildPairs(const Followers::Impl& im, FollowerClass& c, size_t begin, size_t end);
+
+/// Packets [begin, end) of this step: shapes, collision, output.
+void processPackets(const StepContext& ctx, size_t begin, size_t end, Counters& counters);
+
+}  // namespace follower
+}  // namespace hp

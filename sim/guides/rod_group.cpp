@@ -1,0 +1,147 @@
+// The `rod` formulation (the default): each guide is an inextensible elastic
+// rod, advanced by sim/guides/rod_kernels.h's XPBD step with a direct banded solve.
+// No Bullet world: a rod group is a slice of guides and their rest
+// curvatures; strand-strand contacts (Bullet's broadphase and narrowphase,
+// sim/guides/strand_contacts.cpp) act on the shared state between substeps as for
+// the rope.
+//
+// Parameters (GuideSettings → rod::Material): mass per length μ and bending
+// stiffness EI from E, ρ, the fibre radius (hair.radius.root; the render
+// taper is not physical here: a uniform fibre) and hairs_per_guide. GJ is
+// computed but enters nothing: with an isotropic section (EI the same about
+// both axes) and a free tip, the quasistatic twist moment is zero along the
+// rod (Bergou et al. 2008, §4.2: the material frame relaxes to the
+// twist-free Bishop frame), so the material frame is the transported frame
+// and the bending energy alone drives the dynamics. That is the model's
+// twist assumption; anisotropic (elliptic) fibres would need twist.
+//
+// Why this solver (measured on the 2-core machine, loaded; README "Physics
+// of the guides"): the direct banded solve is exact per linearisation, so
+// the static elastica comes out within 0.3% of L at 0.01 s steps; one XPBD
+// step per 0.02 s is unstable (a hanging chain's tip oscillation grows), two
+// are the default; a 23-segment strand costs ~9.5 µs of CPU per XPBD step
+// (B-sim, 845 guides, loaded machine), about 2× the rope's step.
+// Gauss-Seidel XPBD (cheaper per sweep, softer than its EI when
+// under-converged) was not measured.
+#include "sim/guides/guide_group.h"
+#include "sim/guides/rod_kernels.h"
+
+#include <algorithm>
+#include <utility>
+
+namespace hp::guides {
+namespace {
+
+rod::Material materialOf(const GuideSettings& s) {
+    rod::Material m;
+    m.youngs = s.youngsModulus;
+    m.shear = s.shearModulus;
+    m.density = s.density;
+    m.radius = s.rootRadius;
+    m.hairsPerGuide = s.hairsPerGuide;
+    return m;
+}
+
+class RodGroup final : public GuideGroup {
+  public:
+    RodGroup(GuideSet& set, size_t begin, size_t end) : GuideGroup(set, begin, end) {
+        const size_t n = end - begin;
+        invMass_.resize(n * size_t(set.vertices));
+        curvature_.resize(n * size_t(set.segments));
+        for (size_t k = 0; k < invMass_.size(); ++k) {
+            const float m = set.mass[set.vertex(begin, 0) + k];
+            invMass_[k] = m > 0.f ? 1.f / m : 0.f;
+        }
+        for (size_t g = begin; g < end; ++g) computeCurvature(g, 0.f);
+    }
+
+    void reset() override { set_.resetGuides(begin_, end_); }
+    void preload(const SubstepContext& ctx) override {
+        const float h = ctx.h / float(std::max(1, set_.settings.rodSubsteps));
+        for (size_t g = begin_; g < end_; ++g) computeCurvature(g, set_.settings.preload ? h : 0.f);
+    }
+    void substep(const SubstepContext& ctx) override;
+    double kineticEnergy() const override { return set_.kineticEnergy(begin_, end_); }
+    void jointAngles(float& bend, float& twist) const override {
+        bend = set_.maxBend(begin_, end_);
+        twist = 0.f;
+    }
+    size_t takePinned() override { return std::exchange(pinned_, size_t(0)); }
+
+  private:
+    rod::RodStrand strand(size_t g) const {
+        rod::RodStrand s;
+        s.vertices = set_.vertices;
+        s.restLength = &set_.restLength[set_.segment(g, 0)];
+        s.invMass = &invMass_[(g - begin_) * size_t(set_.vertices)];
+        s.restCurvature = &curvature_[(g - begin_) * size_t(set_.segments)];
+        s.ghostDir = set_.groomDir[set_.segment(g, 0)];
+        s.bendStiffness = materialOf(set_.settings).bendStiffness();
+        return s;
+    }
+    /// Rest curvatures of guide g from its rest shape at the end-of-step
+    /// root; with a pre-load step h > 0, the rest shape is made a static
+    /// equilibrium of steps of h under gravity (rod::preload).
+    void computeCurvature(size_t g, float preloadStep) {
+        const Mat3f R = set_.rootRot1[g].toRotationMatrix();
+        std::vector<Vec3f> x(size_t(set_.vertices));
+        set_.restShape(g, set_.rootPos1[g], R, x.data());
+        const rod::RodStrand s = strand(g);
+        rod::Vec2f* c = &curvature_[(g - begin_) * size_t(set_.segments)];
+        rod::restCurvature(s, x.data(), R, c);
+        if (preloadStep > 0.f) rod::preload(s, x.data(), R, set_.settings.gravity, preloadStep, c, scratch_);
+    }
+
+    std::vector<float> invMass_;
+    std::vector<rod::Vec2f> curvature_;
+    rod::RodScratch scratch_;
+    size_t pinned_ = 0;
+};
+
+void RodGroup::substep(const SubstepContext& ctx) {
+    const GuideSettings& s = set_.settings;
+    const strand::HeadQuery* head = ctx.headCollision && ctx.head.collider ? &ctx.head : nullptr;
+    // The rod's own steps inside the solver's substep: root targets
+    // interpolated over [alpha0, alpha].
+    const int k = std::max(1, s.rodSubsteps);
+    const float h = ctx.h / float(k);
+    const float alpha0 = ctx.alpha - ctx.h / s.timeStep;
+    // Guides in batches of rod::kLanes (their banded solves share SIMD
+    // lanes; each guide's result is that of a lone step).
+    for (size_t g0 = begin_; g0 < end_; g0 += rod::kLanes) {
+        const int count = int(std::min<size_t>(rod::kLanes, end_ - g0));
+        rod::RodStrand strands[rod::kLanes];
+        rod::RodStepTarget targets[rod::kLanes];
+        for (int l = 0; l < count; ++l) {
+            const size_t g = g0 + size_t(l);
+            strands[l] = strand(g);
+            targets[l].strand = &strands[l];
+            targets[l].x = &set_.x[set_.vertex(g, 0)];
+            targets[l].v = &set_.v[set_.vertex(g, 0)];
+        }
+        for (int i = 0; i < k; ++i) {
+            const float a = alpha0 + (ctx.alpha - alpha0) * float(i + 1) / float(k);
+            for (int l = 0; l < count; ++l) {
+                targets[l].rootPos = set_.rootPosition(g0 + size_t(l), a);
+                targets[l].rootFrame = set_.rootRotation(g0 + size_t(l), a).toRotationMatrix();
+            }
+            pinned_ += size_t(rod::rodSteps(targets, count, s.gravity, h, s.damping, s.friction, head,
+                                            s.collisionRadius, scratch_));
+        }
+    }
+}
+
+class RodFormulation final : public Formulation {
+  public:
+    std::unique_ptr<GuideGroup> makeGroup(GuideSet& set, size_t begin, size_t end) override {
+        return std::make_unique<RodGroup>(set, begin, end);
+    }
+};
+
+}  // namespace
+
+std::unique_ptr<Formulation> makeRodFormulation() { return std::make_unique<RodFormulation>(); }
+
+double rodMassPerLength(const GuideSettings& s) { return materialOf(s).massPerLength(); }
+
+}  // namespace hp::guides

@@ -1,0 +1,145 @@
+// Solver kernels of the `rod` formulation: a guide as an inextensible
+// elastic rod (discrete elastic rod bending, Bergou et al. 2008) advanced by
+// XPBD (Macklin et al. 2016) with a direct banded solve per strand (Deul et
+// al. 2018: the constraints of a chain give a banded system). Pure functions
+// on plain arrays, testable without a physics world.
+//
+// Notation: x_i vertices (x_0 the kinematic root), e_j = x_{j+1} - x_j,
+// d_j = e_j/|e_j|, l_j rest length, w_i inverse mass, h the step.
+// Joint j couples segment j with its parent, segment j-1; joint 0's parent
+// is a ghost segment along the root frame's rest direction of segment 0
+// (the clamped boundary condition θ(0) = 0 of a follicle).
+#pragma once
+
+#include "sim/guides/strand_constraints.h"
+
+#include <Eigen/Core>
+
+namespace hp::rod {
+
+using Vec2f = Eigen::Vector2f;
+using strand::Mat3f;
+
+/// The section of one hair and the wisp a guide stands for. A guide is a
+/// wisp of N identical fibres that slide freely along each other (no shear
+/// coupling between them), so every sectional quantity adds up:
+///   μ  = N·ρ·π r²          mass per length, kg/m
+///   EI = N·E·π r⁴/4        bending stiffness, N·m²
+///   GJ = N·G·π r⁴/2        twist stiffness, N·m²
+/// and the wisp's gravity bending length (EI/μg)^(1/3) is that of one fibre.
+struct Material {
+    float youngs = 3.8e9f;      ///< E, Pa
+    float shear = 1.3e9f;       ///< G, Pa
+    float density = 1300.f;     ///< ρ, kg/m³
+    float radius = 4e-5f;       ///< r, m (hair.radius.root: a uniform fibre)
+    float hairsPerGuide = 100.f;///< N
+
+    double area() const { return M_PI * double(radius) * radius; }
+    double massPerLength() const { return double(hairsPerGuide) * density * area(); }
+    double bendStiffness() const { return double(hairsPerGuide) * youngs * area() * radius * radius / 4.0; }
+    double twistStiffness() const { return double(hairsPerGuide) * shear * area() * radius * radius / 2.0; }
+};
+
+/// Constant data of one strand of `vertices` vertices for rodStep.
+struct RodStrand {
+    int vertices = 0;
+    const float* restLength = nullptr;     ///< l_j, vertices - 1 entries
+    const float* invMass = nullptr;        ///< w_i, vertices entries (w_0 = 0: kinematic root)
+    const Vec2f* restCurvature = nullptr;  ///< c_j, vertices - 1 entries (joint j; see bendConstraint)
+    Vec3f ghostDir = Vec3f::UnitY();       ///< rest direction of segment 0 in the root frame (root-local)
+    double bendStiffness = 0;              ///< EI, N·m²
+};
+
+/// Strands advanced together by rodSteps: their banded solves run side by
+/// side in SIMD lanes (each lane's arithmetic is that of a lone strand, so
+/// the result does not depend on how strands are batched).
+constexpr int kLanes = 4;
+
+/// Scratch for rodStep, reused between strands (one per thread).
+struct RodScratch {
+    std::vector<Vec3f> grad;      ///< per lane: 3 rows per joint × 3 vertices
+    std::vector<double> band;     ///< banded systems, (bandwidth + 1) per row, lanes interleaved
+    std::vector<double> rhs, invD;
+    std::vector<Vec3f> a;         ///< per lane: positions, predicted and at the step's start
+    std::vector<double> diag, lambda;  ///< stretchSolve's pivots and right-hand side
+    std::vector<Vec3f> dir;            ///< stretchSolve's segment directions
+};
+
+/// One strand's state and root target for rodSteps.
+struct RodStepTarget {
+    const RodStrand* strand = nullptr;
+    Vec3f* x = nullptr;                      ///< positions at the step's start; the step's end on return
+    Vec3f* v = nullptr;                      ///< velocities, likewise
+    Vec3f rootPos = Vec3f::Zero();           ///< root position at the step's end
+    Mat3f rootFrame = Mat3f::Identity();     ///< root frame at the step's end
+};
+
+/// The bending constraint of joint j, in the parent's transported frame
+/// (a_j, b_j = d_{j-1} × a_j, both ⊥ d_{j-1}):
+///   κb_j = 2 d_{j-1} × d_j / (1 + d_{j-1}·d_j)   (|κb| = 2 tan(θ/2), θ the turn)
+///   C_j = (κb_j·a_j, κb_j·b_j) - c_j
+/// with energy E_j = EI/(2 l̄_j) |C_j|², l̄_j = (l_{j-1} + l_j)/2, l̄_0 = l_0/2
+/// (the clamped end's Voronoi half-segment). Returns C_j and writes the
+/// gradients of its two rows with respect to x_{j-1}, x_j, x_{j+1} (the
+/// frame is held fixed: exact for the energy's gradient when c_j = 0, since
+/// κb ⊥ d_{j-1}; the frame's turn with d_{j-1} is neglected otherwise).
+/// For j = 0, `parent` is the ghost direction and g[·][0] is left zero.
+Vec2f bendConstraint(const Vec3f& parentDir, float parentLen, const Vec3f& e, const Vec3f& a, const Vec2f& c,
+                     bool ghost, Vec3f g[2][3]);
+
+/// Parallel transport of a ⊥ d onto d' (the rotation-minimising frame):
+///   a' = a - (d'·a)/(1 + d·d') · (d + d').
+inline Vec3f transportVector(const Vec3f& a, const Vec3f& d, const Vec3f& dNext) {
+    return a - (dNext.dot(a) / (1.f + d.dot(dNext))) * (d + dNext);
+}
+
+/// A unit vector ⊥ d taken from the root frame R (its tangent, else its
+/// bitangent): the start of the transported frame at the ghost segment.
+Vec3f frameStart(const Mat3f& R, const Vec3f& d);
+
+/// Writes the rest curvatures c_j (vertices - 1 entries) of the shape x with
+/// root frame R: C_j(x) = 0, so x is the stress-free shape.
+void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec2f* c);
+
+/// Adds to c the pre-load that balances per-vertex forces f at x:
+///   Σ_r ∇C_r Λ_r = -f  (the free vertices: 3(n-1) equations, 2(n-1) bend
+///   and n-1 stretch multipliers),  c_j += (l̄_j/EI)·Λ_bend,j,
+/// since a bend row's force multiplier is Λ = -C/α = (c - κ)/α.
+void preloadOffset(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f* force, Vec2f* c);
+
+/// Pre-loads c (holding the rest curvatures) so that x is an exact static
+/// equilibrium of rodStep with step h under gravity: preloadOffset for the
+/// weights, then three probe steps from rest, each cancelling the drift left.
+void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gravity, float h, Vec2f* c,
+             RodScratch& scratch);
+
+/// One XPBD step of length h for one strand (x: positions at the step's
+/// start, v: velocities; root at rootPos with frame rootFrame at the end):
+///  1. y = x + h·v + h²·g (root: its target; the root's velocity is real);
+///  2. one Newton step of XPBD on y: (J W Jᵀ + α̃) Δλ = -C(y), α̃ = l̄/(EI h²)
+///     for bend rows, 0 for stretch rows (hard), J the constraint gradients,
+///     W the inverse masses; the system is banded (bandwidth 8 over rows
+///     ordered joint by joint) and solved by banded LDLᵀ in double;
+///     y += W Jᵀ Δλ;
+///  3. exact lengths and head clearance root to tip (strand::placeSegment);
+///     a vertex that cannot be placed outside the head at its length is
+///     pinned: put back at its length toward its place at the step's start
+///     (counted in *pinned);
+///  4. v = (y - x)/h, Coulomb friction against the head's surface velocity,
+///     drag v·exp(-drag·h); x = y.
+/// Returns the number of pinned vertices.
+int rodStep(const RodStrand& s, Vec3f* x, Vec3f* v, const Vec3f& rootPos, const Mat3f& rootFrame,
+            const Vec3f& gravity, float h, float drag, float friction, const strand::HeadQuery* head, float radius,
+            RodScratch& scratch);
+
+/// rodStep for `count` (1..kLanes) strands of the same vertex count at once:
+/// the same result per strand, bit for bit (B-sim: 1.3–1.4× the throughput
+/// of one strand at a time). Returns the
+/// number of pinned vertices of all of them.
+int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, float h, float drag, float friction,
+             const strand::HeadQuery* head, float radius, RodScratch& scratch);
+
+/// Total bending energy Σ EI/(2 l̄_j)|C_j|² of a strand, J.
+double bendEnergy(const RodStrand& s, const Vec3f* x, const Mat3f& rootFrame);
+
+}  // namespace hp::rod
