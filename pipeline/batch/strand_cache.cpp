@@ -1,13 +1,12 @@
 #include "pipeline/batch/strand_cache.h"
 
 #include "core/errors.h"
+#include "core/bytes.h"
 #include "core/files.h"
-
-#include <zlib.h>
+#include "pipeline/batch/checksum.h"
 
 #include <cstring>
 #include <fstream>
-#include <limits>
 
 namespace hp {
 
@@ -16,67 +15,16 @@ namespace {
 constexpr char kMagic[8] = {'H', 'P', 'S', 'T', 'R', 'A', 'N', 'D'};
 constexpr uint32_t kHasVelocities = 1u;
 
-/// Appends raw bytes to a buffer while keeping a running CRC.
-class Writer {
-  public:
-    template <typename T>
-    void put(const T& value) { bytes(&value, sizeof(T)); }
-    template <typename T>
-    void array(const std::vector<T>& v) { bytes(v.data(), v.size() * sizeof(T)); }
-    void bytes(const void* data, size_t n) {
-        const auto* p = static_cast<const char*>(data);
-        buffer.insert(buffer.end(), p, p + n);
-    }
-    std::vector<char> buffer;
-};
-
-class Reader {
-  public:
-    Reader(const std::vector<char>& data, const std::string& file) : data_(data), file_(file) {}
-    template <typename T>
-    T get() {
-        T value;
-        bytes(&value, sizeof(T));
-        return value;
-    }
-    template <typename T>
-    void array(std::vector<T>& v, uint64_t count) {
-        if (count > remaining() / sizeof(T)) fail("truncated (arrays extend past the end of the file)");
-        v.resize(count);
-        bytes(v.data(), count * sizeof(T));
-    }
-    void bytes(void* out, size_t n) {
-        if (n > remaining()) fail("truncated");
-        if (n == 0) return;  // an empty array's data() may be null: memcpy(nullptr, ..., 0) is UB (UBSan)
-        std::memcpy(out, data_.data() + pos_, n);
-        pos_ += n;
-    }
-    size_t remaining() const { return data_.size() - pos_; }
-    [[noreturn]] void fail(const std::string& why) const { throw AssetError(file_, "strand cache " + why); }
-
-  private:
-    const std::vector<char>& data_;
-    std::string file_;
-    size_t pos_ = 0;
-};
-
-uint32_t crc(const char* data, size_t n) {
-    uLong c = crc32(0L, Z_NULL, 0);
-    // zlib takes uInt lengths: feed large buffers in pieces.
-    while (n > 0) {
-        const uInt chunk = uInt(std::min<size_t>(n, std::numeric_limits<uInt>::max()));
-        c = crc32(c, reinterpret_cast<const Bytef*>(data), chunk);
-        data += chunk;
-        n -= chunk;
-    }
-    return uint32_t(c);
+/// Reads a strand cache, naming the file in every refusal.
+ByteReader cacheReader(const std::vector<char>& data, const std::string& file) {
+    return ByteReader(data, [file](const std::string& why) { throw AssetError(file, "strand cache " + why); });
 }
 
 }  // namespace
 
 void writeStrandCache(const std::filesystem::path& path, const StrandFrame& frame) {
     frame.validate();
-    Writer w;
+    ByteWriter w;
     w.bytes(kMagic, sizeof kMagic);
     w.put(kStrandCacheVersion);
     const bool velocities = !frame.velocities.empty();
@@ -86,15 +34,15 @@ void writeStrandCache(const std::filesystem::path& path, const StrandFrame& fram
     w.put(double(frame.time));
     w.put(uint64_t(frame.strandCount()));
     w.put(uint64_t(frame.vertexCount()));
-    w.array(frame.offsets);
-    w.array(frame.ids);
+    w.values(frame.offsets);
+    w.values(frame.ids);
     static_assert(sizeof(Vec3f) == 3 * sizeof(float), "Vec3f must be packed");
-    w.array(frame.positions);
-    w.array(frame.radii);
-    if (velocities) w.array(frame.velocities);
-    w.put(crc(w.buffer.data(), w.buffer.size()));
+    w.values(frame.positions);
+    w.values(frame.radii);
+    if (velocities) w.values(frame.velocities);
+    w.put(crc32Of(w.data.data(), w.data.size()));
 
-    writeFileChecked(path, w.buffer.data(), w.buffer.size());
+    writeFileChecked(path, w.data.data(), w.data.size());
 }
 
 StrandFrame readStrandCache(const std::filesystem::path& path) {
@@ -102,7 +50,7 @@ StrandFrame readStrandCache(const std::filesystem::path& path) {
 }
 
 StrandFrame parseStrandCache(const std::vector<char>& data, const std::string& name) {
-    Reader r(data, name);
+    ByteReader r = cacheReader(data, name);
     char magic[8];
     r.bytes(magic, sizeof magic);
     if (std::memcmp(magic, kMagic, sizeof magic) != 0) r.fail("has a wrong magic number (not a hairpipe strand cache)");
@@ -112,7 +60,7 @@ StrandFrame parseStrandCache(const std::vector<char>& data, const std::string& n
     if (data.size() < sizeof(uint32_t)) r.fail("truncated");
     uint32_t stored;
     std::memcpy(&stored, data.data() + data.size() - sizeof stored, sizeof stored);
-    if (crc(data.data(), data.size() - sizeof stored) != stored)
+    if (crc32Of(data.data(), data.size() - sizeof stored) != stored)
         r.fail("checksum mismatch: the file is corrupt or was truncated");
 
     StrandFrame f;
@@ -127,11 +75,11 @@ StrandFrame parseStrandCache(const std::vector<char>& data, const std::string& n
                               ((flags & kHasVelocities) ? vertices * 12 : 0) + sizeof(uint32_t);
     if (strands > (1ull << 32) || vertices > (1ull << 32) || expected != r.remaining())
         r.fail(cat("sizes disagree with the file length (", strands, " strands, ", vertices, " vertices)"));
-    r.array(f.offsets, strands + 1);
-    r.array(f.ids, strands);
-    r.array(f.positions, vertices);
-    r.array(f.radii, vertices);
-    if (flags & kHasVelocities) r.array(f.velocities, vertices);
+    r.values(f.offsets, strands + 1);
+    r.values(f.ids, strands);
+    r.values(f.positions, vertices);
+    r.values(f.radii, vertices);
+    if (flags & kHasVelocities) r.values(f.velocities, vertices);
     try {
         f.validate();
     } catch (const Error& e) {

@@ -1,11 +1,11 @@
 #include "pipeline/groom/groom_settle.h"
 
+#include "core/bytes.h"
 #include "core/errors.h"
 #include "core/files.h"
 #include "core/log.h"
+#include "pipeline/batch/checksum.h"
 #include "pipeline/batch/output.h"
-
-#include <zlib.h>
 
 #include <algorithm>
 #include <cstring>
@@ -33,10 +33,6 @@ struct Fnv {
         for (const Vec3f& p : v) bytes(p.data(), sizeof(float) * 3);
     }
 };
-
-uint32_t crc(const std::vector<char>& b, size_t n) {
-    return uint32_t(crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(b.data()), uInt(n)));
-}
 
 }  // namespace
 
@@ -80,25 +76,22 @@ uint64_t settleKey(const GuideSettings& settings, const std::vector<SurfaceFrame
 }
 
 void writeSettledGroom(const fs::path& file, uint64_t key, const SettledGroom& g) {
-    std::vector<char> b;
-    auto put = [&](const void* p, size_t n) { b.insert(b.end(), static_cast<const char*>(p), static_cast<const char*>(p) + n); };
-    const uint32_t converged = g.converged, strands = uint32_t(g.strands.size()),
-                   vertices = strands ? uint32_t(g.strands[0].size()) : 0;
-    put(kMagic, 8);
-    put(&kVersion, 4);
-    put(&key, 8);
-    put(&g.seconds, 8);
-    put(&g.kineticEnergy, 8);
-    put(&converged, 4);
-    put(&strands, 4);
-    put(&vertices, 4);
+    const uint32_t strands = uint32_t(g.strands.size()), vertices = strands ? uint32_t(g.strands[0].size()) : 0;
+    ByteWriter w;
+    w.bytes(kMagic, 8);
+    w.put(kVersion);
+    w.put(key);
+    w.put(g.seconds);
+    w.put(g.kineticEnergy);
+    w.put(uint32_t(g.converged));
+    w.put(strands);
+    w.put(vertices);
     for (const auto& s : g.strands) {
         if (s.size() != vertices) throw Error("settled groom: strands of different lengths");
-        put(s.data(), s.size() * 12);
+        w.values(s);
     }
-    const uint32_t c = crc(b, b.size());
-    put(&c, 4);
-    writeAtomically(file, [&](const fs::path& tmp) { writeFileChecked(tmp, b.data(), b.size()); });
+    w.put(crc32Of(w.data.data(), w.data.size()));
+    writeAtomically(file, [&](const fs::path& tmp) { writeFileChecked(tmp, w.data.data(), w.data.size()); });
 }
 
 bool readSettledGroom(const fs::path& file, uint64_t key, SettledGroom& g) {
@@ -110,24 +103,28 @@ bool readSettledGroom(const fs::path& file, uint64_t key, SettledGroom& g) {
     } catch (const AssetError&) {
         return false;
     }
-    constexpr size_t kHeader = 8 + 4 + 8 + 8 + 8 + 4 + 4 + 4;
-    if (b.size() < kHeader + 4 || std::memcmp(b.data(), kMagic, 8) != 0) return false;
-    uint32_t version, converged, strands, vertices, stored;
-    uint64_t fileKey;
-    std::memcpy(&version, b.data() + 8, 4);
-    std::memcpy(&fileKey, b.data() + 12, 8);
-    std::memcpy(&stored, b.data() + b.size() - 4, 4);
-    if (version != kVersion || fileKey != key || stored != crc(b, b.size() - 4)) return false;
-    std::memcpy(&g.seconds, b.data() + 20, 8);
-    std::memcpy(&g.kineticEnergy, b.data() + 28, 8);
-    std::memcpy(&converged, b.data() + 36, 4);
-    std::memcpy(&strands, b.data() + 40, 4);
-    std::memcpy(&vertices, b.data() + 44, 4);
-    if (uint64_t(strands) * vertices * 12 != b.size() - kHeader - 4) return false;
-    g.converged = converged != 0;
-    g.strands.assign(strands, std::vector<Vec3f>(vertices));
-    for (uint32_t s = 0; s < strands; ++s)
-        std::memcpy(static_cast<void*>(g.strands[s].data()), b.data() + kHeader + size_t(s) * vertices * 12, size_t(vertices) * 12);
+    // A cache that does not match (other keys, another version, damaged) is
+    // simply not reused: the groom is settled again and the file rewritten.
+    struct Stale {};
+    ByteReader r(b, [](const std::string&) { throw Stale{}; });
+    try {
+        char magic[8];
+        r.bytes(magic, 8);
+        if (std::memcmp(magic, kMagic, 8) != 0 || r.get<uint32_t>() != kVersion || r.get<uint64_t>() != key)
+            return false;
+        uint32_t stored;
+        std::memcpy(&stored, b.data() + b.size() - 4, 4);
+        if (stored != crc32Of(b.data(), b.size() - 4)) return false;
+        g.seconds = r.get<double>();
+        g.kineticEnergy = r.get<double>();
+        g.converged = r.get<uint32_t>() != 0;
+        const uint32_t strands = r.get<uint32_t>(), vertices = r.get<uint32_t>();
+        if (r.remaining() < 4 || uint64_t(strands) * vertices * 12 != r.remaining() - 4) return false;
+        g.strands.assign(strands, {});
+        for (auto& s : g.strands) r.values(s, vertices);
+    } catch (const Stale&) {
+        return false;
+    }
     g.fromCache = true;
     return true;
 }

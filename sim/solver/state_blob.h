@@ -3,60 +3,35 @@
 // bits it saved.
 #pragma once
 
+#include "core/bytes.h"
 #include "core/errors.h"
 
-#include <cstring>
 #include <string>
 #include <vector>
 
 namespace hp {
 
-class BlobWriter {
+/// Checkpoint arrays carry their element count, checked on restore.
+class BlobWriter : public ByteWriter {
   public:
     template <typename T>
-    void put(const T& value) { bytes(&value, sizeof(T)); }
-    template <typename T>
-    void array(const std::vector<T>& v) {
-        put(uint64_t(v.size()));
-        bytes(v.data(), v.size() * sizeof(T));
-    }
-    void bytes(const void* p, size_t n) {
-        const char* c = static_cast<const char*>(p);
-        data.insert(data.end(), c, c + n);
-    }
-    std::vector<char> data;
+    void array(const std::vector<T>& v) { sized(v); }
 };
 
-class BlobReader {
+class BlobReader : public ByteReader {
   public:
-    BlobReader(const std::vector<char>& data, std::string what) : data_(data), what_(std::move(what)) {}
-    template <typename T>
-    T get() {
-        T value;
-        bytes(&value, sizeof(T));
-        return value;
-    }
+    BlobReader(const std::vector<char>& data, std::string what)
+        : ByteReader(data, [what](const std::string& why) { throw Error(what + ": checkpoint is " + why); }) {}
     /// Reads an array that must have `expected` elements (the solver's own size).
     template <typename T>
     void array(std::vector<T>& v, size_t expected) {
         const uint64_t n = get<uint64_t>();
-        if (n != expected) throw Error(cat(what_, ": checkpoint holds ", n, " values where ", expected, " are expected"));
-        v.resize(n);
-        bytes(v.data(), n * sizeof(T));
-    }
-    void bytes(void* p, size_t n) {
-        if (n > data_.size() - pos_) throw Error(what_ + ": checkpoint is truncated");
-        std::memcpy(p, data_.data() + pos_, n);
-        pos_ += n;
+        if (n != expected) fail(cat("holding ", n, " values where ", expected, " are expected"));
+        values(v, n);
     }
     void finish() const {
-        if (pos_ != data_.size()) throw Error(what_ + ": checkpoint has trailing data");
+        if (remaining() != 0) fail("followed by trailing data");
     }
-
-  private:
-    const std::vector<char>& data_;
-    std::string what_;
-    size_t pos_ = 0;
 };
 
 }  // namespace hp
