@@ -1,5 +1,6 @@
 #include "sim/curly/curly_dynamics.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hp::curly {
@@ -15,6 +16,24 @@ void StrandScratch::resize(size_t n) {
     rhs.resize(n);
     diag.resize(n);
     upper.resize(n);
+}
+
+MaterialSprings materialSprings(const rod::Material& m, float R, float P, float l, float mass, float h) {
+    MaterialSprings out;
+    out.massPerLength = float(m.massPerLength());
+    const double mu = mass >= 0.f ? double(mass) : m.massPerLength();
+    out.ks = float(1e4 * mu * l / (double(h) * h));
+    const double EI = m.bendStiffness(), GJ = m.twistStiffness();
+    double kb = EI / (double(l) * l * l);  // the straight rod's cap
+    if (R > 0.f) {
+        const double alpha = std::atan2(double(P), 2.0 * M_PI * R);
+        const double c2 = std::cos(alpha) * std::cos(alpha), s2 = 1.0 - c2;
+        const double compliance = double(R) * R * l * (c2 / GJ + s2 / EI);  // c_l, m/N
+        kb = std::min(kb, c2 / compliance);
+    }
+    out.kb = float(kb);
+    out.kc = 0.f;
+    return out;
 }
 
 bool implicitStep(const Vec3f* x, const Vec3f* v, size_t n, const Mat3f& root, const Vec3f& rootVelocity,
