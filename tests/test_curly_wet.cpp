@@ -1,5 +1,5 @@
 // The curly/wet guide solver (sim/curly/curly_wet.h) in Bullet worlds: curls that
-// survive a bouncing head, dry hair unaffected by the wet machinery, cohesion
+// survive a bouncing head (hanging curls: test_curly_hang.cpp), dry hair unaffected by the wet machinery, cohesion
 // that clumps wet strands only, adhesion that holds wet hair to the head,
 // stability under fast rotation, and thread-count independence.
 #include "core/errors.h"
@@ -9,6 +9,7 @@
 #include "sim/strands/fibonacci.h"
 #include "sim/strands/head.h"
 
+#include "curly_support.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -25,59 +26,11 @@
 namespace hp {
 namespace {
 
-/// A rigid sphere head whose centre follows `path(t)` (no rotation).
-class MovingSphere final : public HeadMotion {
-  public:
-    MovingSphere(float radius, std::function<Vec3f(double)> path) : radius_(radius), path_(std::move(path)) {}
-    HeadPose sample(double time) const override {
-        HeadPose pose;
-        pose.time = time;
-        pose.transform = Eigen::Isometry3f(Eigen::Translation3f(path_(time)));
-        pose.collider = std::make_shared<SphereCollider>(path_(time), radius_);
-        return pose;
-    }
-
-  private:
-    float radius_;
-    std::function<Vec3f(double)> path_;
-};
-
-/// Root frames of head-fixed directions on a sphere of `radius`, posed.
-std::vector<SurfaceFrame> rootFrames(const std::vector<Vec3f>& dirs, const HeadPose& pose, float radius) {
-    std::vector<SurfaceFrame> roots(dirs.size());
-    for (size_t i = 0; i < dirs.size(); ++i) {
-        const Vec3f n = dirs[i];
-        Vec3f t = Vec3f::UnitY().cross(n);
-        if (t.squaredNorm() < 1e-8f) t = Vec3f::UnitX();
-        roots[i].position = pose.transform * (radius * n);
-        roots[i].normal = pose.transform.linear() * n;
-        roots[i].tangent = pose.transform.linear() * t.normalized();
-    }
-    return roots;
-}
-
-/// Runs `steps` steps of `head`; calls `each` after every step.
-void simulate(CurlyWetSolver& solver, const HeadMotion& head, const std::vector<Vec3f>& dirs, float radius, int steps,
-              const std::function<void(const CurlyWetStats&)>& each = {}) {
-    const double dt = solver.settings().timeStep;
-    for (int k = 0; k < steps; ++k) {
-        const HeadPose pose = head.sample(solver.time() + dt);
-        const CurlyWetStats& s = solver.step(rootFrames(dirs, pose, radius), pose);
-        if (each) each(s);
-    }
-}
-
-void start(CurlyWetSolver& solver, const HeadMotion& head, const std::vector<Vec3f>& dirs, float radius,
-           const std::vector<std::vector<Vec3f>>* groom = nullptr) {
-    const HeadPose pose = head.sample(0.0);
-    solver.initialize(rootFrames(dirs, pose, radius), pose, groom);
-}
-
-std::vector<Vec3f> positions(const CurlyWetSolver& solver) {
-    StrandFrame f;
-    solver.write(f);
-    return f.positions;
-}
+using test::MovingSphere;
+using test::positions;
+using test::rootFrames;
+using test::simulate;
+using test::start;
 
 /// Mean over particles [from, n) of the distance to the nearest particle of
 /// another strand.
@@ -377,119 +330,6 @@ TEST(CurlyWet, WritesInterpolatedFramesAndResetsOnTeleport) {
     solver.write(mid, solver.time() - 0.5 * s.timeStep);
     EXPECT_EQ(mid.vertexCount(), f.vertexCount());
     EXPECT_THROW(solver.write(mid, solver.time() - 2.0 * s.timeStep), Error);
-}
-
-/// Curls rooted under a still head, hanging straight down for 2 s: the
-/// curl's (radius, pitch) before and after.
-std::pair<Eigen::Vector2f, Eigen::Vector2f> hangCurls(bool preload) {
-    const MovingSphere head(0.1f, [](double) { return Vec3f::Zero(); });
-    const std::vector<Vec3f> dirs = fibonacciCap(6, -Vec3f::UnitY(), 0.9f);
-    CurlyWetSettings s;
-    s.preload = preload;
-    CurlyWetSolver solver(s);
-    start(solver, head, dirs, 0.1f);
-    const Eigen::Vector2f rest = solver.measureCurl();
-    simulate(solver, head, dirs, 0.1f, 100);
-    const Eigen::Vector2f c = solver.measureCurl();
-    std::printf("hanging curl, preload %s: radius %.2f -> %.2f mm, pitch %.2f -> %.2f mm\n", preload ? "on" : "off",
-                1e3f * rest.x(), 1e3f * c.x(), 1e3f * rest.y(), 1e3f * c.y());
-    return {rest, c};
-}
-
-TEST(CurlyWet, HangingDryCurlKeepsItsShapeWithPreload) {
-    // Pre-loaded, the helix is the equilibrium under gravity: radius and
-    // pitch hold within 10%.
-    const auto [rest, held] = hangCurls(true);
-    EXPECT_NEAR(held.x(), rest.x(), 0.1f * rest.x());
-    EXPECT_NEAR(held.y(), rest.y(), 0.1f * rest.y());
-}
-
-/// One curl hanging straight down from the bottom of a still sphere (its
-/// axis along gravity), released from rest without the pre-load and left 3 s
-/// to settle: its median pitch (fitHelix, skipping the first `skip` edges)
-/// before and after, and the settled kinetic energy.
-struct Hang {
-    Eigen::Vector2f rest, hung;
-    double energy = 0;
-};
-Hang hangOneCurl(const CurlyWetSettings& s) {
-    const MovingSphere head(0.1f, [](double) { return Vec3f::Zero(); });
-    const std::vector<Vec3f> dirs = {-Vec3f::UnitY()};
-    CurlyWetSolver solver(s);
-    start(solver, head, dirs, 0.1f);
-    Hang h;
-    h.rest = solver.measureCurl();
-    simulate(solver, head, dirs, 0.1f, 150, [&](const CurlyWetStats& st) {
-        EXPECT_EQ(st.nanCount, 0u);
-        EXPECT_EQ(st.implicitFailures, 0u);
-        h.energy = st.kineticEnergy;
-    });
-    h.hung = solver.measureCurl();
-    return h;
-}
-
-/// The pitch strain a helical coil spring hanging under its own weight has
-/// at arc length s from the root, by Castigliano (linear, close to rest): a
-/// wire of length L, mass per length μ, rigidities EI and GJ, coiled at
-/// radius R and pitch angle α (axis vertical). The weight below s, F(s) =
-/// μ g (L - s), is a moment F·R in the wire, a twist F·R·cos α and a bend
-/// F·R·sin α; the energy per wire length ½F²R²(cos²α/GJ + sin²α/EI) gives the
-/// extension per wire length F·R²(cos²α/GJ + sin²α/EI), per axial length that
-/// over sin α: ε(s) = μ g (L - s) R² (cos²α/GJ + sin²α/EI) / sin α.
-/// (The whole coil extends by ½·μgL·R²L(cos²α/GJ + sin²α/EI): a uniform
-/// self-weight gives half the extension of the same load hung at the end.)
-double coilStrain(double s, double L, double mu, double EI, double GJ, double R, double pitch, double g) {
-    const double alpha = std::atan(pitch / (2.0 * M_PI * R));
-    const double c = std::cos(alpha), sn = std::sin(alpha);
-    return mu * g * (L - s) * R * R * (c * c / GJ + sn * sn / EI) / sn;
-}
-
-TEST(CurlyWet, HangingDryCurlStretchesWithoutPreload) {
-    // Real hair's weight and stiffness (the rod's material: a wisp of 100
-    // hairs of 40 µm radius, E = 3.8 GPa, G = 1.3 GPa) in 1 cm curls of 4 cm
-    // pitch: without the pre-load a ringlet extends under its own weight,
-    // and by how much is the coil spring's closed form above, with the
-    // wisp's μ, EI, GJ computed here from the fibre, not read from the solver.
-    CurlyWetSettings s;
-    s.preload = false;
-    const double r = s.material.radius, N = s.material.hairsPerGuide;
-    const double mu = N * s.material.density * M_PI * r * r;
-    const double EI = N * s.material.youngs * M_PI * std::pow(r, 4) / 4.0;
-    const double GJ = N * s.material.shear * M_PI * std::pow(r, 4) / 2.0;
-    const double g = 9.81, L = s.length;
-    for (int particles : {24, 40}) {
-        s.particles = particles;
-        // fitHelix's median is the triple centred on edge (skip + n - 3)/2,
-        // whose middle is at arc length (that + ½)·l.
-        const double l = L / (particles - 1), skip = 3;
-        const double sMedian = (std::floor((skip + particles - 3) / 2.0) + 0.5) * l;
-        const double expected = coilStrain(sMedian, L, mu, EI, GJ, s.curlRadius, s.curlPitch, g);
-        const Hang h = hangOneCurl(s);
-        const double measured = h.hung.y() / h.rest.y() - 1.0;
-        std::printf("hanging curl, %d particles, no preload: pitch %.2f -> %.2f mm (strain %.1f%%; coil theory "
-                    "%.1f%%), radius %.2f -> %.2f mm, kinetic energy %.2g J\n",
-                    particles, 1e3f * h.rest.y(), 1e3f * h.hung.y(), 100 * measured, 100 * expected,
-                    1e3f * h.rest.x(), 1e3f * h.hung.x(), h.energy);
-        EXPECT_LT(h.energy, 1e-9) << "settled";
-        // Measured: 10.3% (24 particles) and 9.3% (40) against the coil's
-        // 23.7% and 24.6%, the discrete model 2.3-2.6× stiffer than the coil
-        // (springs anchored to frames on the smoothed curve, ~7 edges per
-        // turn; the same ratio at both resolutions and for smoothing lengths
-        // of 5 to 20 cm). The band below accepts that and rejects a mapping
-        // off by the factor 25 the seed's springs are (next check).
-        EXPECT_GT(measured, 0.3 * expected) << "a ringlet visibly extends under its own weight";
-        EXPECT_LT(measured, 1.3 * expected);
-
-        // The seed's springs on the same real hair's weight hold the curl:
-        // the check above can fail.
-        CurlyWetSettings seed = CurlyWetSettings::seedSprings();
-        seed.preload = false;
-        seed.particles = particles;
-        seed.massPerLength = float(mu);
-        const Hang held = hangOneCurl(seed);
-        std::printf("  the seed's springs: pitch %.2f -> %.2f mm\n", 1e3f * held.rest.y(), 1e3f * held.hung.y());
-        EXPECT_LT(held.hung.y() / held.rest.y() - 1.0, 0.1 * expected);
-    }
 }
 
 TEST(CurlyWet, NonFiniteImplicitStepIsCountedNotSilent) {
