@@ -47,7 +47,8 @@ bool implicitStep(const Vec3f* x, const Vec3f* v, size_t n, const Mat3f& root, c
     const size_t edges = n - 1;
     // Bending frames on the smoothed curve (eq. 2-3), core edges b_i and the
     // smoothed velocity differences ν_i (eq. 5).
-    smoothEdges(x, n, k.betaBend, s.d.data());
+    const Vec3f start = bendingCurveStart(x, root);
+    smoothEdges(x, n, k.betaBend, s.d.data(), &start);
     transportFrames(s.d.data(), edges, root, s.frames.data());
     if (k.kc > 0.f || k.cc > 0.f) {
         smoothEdges(x, n, k.betaCore, s.b.data());
@@ -134,7 +135,8 @@ void restData(const Vec3f* p, size_t n, const Mat3f& root, const StrandCoefficie
     const size_t edges = n - 1;
     std::vector<Vec3f> d(edges), b(edges);
     std::vector<Mat3f> frames(edges);
-    smoothEdges(p, n, k.betaBend, d.data());
+    const Vec3f start = bendingCurveStart(p, root);
+    smoothEdges(p, n, k.betaBend, d.data(), &start);
     transportFrames(d.data(), edges, root, frames.data());
     smoothEdges(p, n, k.betaCore, b.data());
     Vec3f weight = Vec3f::Zero();  // W_i = g Σ_{k>i} m_k
