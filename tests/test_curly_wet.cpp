@@ -73,14 +73,15 @@ TEST(CurlyWet, RestShapeIsCurlyAndHoldsStill) {
 
 TEST(CurlyWet, CurlRadiusAndPitchSurviveABouncingHead) {
     // The seed's springs, set explicitly (hair.curly.*_stiffness given):
-    // they hold curls against a 1.8 g bounce. The material's do not, as real
-    // ringlets do not (they open by ~28% here); HangingDryCurlStretches...
-    // checks their stiffness against the coil spring's.
+    // they hold curls against a 1.8 g bounce. The material's, like real
+    // ringlets, stretch; test_curly_hang.cpp checks their stiffness against
+    // the coil spring's.
     const CurlyWetSettings s = CurlyWetSettings::seedSprings();
     CurlyWetSolver solver(s);
-    // 5 cm bounces at 3 Hz (peak 1.8 g) for a second, then still. Hair
-    // standing on the head flops over; the curls must not open or unwind.
-    // (With kb = kc = 5 N/m instead of 20 the pitch opens by 70%.)
+    // 5 cm bounces at 3 Hz (peak 1.8 g) for a second, then still. The hair
+    // swings (19 mm at most relative to the head since the bending frames
+    // start along the root normal; 27 cm before, when it flopped over); the
+    // curls must not open or unwind.
     const MovingSphere head(0.1f, [](double t) {
         return Vec3f(0.f, t < 1.0 ? 0.05f * float(std::sin(6.0 * M_PI * t)) : 0.f, 0.f);
     });
