@@ -55,11 +55,12 @@ struct CurlyWetSettings {
     int substeps = 1;               ///< Bullet steps per step
     int iterations = 8;             ///< Bullet link (inextensibility) iterations per Bullet step
 
-    // Material and springs (seed eq. 1, 4, 5). Mass and the bending and core
-    // springs follow from `material` (the rod formulation's fibre and wisp)
-    // and the curl where they are kFromMaterial (the default):
-    // curly::materialSprings, sim/curly/curly_dynamics.h. A value ≥ 0 is used
-    // as given (the seed's: 0.005 kg/m, ks = 5000, kb = kc = 20 N/m).
+    // Material and springs (seed eq. 1, 4, 5). Mass and the stretch, bending
+    // and core springs follow from `material` (the rod formulation's fibre
+    // and wisp), the curl and the step where they are kFromMaterial (the
+    // default): curly::materialSprings, sim/curly/curly_dynamics.h; so does
+    // helixWeight (5 kb). A value ≥ 0 is used as given (the seed's:
+    // 0.005 kg/m, ks = 5000, kb = kc = 20 N/m, w_h = 100 N/m).
     rod::Material material;         ///< E, G, ρ, fibre radius, hairs per guide
     float massPerLength = kFromMaterial; ///< kg/m (a guide stands for a clump of hairs)
     Vec3f gravity = Vec3f(0.f, -9.81f, 0.f);  ///< m/s²
