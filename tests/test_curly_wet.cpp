@@ -1,5 +1,5 @@
 // The curly/wet guide solver (sim/curly/curly_wet.h) in Bullet worlds: curls that
-// survive a bouncing head, dry hair unaffected by the wet machinery, cohesion
+// survive a bouncing head (hanging curls: test_curly_hang.cpp), dry hair unaffected by the wet machinery, cohesion
 // that clumps wet strands only, adhesion that holds wet hair to the head,
 // stability under fast rotation, and thread-count independence.
 #include "core/errors.h"
@@ -9,6 +9,7 @@
 #include "sim/strands/fibonacci.h"
 #include "sim/strands/head.h"
 
+#include "curly_support.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -25,59 +26,11 @@
 namespace hp {
 namespace {
 
-/// A rigid sphere head whose centre follows `path(t)` (no rotation).
-class MovingSphere final : public HeadMotion {
-  public:
-    MovingSphere(float radius, std::function<Vec3f(double)> path) : radius_(radius), path_(std::move(path)) {}
-    HeadPose sample(double time) const override {
-        HeadPose pose;
-        pose.time = time;
-        pose.transform = Eigen::Isometry3f(Eigen::Translation3f(path_(time)));
-        pose.collider = std::make_shared<SphereCollider>(path_(time), radius_);
-        return pose;
-    }
-
-  private:
-    float radius_;
-    std::function<Vec3f(double)> path_;
-};
-
-/// Root frames of head-fixed directions on a sphere of `radius`, posed.
-std::vector<SurfaceFrame> rootFrames(const std::vector<Vec3f>& dirs, const HeadPose& pose, float radius) {
-    std::vector<SurfaceFrame> roots(dirs.size());
-    for (size_t i = 0; i < dirs.size(); ++i) {
-        const Vec3f n = dirs[i];
-        Vec3f t = Vec3f::UnitY().cross(n);
-        if (t.squaredNorm() < 1e-8f) t = Vec3f::UnitX();
-        roots[i].position = pose.transform * (radius * n);
-        roots[i].normal = pose.transform.linear() * n;
-        roots[i].tangent = pose.transform.linear() * t.normalized();
-    }
-    return roots;
-}
-
-/// Runs `steps` steps of `head`; calls `each` after every step.
-void simulate(CurlyWetSolver& solver, const HeadMotion& head, const std::vector<Vec3f>& dirs, float radius, int steps,
-              const std::function<void(const CurlyWetStats&)>& each = {}) {
-    const double dt = solver.settings().timeStep;
-    for (int k = 0; k < steps; ++k) {
-        const HeadPose pose = head.sample(solver.time() + dt);
-        const CurlyWetStats& s = solver.step(rootFrames(dirs, pose, radius), pose);
-        if (each) each(s);
-    }
-}
-
-void start(CurlyWetSolver& solver, const HeadMotion& head, const std::vector<Vec3f>& dirs, float radius,
-           const std::vector<std::vector<Vec3f>>* groom = nullptr) {
-    const HeadPose pose = head.sample(0.0);
-    solver.initialize(rootFrames(dirs, pose, radius), pose, groom);
-}
-
-std::vector<Vec3f> positions(const CurlyWetSolver& solver) {
-    StrandFrame f;
-    solver.write(f);
-    return f.positions;
-}
+using test::MovingSphere;
+using test::positions;
+using test::rootFrames;
+using test::simulate;
+using test::start;
 
 /// Mean over particles [from, n) of the distance to the nearest particle of
 /// another strand.
@@ -119,11 +72,16 @@ TEST(CurlyWet, RestShapeIsCurlyAndHoldsStill) {
 }
 
 TEST(CurlyWet, CurlRadiusAndPitchSurviveABouncingHead) {
-    CurlyWetSettings s;
+    // The seed's springs, set explicitly (hair.curly.*_stiffness given):
+    // they hold curls against a 1.8 g bounce. The material's, like real
+    // ringlets, stretch; test_curly_hang.cpp checks their stiffness against
+    // the coil spring's.
+    const CurlyWetSettings s = CurlyWetSettings::seedSprings();
     CurlyWetSolver solver(s);
-    // 5 cm bounces at 3 Hz (peak 1.8 g) for a second, then still. Hair
-    // standing on the head flops over; the curls must not open or unwind.
-    // (With kb = kc = 5 N/m instead of 20 the pitch opens by 70%.)
+    // 5 cm bounces at 3 Hz (peak 1.8 g) for a second, then still. The hair
+    // swings (19 mm at most relative to the head since the bending frames
+    // start along the root normal; 27 cm before, when it flopped over); the
+    // curls must not open or unwind.
     const MovingSphere head(0.1f, [](double t) {
         return Vec3f(0.f, t < 1.0 ? 0.05f * float(std::sin(6.0 * M_PI * t)) : 0.f, 0.f);
     });
@@ -278,7 +236,7 @@ TEST(CurlyWet, StableUnderFastRotationWithCohesion) {
     start(solver, head, dirs, 0.1f);
     // Bound: every particle co-rotating rigidly at the strand's full reach.
     const double omega = rate * M_PI / 180.0;
-    const double mass = double(dirs.size()) * s.length * s.massPerLength;
+    const double mass = double(dirs.size()) * s.length * solver.settings().massPerLength;
     const double bound = 0.5 * mass * std::pow(omega * (0.1 + s.length), 2);
     CurlyWetStats acc;
     std::vector<double> energy;
@@ -375,39 +333,6 @@ TEST(CurlyWet, WritesInterpolatedFramesAndResetsOnTeleport) {
     EXPECT_THROW(solver.write(mid, solver.time() - 2.0 * s.timeStep), Error);
 }
 
-/// Curls rooted under a still head, hanging straight down for 2 s: the
-/// curl's (radius, pitch) before and after.
-std::pair<Eigen::Vector2f, Eigen::Vector2f> hangCurls(bool preload) {
-    const MovingSphere head(0.1f, [](double) { return Vec3f::Zero(); });
-    const std::vector<Vec3f> dirs = fibonacciCap(6, -Vec3f::UnitY(), 0.9f);
-    CurlyWetSettings s;
-    s.preload = preload;
-    CurlyWetSolver solver(s);
-    start(solver, head, dirs, 0.1f);
-    const Eigen::Vector2f rest = solver.measureCurl();
-    simulate(solver, head, dirs, 0.1f, 100);
-    const Eigen::Vector2f c = solver.measureCurl();
-    std::printf("hanging curl, preload %s: radius %.2f -> %.2f mm, pitch %.2f -> %.2f mm\n", preload ? "on" : "off",
-                1e3f * rest.x(), 1e3f * c.x(), 1e3f * rest.y(), 1e3f * c.y());
-    return {rest, c};
-}
-
-TEST(CurlyWet, HangingDryCurlKeepsItsShapeWithPreload) {
-    // Pre-loaded, the helix is the equilibrium under gravity: radius and
-    // pitch hold within 10%.
-    const auto [rest, held] = hangCurls(true);
-    EXPECT_NEAR(held.x(), rest.x(), 0.1f * rest.x());
-    EXPECT_NEAR(held.y(), rest.y(), 0.1f * rest.y());
-}
-
-// Not met yet (issue 18, test 5): without the pre-load a hanging curl of
-// real hair extends under its own weight, but the seed's spring constants
-// (kb = kc = 20 N/m) hold it: the pitch opens by 0.25% (40.00 -> 40.10 mm).
-TEST(CurlyWet, DISABLED_HangingDryCurlStretchesWithoutPreload) {
-    const auto [rest, sagged] = hangCurls(false);
-    EXPECT_GT(sagged.y(), 1.1f * rest.y()) << "without the pre-load gravity stretches the curl";
-}
-
 TEST(CurlyWet, NonFiniteImplicitStepIsCountedNotSilent) {
     // A stretch stiffness at the float limit overflows the implicit system
     // (h²·ks·|e| is not finite): the step must say so instead of quietly
@@ -470,8 +395,21 @@ hair:
     EXPECT_EQ(s.particles, 16);
     EXPECT_FLOAT_EQ(s.curlRadius, 0.006f);
     EXPECT_FLOAT_EQ(s.curlPitch, 0.02f);
-    EXPECT_FLOAT_EQ(s.bendStiffness, 12.f);
+    EXPECT_FLOAT_EQ(s.bendStiffness, 12.f);  // given: the seed's spring model
     EXPECT_EQ(s.iterations, 5);
+    // Not given: from hair.material and hair.radius.root, as for the rod.
+    EXPECT_LT(s.coreStiffness, 0.f);
+    EXPECT_LT(s.massPerLength, 0.f);
+    EXPECT_FLOAT_EQ(s.material.youngs, 3.8e9f);
+    EXPECT_FLOAT_EQ(s.material.radius, 4e-5f);
+    const CurlyWetSettings m = curlyWetSettings(Scene::parse(
+        "hair: {model: curly-wet, radius: {root: 0.00005}, material: {density: 1000, hairs_per_guide: 10}}\n",
+        "m.yaml", "."));
+    const CurlyWetSettings r = m.resolved();
+    EXPECT_NEAR(r.massPerLength, 10 * 1000 * M_PI * 25e-10, 1e-9);  // N·ρ·πr²
+    EXPECT_GT(r.bendStiffness, 0.f);
+    EXPECT_EQ(r.coreStiffness, 0.f);
+    EXPECT_FLOAT_EQ(r.helixWeight, 5.f * r.bendStiffness);
     EXPECT_FLOAT_EQ(s.saturationRoot, 0.3f);
     EXPECT_FALSE(s.cohesion);
     EXPECT_FLOAT_EQ(s.adhesionWeight, 2000.f);

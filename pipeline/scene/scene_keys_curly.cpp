@@ -26,18 +26,28 @@ void addCurlyKeys(SchemaBuilder& b) {
         .number("hair.curly.time_step", 0.02, 1e-4, 0.1, "s", "Simulation step.")
         .integer("hair.curly.substeps", 1, 1, 64, "", "Bullet steps per simulation step.")
         .integer("hair.curly.iterations", 8, 1, 200, "", "Bullet link (inextensibility) iterations per Bullet step.")
-        .number("hair.curly.mass_per_length", 0.005, 1e-6, 10, "kg/m", "Mass per length (a guide stands for a clump).")
+        .number("hair.curly.mass_per_length", 0.005, 1e-6, 10, "kg/m",
+                "Only when given (the seed's value is the default shown): mass per length of a guide. Unset, it is "
+                "the wisp's N·ρ·πr² from hair.material and hair.radius.root, as for the rod.")
         .vec3("hair.curly.gravity", 0, -9.81, 0, "m/s²", "Gravity.")
         .flag("hair.curly.preload", true, "Pre-load the bending springs so the rest shape holds under gravity at the "
                                           "first frame.")
-        .number("hair.curly.stretch_stiffness", 5000, 0, 1e7, "N/m", "ks of the stretch springs (seed eq. 1).")
+        .number("hair.curly.stretch_stiffness", 5000, 0, 1e7, "N/m",
+                "Only when given (the seed's value is the default shown): ks of the stretch springs (seed eq. 1). "
+                "Unset, it follows the particle mass m and the Bullet step h: ks = 10⁴·m/h² (the links keep the "
+                "edges inextensible; a stiffer spring destabilises the step with light, physical particles).")
         .number("hair.curly.stretch_damping", 0.05, 0, 1e4, "N·s/m", "cs of the stretch springs.")
-        .number("hair.curly.bend_stiffness", 20, 0, 1e6, "N/m", "kb of the bending springs (seed eq. 4).")
+        .number("hair.curly.bend_stiffness", 20, 0, 1e6, "N/m",
+                "Only when given (the seed's value is the default shown): kb of the bending springs (seed eq. 4). "
+                "Unset, it is derived from hair.material and the curl so that a curl stretches under load as a "
+                "helical coil of that wire does (Castigliano; README, curly hair).")
         .number("hair.curly.bend_damping", 0.02, 0, 1e4, "N·s/m", "cb of the bending springs.")
         .number("hair.curly.bend_smoothing", 0.05, 0, 10, "m",
                 "α of the smoothing filter whose curve carries the bending frames (seed eq. 2); 0: none.")
         .number("hair.curly.core_stiffness", 20, 0, 1e6, "N/m",
-                "kc of the core springs on the smoothed curve (seed eq. 5): keeps curls from unwinding.")
+                "Only when given (the seed's value is the default shown): kc of the core springs on the smoothed "
+                "curve (seed eq. 5), stiffening curls against being pulled straight. Unset, 0: the derived kb already "
+                "carries the coil's whole stiffness.")
         .number("hair.curly.core_damping", 0.02, 0, 1e4, "N·s/m", "cc of the core springs.")
         .number("hair.curly.core_smoothing", 0.05, 0, 10, "m", "α_c of the core curve's smoothing filter.")
         .number("hair.curly.max_strain", 0.001, 1e-5, 0.5, "", "Strain limit |l/l_rest - 1| of an edge.")
@@ -61,8 +71,9 @@ void addCurlyKeys(SchemaBuilder& b) {
                 "Radius of the wet helix that curl exaggeration pulls toward (seed eq. 6); 0: hair.curly.radius.")
         .number("hair.wet.helix_pitch", 0, 0, 10, "m", "Advance per turn of the wet helix; 0: hair.curly.pitch.")
         .number("hair.wet.helix_weight", 100, 0, 1e6, "N/m",
-                "w_h of curl exaggeration (seed eq. 9). Against the bending springs (bend_stiffness) that hold the "
-                "dry curl: at 5× their stiffness, soaked hair takes most of the wet helix's shape.")
+                "Only when given (the seed's value is the default shown): w_h of curl exaggeration (seed eq. 9). "
+                "Unset, 5× the bending springs' kb that hold the dry curl: soaked hair takes most of the wet "
+                "helix's shape.")
         .flag("hair.wet.cohesion", true, "Cohesion between wet strands (seed eq. 10).")
         .number("hair.wet.cohesion_tightness", 0.85, 0, 1, "", "λ, the tightness of the cohesive position (seed: 0.85).")
         .number("hair.wet.cohesion_radius", 0.01, 1e-5, 1, "m", "Kernel radius of the neighbour average.")

@@ -1,5 +1,6 @@
 #include "sim/curly/curly_dynamics.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hp::curly {
@@ -17,6 +18,24 @@ void StrandScratch::resize(size_t n) {
     upper.resize(n);
 }
 
+MaterialSprings materialSprings(const rod::Material& m, float R, float P, float l, float mass, float h) {
+    MaterialSprings out;
+    out.massPerLength = float(m.massPerLength());
+    const double mu = mass >= 0.f ? double(mass) : m.massPerLength();
+    out.ks = float(1e4 * mu * l / (double(h) * h));
+    const double EI = m.bendStiffness(), GJ = m.twistStiffness();
+    double kb = EI / (double(l) * l * l);  // the straight rod's cap
+    if (R > 0.f) {
+        const double alpha = std::atan2(double(P), 2.0 * M_PI * R);
+        const double c2 = std::cos(alpha) * std::cos(alpha), s2 = 1.0 - c2;
+        const double compliance = double(R) * R * l * (c2 / GJ + s2 / EI);  // c_l, m/N
+        kb = std::min(kb, c2 / compliance);
+    }
+    out.kb = float(kb);
+    out.kc = 0.f;
+    return out;
+}
+
 bool implicitStep(const Vec3f* x, const Vec3f* v, size_t n, const Mat3f& root, const Vec3f& rootVelocity,
                   const StrandRest& rest, const StrandCoefficients& k, const StrandLoads& loads, float h,
                   StrandScratch& s, Vec3f* dv) {
@@ -28,7 +47,8 @@ bool implicitStep(const Vec3f* x, const Vec3f* v, size_t n, const Mat3f& root, c
     const size_t edges = n - 1;
     // Bending frames on the smoothed curve (eq. 2-3), core edges b_i and the
     // smoothed velocity differences ν_i (eq. 5).
-    smoothEdges(x, n, k.betaBend, s.d.data());
+    const Vec3f start = bendingCurveStart(x, root);
+    smoothEdges(x, n, k.betaBend, s.d.data(), &start);
     transportFrames(s.d.data(), edges, root, s.frames.data());
     if (k.kc > 0.f || k.cc > 0.f) {
         smoothEdges(x, n, k.betaCore, s.b.data());
@@ -115,7 +135,8 @@ void restData(const Vec3f* p, size_t n, const Mat3f& root, const StrandCoefficie
     const size_t edges = n - 1;
     std::vector<Vec3f> d(edges), b(edges);
     std::vector<Mat3f> frames(edges);
-    smoothEdges(p, n, k.betaBend, d.data());
+    const Vec3f start = bendingCurveStart(p, root);
+    smoothEdges(p, n, k.betaBend, d.data(), &start);
     transportFrames(d.data(), edges, root, frames.data());
     smoothEdges(p, n, k.betaCore, b.data());
     Vec3f weight = Vec3f::Zero();  // W_i = g Σ_{k>i} m_k

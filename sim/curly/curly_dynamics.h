@@ -17,6 +17,7 @@
 
 #include "sim/curly/curly_kernels.h"
 #include "sim/curly/wet_forces.h"
+#include "sim/guides/rod_kernels.h"
 
 #include <vector>
 
@@ -41,6 +42,50 @@ struct StrandCoefficients {
     float cohesionStiffness = 0; ///< κ, 1/s²: pull toward the cohesive position, per unit mass
     Vec3f gravity = Vec3f(0.f, -9.81f, 0.f);
 };
+
+/// Mass and spring constants of a guide derived from its wisp's material.
+struct MaterialSprings {
+    float massPerLength = 0;  ///< μ, kg/m
+    float ks = 0;             ///< stretch spring, N/m
+    float kb = 0;             ///< bending spring, N/m
+    float kc = 0;             ///< core spring, N/m
+};
+
+/// The seed's spring model made physical: μ, kb and kc of a guide whose rest
+/// shape is a curl of radius R and pitch P (advance per turn), sampled by
+/// inextensible edges of length l, from the wisp's material (rod::Material:
+/// the same keys, μ = Nρπr², EI = NEπr⁴/4 and GJ = NGπr⁴/2, as the rod).
+///
+/// The load a hanging curl carries is an axial pull F. In the wire of a helix
+/// (pitch angle α, tan α = P/(2πR)) it is a moment F·R, a twist F·R·cos α and
+/// a bend F·R·sin α, so by Castigliano an edge's length l of wire stores
+/// ½F²·c_l with
+///   c_l = R² l (cos²α/GJ + sin²α/EI),
+/// its share of the coil's axial compliance (the coil's is Σ c_l). In the
+/// spring model the bending frames follow the smoothed curve, i.e. the curl's
+/// axis, so the same pull, F·cos α across the edge, tilts the edge by
+/// Δα = F cos α/(kb l) against its bending spring, and the edge's advance
+/// along the axis grows by l cos α·Δα = F cos²α/kb. Equal compliance:
+///   kb = cos²α / c_l.
+/// The coil's whole axial stiffness is then in kb, so kc = 0 (a core spring
+/// would add kc cos²α per edge on top of it; set it to get the seed's stiffer
+/// curls). A curl no wider than an edge is not resolved by the edges and c_l
+/// vanishes with R: kb is capped by a straight rod's, the discrete joint
+/// stiffness EI/l (the rod formulation's) felt at the edge's end,
+///   kb ≤ EI/l³,
+/// which is also kb for a straight rest shape (R = 0).
+///
+/// The stretch spring is not the fibre's EA/l (~10⁵ N/m, far beyond what the
+/// once-linearised step carries at 0.02 s on particles of a few mg): Bullet's
+/// links and the strain limit keep the edges inextensible and ks only helps
+/// them, so it is set by the step, h²·ks/m = 10⁴ for a particle of mass
+/// m = μ·l (`mass`, when ≥ 0, is the μ to use instead of the material's):
+/// ks = 10⁴·m/h². (Measured: a pre-loaded hanging curl with the material's
+/// kb loses its equilibrium within a second at h²·ks/m ≈ 4·10⁴, which is the
+/// seed's 5000 N/m on 0.005 kg/m and 24 particles; at 10⁴ it holds, and the
+/// hanging extension does not change between ks = 30 and 300 N/m.)
+MaterialSprings materialSprings(const rod::Material& material, float curlRadius, float curlPitch, float edgeLength,
+                                float mass, float step);
 
 /// Per-particle inputs of one step that are not positions or velocities.
 struct StrandLoads {

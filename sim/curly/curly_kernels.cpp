@@ -11,11 +11,11 @@ float smoothingBeta(float edgeLength, float alpha) {
     return std::min(1.f, 1.f - std::exp(-edgeLength / alpha));
 }
 
-void smoothEdges(const Vec3f* lambda, size_t n, float beta, Vec3f* d) {
+void smoothEdges(const Vec3f* lambda, size_t n, float beta, Vec3f* d, const Vec3f* start) {
     if (n < 2) return;
     const float a = 1.f - beta;
     const float c1 = 2.f * a, c2 = a * a, c3 = beta * beta;
-    Vec3f d1 = lambda[1] - lambda[0];  // d_{i-1}
+    Vec3f d1 = start ? *start : Vec3f(lambda[1] - lambda[0]);  // d_{i-1}
     Vec3f d2 = d1;                     // d_{i-2}
     for (size_t i = 0; i + 1 < n; ++i) {
         const Vec3f di = c1 * d1 - c2 * d2 + c3 * (lambda[i + 1] - lambda[i]);
@@ -24,6 +24,8 @@ void smoothEdges(const Vec3f* lambda, size_t n, float beta, Vec3f* d) {
         d1 = di;
     }
 }
+
+Vec3f bendingCurveStart(const Vec3f* x, const Mat3f& root) { return root.col(1) * (x[1] - x[0]).norm(); }
 
 void smoothedCurve(const Vec3f* lambda, size_t n, float beta, Vec3f* out) {
     if (n == 0) return;

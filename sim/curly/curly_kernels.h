@@ -34,7 +34,22 @@ float smoothingBeta(float edgeLength, float alpha);
 /// damped second-order low-pass whose gain at zero frequency is 1: β = 1
 /// returns the edges unchanged, smaller β smooths over ~1/β edges.
 /// `lambda` has n ≥ 2 entries (positions or velocities), `d` receives n - 1.
-void smoothEdges(const Vec3f* lambda, size_t n, float beta, Vec3f* d);
+/// `start`, when given, replaces λ_1 - λ_0 as d_{-1} = d_{-2}: the bending
+/// frames start the filter along the root's hair direction (see
+/// bendingCurveStart).
+void smoothEdges(const Vec3f* lambda, size_t n, float beta, Vec3f* d, const Vec3f* start = nullptr);
+
+/// Where the bending frames' smoothed curve starts: the root's hair
+/// direction R·ŷ (the follicle normal, the axis a curl is grown along) times
+/// the first edge's length, instead of the seed's first edge λ_1 - λ_0. The
+/// first edge of a curl runs around the coil (58° off its axis at the
+/// default curl), and the frames are transported from it to every edge, so
+/// when a load tilted that edge every bending target turned with it: a
+/// hanging curl with the material's springs (curly::materialSprings)
+/// extended 2.3-2.6× less than the coil spring it stands for (pitch +10%
+/// against +24%); started along the hair direction it extends by +19% (80%
+/// of the linear coil, as with frames frozen at rest: +20%).
+Vec3f bendingCurveStart(const Vec3f* x, const Mat3f& root);
 
 /// The smoothed curve of eq. (3): p'_0 = λ_0, p'_i = p'_{i-1} + d_{i-1}.
 /// `out` receives n points.

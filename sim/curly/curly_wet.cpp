@@ -33,10 +33,14 @@ void CurlyWetSettings::validate() const {
     check(collisionRadius >= 0.f, "collision radius must be ≥ 0");
     check(timeStep > 0.f && finite(timeStep), "time step must be positive");
     check(substeps >= 1 && iterations >= 1, "substeps and iterations must be ≥ 1");
-    check(massPerLength > 0.f, "mass per length must be positive");
+    check(massPerLength > 0.f || massPerLength < 0.f, "mass per length must be positive (or kFromMaterial)");
+    if (massPerLength < 0.f || bendStiffness < 0.f || coreStiffness < 0.f)
+        check(material.youngs > 0.f && material.shear > 0.f && material.density > 0.f && material.radius > 0.f &&
+                  material.hairsPerGuide > 0.f && finite(material.youngs) && finite(material.shear) &&
+                  finite(material.density) && finite(material.radius) && finite(material.hairsPerGuide),
+              "the material (E, G, density, fibre radius, hairs per guide) must be positive and finite");
     check(gravity.allFinite(), "gravity must be finite");
-    check(stretchStiffness >= 0.f && stretchDamping >= 0.f && bendStiffness >= 0.f && bendDamping >= 0.f &&
-              coreStiffness >= 0.f && coreDamping >= 0.f,
+    check(stretchDamping >= 0.f && bendDamping >= 0.f && coreDamping >= 0.f,
           "spring stiffness and damping must be ≥ 0");
     check(bendSmoothing >= 0.f && coreSmoothing >= 0.f, "smoothing lengths must be ≥ 0");
     check(maxStrain > 0.f && maxStrain < 1.f, "strain limit must be in (0, 1)");
@@ -44,7 +48,8 @@ void CurlyWetSettings::validate() const {
     check(friction >= 0.f, "friction must be ≥ 0");
     check(saturation >= 0.f && saturation <= 1.f, "saturation must be in [0, 1]");
     check(saturationRoot >= 0.f && saturationTip >= 0.f, "saturation profile must be ≥ 0");
-    check(helixRadius >= 0.f && helixPitch >= 0.f && helixWeight >= 0.f, "helix radius, pitch, weight must be ≥ 0");
+    check(helixRadius >= 0.f && helixPitch >= 0.f && (helixWeight >= 0.f || helixWeight < 0.f),
+          "helix radius and pitch must be ≥ 0, the weight a number");
     check(cohesionTightness >= 0.f && cohesionTightness <= 1.f, "cohesion tightness must be in [0, 1]");
     check(cohesionRadius > 0.f && cohesionStiffness >= 0.f, "cohesion radius must be positive, stiffness ≥ 0");
     check(adhesionWeight >= 0.f && adhesionRadius > 0.f, "adhesion weight must be ≥ 0, radius positive");
@@ -54,6 +59,28 @@ void CurlyWetSettings::validate() const {
     check(stiffnessStep > 0.f, "stiffness reference step must be positive");
     check(teleportDistance > 0.f && teleportAngle > 0.f, "teleport limits must be positive");
     check(strandsPerWorld >= 1 && threads >= 0, "strands per world must be ≥ 1, threads ≥ 0");
+}
+
+CurlyWetSettings CurlyWetSettings::resolved() const {
+    CurlyWetSettings r = *this;
+    const curly::MaterialSprings m = curly::materialSprings(material, curlRadius, curlPitch,
+                                                            length / float(std::max(1, particles - 1)),
+                                                            massPerLength, timeStep / float(std::max(1, substeps)));
+    if (r.massPerLength < 0.f) r.massPerLength = m.massPerLength;
+    if (r.stretchStiffness < 0.f) r.stretchStiffness = m.ks;
+    if (r.bendStiffness < 0.f) r.bendStiffness = m.kb;
+    if (r.coreStiffness < 0.f) r.coreStiffness = m.kc;
+    if (r.helixWeight < 0.f) r.helixWeight = 5.f * r.bendStiffness;
+    return r;
+}
+
+CurlyWetSettings CurlyWetSettings::seedSprings() {
+    CurlyWetSettings s;
+    s.massPerLength = 0.005f;
+    s.stretchStiffness = 5000.f;
+    s.bendStiffness = s.coreStiffness = 20.f;
+    s.helixWeight = 100.f;
+    return s;
 }
 
 void CurlyWetStats::accumulate(const CurlyWetStats& s) {
@@ -142,7 +169,7 @@ struct CurlyWetSolver::Impl {
 
 CurlyWetSolver::CurlyWetSolver(const CurlyWetSettings& settings) : impl_(std::make_unique<Impl>()) {
     settings.validate();
-    impl_->set.settings = settings;
+    impl_->set.settings = settings.resolved();
     if (settings.threads > 0) impl_->arena = std::make_unique<tbb::task_arena>(settings.threads);
 }
 

@@ -24,6 +24,7 @@
 // Bullet stays inside sim/*.cpp; this header is plain C++ and Eigen.
 #pragma once
 
+#include "sim/guides/rod_kernels.h"
 #include "sim/strands/head.h"
 #include "sim/strands/strand.h"
 
@@ -31,6 +32,10 @@
 #include <vector>
 
 namespace hp {
+
+/// A mass or spring constant of CurlyWetSettings left to the material
+/// (any negative value means the same).
+inline constexpr float kFromMaterial = -1.f;
 
 /// Everything the curly/wet solver needs. Units: metres, seconds, kg,
 /// degrees for angles. Defaults are the seed's values where it gives one.
@@ -50,16 +55,22 @@ struct CurlyWetSettings {
     int substeps = 1;               ///< Bullet steps per step
     int iterations = 8;             ///< Bullet link (inextensibility) iterations per Bullet step
 
-    // Material and springs (seed eq. 1, 4, 5).
-    float massPerLength = 0.005f;   ///< kg/m (a guide stands for a clump of hairs)
+    // Material and springs (seed eq. 1, 4, 5). Mass and the stretch, bending
+    // and core springs follow from `material` (the rod formulation's fibre
+    // and wisp), the curl and the step where they are kFromMaterial (the
+    // default): curly::materialSprings, sim/curly/curly_dynamics.h; so does
+    // helixWeight (5 kb). A value ≥ 0 is used as given (the seed's:
+    // 0.005 kg/m, ks = 5000, kb = kc = 20 N/m, w_h = 100 N/m).
+    rod::Material material;         ///< E, G, ρ, fibre radius, hairs per guide
+    float massPerLength = kFromMaterial; ///< kg/m (a guide stands for a clump of hairs)
     Vec3f gravity = Vec3f(0.f, -9.81f, 0.f);  ///< m/s²
     bool preload = true;            ///< bending targets pre-loaded so the rest shape holds under gravity at t0
-    float stretchStiffness = 5000.f;///< ks, N/m (stiff: the implicit step keeps edges nearly inextensible)
+    float stretchStiffness = kFromMaterial; ///< ks, N/m (a numerical aid: Bullet's links keep edges inextensible)
     float stretchDamping = 0.05f;   ///< cs, N·s/m
-    float bendStiffness = 20.f;     ///< kb, N/m
+    float bendStiffness = kFromMaterial; ///< kb, N/m
     float bendDamping = 0.02f;      ///< cb, N·s/m
     float bendSmoothing = 0.05f;    ///< α of the bending frames' smoothing filter, m
-    float coreStiffness = 20.f;     ///< kc, N/m
+    float coreStiffness = kFromMaterial; ///< kc, N/m
     float coreDamping = 0.02f;      ///< cc, N·s/m
     float coreSmoothing = 0.05f;    ///< α_c of the core curve, m
     float maxStrain = 0.001f;       ///< strain limit |l/l̄ - 1| after each Bullet step
@@ -73,7 +84,7 @@ struct CurlyWetSettings {
     float saturationTip = 1.f;      ///< profile factor at the tip (linear in between)
     float helixRadius = 0.f;        ///< wet helix radius r (eq. 6), m; 0: the curl radius
     float helixPitch = 0.f;         ///< wet helix advance per turn (2π p of eq. 6), m; 0: the curl pitch
-    float helixWeight = 100.f;      ///< w_h of eq. (9), N/m (5 kb: a wet helix unlike the rest curl wins)
+    float helixWeight = kFromMaterial; ///< w_h of eq. (9), N/m; kFromMaterial: 5 kb (a wet helix unlike the rest curl wins)
     bool cohesion = true;           ///< cohesion between wet strands (eq. 10)
     float cohesionTightness = 0.85f;///< λ (seed: 0.85)
     float cohesionRadius = 0.01f;   ///< kernel radius of the neighbour average, m
@@ -96,6 +107,12 @@ struct CurlyWetSettings {
 
     /// Throws hp::Error naming the first setting out of range.
     void validate() const;
+    /// These settings with the material's mass and springs in place of every
+    /// kFromMaterial (what the solver runs with: CurlyWetSolver::settings()).
+    CurlyWetSettings resolved() const;
+    /// The seed's mass and spring constants (0.005 kg/m, ks = 5000, kb = kc = 20 N/m)
+    /// instead of the material's.
+    static CurlyWetSettings seedSprings();
 };
 
 /// Measurements of one step (same fields as the rigid-chain GuideStats, plus
