@@ -16,8 +16,10 @@ void addSimKeys(SchemaBuilder& b) {
         .number("hair.radius.tip", 0.00001, 0, 0.01, "m", "Radius at the tip.");
 
     b.section("hair.material",
-              "Rod formulation: the fibre and the wisp a guide stands for (SI units). Mass per length "
-              "N·ρ·πr², bending stiffness N·E·πr⁴/4, twist stiffness N·G·πr⁴/2, r = hair.radius.root.")
+              "The fibre and the wisp a guide stands for (SI units), read by the rod formulation and by the "
+              "curly model (hair.model: curly-wet, whose springs follow from it unless hair.curly.* sets them). "
+              "Mass per length N·ρ·πr², bending stiffness N·E·πr⁴/4, twist stiffness N·G·πr⁴/2, "
+              "r = hair.radius.root.")
         .number("hair.material.youngs_modulus", 3.8e9, 0, 1e12, "Pa", "Young's modulus E of one hair (human: 3.5–4 GPa).")
         .number("hair.material.shear_modulus", 1.3e9, 0, 1e12, "Pa",
                 "Shear modulus G of one hair (twist stiffness; an isotropic fibre with a free tip carries no "
