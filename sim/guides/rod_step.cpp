@@ -1,0 +1,317 @@
+// rod::rodSteps: one XPBD step (sim/guides/rod_kernels.h gives its four
+// stages and equations) for up to four strands at once, each strand in one
+// SIMD lane (sim/guides/rod_lanes.h) from the prediction through the
+// assembly, the banded solve and the stretch pass; only the last stage, the
+// placement against the head (a virtual signed-distance query per vertex,
+// with branches), runs strand by strand. Each lane computes what the
+// single-strand arithmetic does, operation for operation, so a strand's
+// result is the same whatever the batch, the lane or the thread count.
+//
+// Layout: lane-major structure of arrays. y[i] holds vertex i of the four
+// strands (V3 of F4), grad[3r + slot] the gradient of row r on the row's
+// vertex `slot`, and the banded system's entry A(r, r-k) of the four
+// strands is band[r·(kBand+1) + k] (a D4). Idle lanes (fewer than four
+// strands) repeat lane 0's strand and are dropped at the end.
+#include "sim/guides/rod_kernels.h"
+
+#include <algorithm>
+#include <cmath>
+
+// See rod_lanes.h: D4 values never cross a library boundary.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace hp::rod {
+
+using lanes::D4;
+using lanes::F4;
+using V3 = lanes::V3<F4>;
+
+namespace {
+
+static_assert(kLanes == 4, "rod_lanes.h packs four strands per SIMD register");
+
+/// Bandwidth of the XPBD system: rows ordered (bend a, bend b, stretch) per
+/// joint; joints j and k share a vertex iff |j - k| ≤ 2, so A(r, s) = 0 for
+/// |r - s| > 3·2 + 2.
+constexpr int kBand = 8;
+constexpr int kRowLen = kBand + 1;
+
+/// First column of row i's envelope: a bend row of joint j shares vertex
+/// j-1 with the rows of joint j-2 (first column 3(j-2)); a stretch row
+/// (vertices j, j+1) meets joint j-1 at the earliest (3(j-1)). LDLᵀ fills
+/// only inside this envelope, so the factorization skips the zeros of the
+/// band (the same sums, without the terms that are exactly zero).
+inline int envelopeStart(int i) {
+    const int j = i / 3;
+    return std::max(0, i - 3 * j == 2 ? 3 * j - 3 : 3 * j - 6);
+}
+
+/// Banded LDLᵀ in place, four independent systems in lanes: L(i, i-k)
+/// (k > 0) replaces A(i, i-k), invD receives 1/D(i), then L D Lᵀ z = rhs is
+/// solved in place:
+///   D_i = A_ii - Σ_m L_im² D_m,  L_ij = (A_ij - Σ_m L_im D_m L_jm) / D_j,
+/// the sums over the envelope (envelopeStart).
+void bandedSolve(D4* band, D4* invD, D4* rhs, int n) {
+    D4 t[kBand];  // t[m - lo] = L_im·D_m of the current row
+    for (int i = 0; i < n; ++i) {
+        const int lo = envelopeStart(i);
+        D4* Li = band + size_t(i) * kRowLen;
+        D4 d = Li[0];
+        for (int j = lo; j < i; ++j) {
+            const D4* Lj = band + size_t(j) * kRowLen;
+            D4 sum = Li[i - j];
+            for (int m = std::max(lo, envelopeStart(j)); m < j; ++m) sum -= t[m - lo] * Lj[j - m];
+            t[j - lo] = sum;
+            const D4 lij = sum * invD[j];
+            Li[i - j] = lij;
+            d -= sum * lij;
+        }
+        invD[i] = 1.0 / d;
+    }
+    for (int i = 0; i < n; ++i) {
+        const D4* Li = band + size_t(i) * kRowLen;
+        for (int m = envelopeStart(i); m < i; ++m) rhs[i] -= Li[i - m] * rhs[m];
+    }
+    for (int i = 0; i < n; ++i) rhs[i] *= invD[i];
+    for (int i = n - 1; i >= 0; --i)
+        for (int k = i + 1; k <= std::min(n - 1, i + kBand); ++k)
+            if (envelopeStart(k) <= i) rhs[i] -= band[size_t(k) * kRowLen + size_t(k - i)] * rhs[k];
+}
+
+/// One mass-weighted Newton step on the stretch constraints alone,
+/// C_j = |x_{j+1} - x_j| - l_j: J W Jᵀ is tridiagonal,
+///   A_jj = w_j + w_{j+1},  A_{j,j+1} = -w_{j+1} d_j·d_{j+1},
+/// solved by the Thomas algorithm; x_j -= w_j d_j Δλ_j, x_{j+1} += w_{j+1} d_j Δλ_j.
+/// Momentum-conserving, unlike follow-the-leader; it leaves a stretch error
+/// of the second order, which the final exact placement then removes
+/// without visible bias.
+void stretchSolve(V3* x, const F4* w, const F4* rest, int n, D4* diag, D4* rhs, V3* dir, F4* cosine) {
+    const int S = n - 1;
+    for (int j = 0; j < S; ++j) {
+        const V3 e = x[j + 1] - x[j];
+        const F4 len = lanes::norm(e);
+        dir[j] = e / len;
+        rhs[j] = -(lanes::widen(len) - lanes::widen(rest[j]));
+    }
+    for (int j = 0; j + 1 < S; ++j) cosine[j] = lanes::dot(dir[j], dir[j + 1]);
+    // Forward elimination: diag holds the modified pivots.
+    for (int j = 0; j < S; ++j) {
+        D4 a = lanes::widen(w[j]) + lanes::widen(w[j + 1]);
+        if (j > 0) {
+            const D4 off = -lanes::widen(w[j]) * lanes::widen(cosine[j - 1]);
+            const D4 f = off / diag[j - 1];
+            a -= f * off;
+            rhs[j] -= f * rhs[j - 1];
+        }
+        diag[j] = a;
+    }
+    for (int j = S - 1; j >= 0; --j) {
+        if (j + 1 < S) rhs[j] -= -lanes::widen(w[j + 1]) * lanes::widen(cosine[j]) * rhs[j + 1];
+        rhs[j] /= diag[j];
+    }
+    for (int j = 0; j < S; ++j) {
+        const V3 dl = lanes::narrow(rhs[j]) * dir[j];
+        x[j] = x[j] - w[j] * dl;
+        x[j + 1] = x[j + 1] + w[j + 1] * dl;
+    }
+}
+
+/// Lane l of a lane vector, and writing it.
+inline Vec3f lane(const V3& v, int l) { return Vec3f(v.x[l], v.y[l], v.z[l]); }
+inline void setLane(V3& v, int l, const Vec3f& p) {
+    v.x[l] = p.x();
+    v.y[l] = p.y();
+    v.z[l] = p.z();
+}
+
+/// Steps 1–2 of rodStep up to the solve: predicts y, writes the constraint
+/// gradients (rows a, b, stretch of joint j at 3j..3j+2, slots j-1, j, j+1)
+/// and the system A = J W Jᵀ + α̃ with right-hand side -C(y), for the four
+/// lanes (src[l]: the target in lane l).
+void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, float h, RodScratch& sc) {
+    const RodStrand& s0 = *t[0].strand;
+    const int n = s0.vertices, S = n - 1;
+    V3* y = sc.y.data();
+    V3* grad = sc.grad.data();
+    D4* band = sc.band.data();
+    D4* rhs = sc.rhs.data();
+    F4* w = sc.w.data();
+    F4* rest = sc.rest.data();
+
+    // Per-lane constants: masses, rest lengths, the start of the frame, α̃.
+    V3 u, a;
+    F4 bendLane{};  // nonzero where the strand bends (EI > 0)
+    D4 alphaScale{};
+    for (int l = 0; l < kLanes; ++l) {
+        const RodStepTarget& tl = t[src[l]];
+        const RodStrand& s = *tl.strand;
+        for (int i = 0; i < n; ++i) w[i][l] = s.invMass[i];
+        for (int j = 0; j < S; ++j) rest[j][l] = s.restLength[j];
+        const Vec3f ul = (tl.rootFrame * s.ghostDir).normalized();
+        setLane(u, l, ul);
+        setLane(a, l, frameStart(tl.rootFrame, ul));
+        bendLane[l] = s.bendStiffness > 0 ? 1.f : 0.f;
+        alphaScale[l] = s.bendStiffness * double(h) * h;
+        // 1. Prediction y = x + h·v + h²·g; the root at its target.
+        setLane(y[0], l, tl.rootPos);
+        for (int i = 1; i < n; ++i) setLane(y[i], l, tl.x[i] + h * tl.v[i] + (h * h) * gravity);
+    }
+    const auto bends = bendLane != 0.f;
+    F4 ulen = lanes::splat<F4>(1.f);
+
+    // Constraint rows and gradients at y, joint by joint along the transported frame.
+    for (int j = 0; j < S; ++j) {
+        const V3 e = y[j + 1] - y[j];
+        const Vec2f* rc[kLanes];  // rest curvatures of joint j
+        D4 alpha{};
+        for (int l = 0; l < kLanes; ++l) {
+            const RodStrand& s = *t[src[l]].strand;
+            rc[l] = &s.restCurvature[j];
+            alpha[l] = double(voronoiLength(s, j));
+        }
+        const F4 c[2] = {F4{(*rc[0])[0], (*rc[1])[0], (*rc[2])[0], (*rc[3])[0]},
+                         F4{(*rc[0])[1], (*rc[1])[1], (*rc[2])[1], (*rc[3])[1]}};
+        F4 C[2];
+        V3 g[2][3];
+        lanes::bendRows(u, ulen, e, a, c, j == 0, C, g);
+        alpha /= alphaScale;  // α̃ = l̄/(EI h²)
+        for (int k = 0; k < 2; ++k) {
+            const int r = 3 * j + k;
+            // A strand without bending stiffness has inert bend rows
+            // (A = 1, C = 0, no gradient: Δλ = 0).
+            for (int slot = j == 0 ? 1 : 0; slot < 3; ++slot) grad[3 * r + slot] = lanes::select(bends, g[k][slot], V3{});
+            rhs[r] = lanes::widen(lanes::select(bends, -C[k], F4{}));
+            for (int l = 0; l < kLanes; ++l) band[size_t(r) * kRowLen][l] = bendLane[l] != 0.f ? alpha[l] : 1.0;
+        }
+        const F4 len = lanes::norm(e);
+        const V3 d = e / len;
+        const int r = 3 * j + 2;
+        grad[3 * r] = V3{};  // the stretch row does not touch vertex j-1
+        grad[3 * r + 1] = -d;
+        grad[3 * r + 2] = d;
+        rhs[r] = lanes::widen(-(len - rest[j]));
+        lanes::advanceFrame(u, ulen, a, e);
+    }
+
+    // A = J W Jᵀ (+ α̃ already on the diagonal), lower band, vertex by
+    // vertex: the rows touching free vertex v are the bend rows of joints
+    // v-1, v, v+1 and the stretch rows of joints v-1, v (at most 8, rows
+    // within 7 of each other); each pair adds w_v·g_a·g_b.
+    for (int vtx = 1; vtx < n; ++vtx) {
+        int rows[8];
+        const V3* grads[8];
+        int count = 0;
+        for (int j = vtx - 1; j <= std::min(vtx + 1, S - 1); ++j) {
+            const int slot = vtx - j + 1;
+            const int kinds = j <= vtx ? 3 : 2;  // joint v+1's stretch row does not touch v
+            for (int k = 0; k < kinds; ++k) {
+                rows[count] = 3 * j + k;
+                grads[count++] = &grad[3 * (3 * j + k) + slot];
+            }
+        }
+        for (int p = 0; p < count; ++p) {
+            const V3 ga = w[vtx] * *grads[p];
+            D4* row = band + size_t(rows[p]) * kRowLen;
+            for (int q = 0; q <= p; ++q) row[rows[p] - rows[q]] += lanes::widen(lanes::dot(ga, *grads[q]));
+        }
+    }
+}
+
+/// Step 3–4 for the strand in lane l: exact lengths and head clearance root
+/// to tip, pinning where both cannot hold, then velocities. y: its positions
+/// after the solves (overwritten); t.x still holds the step's start, read at vertex i just
+/// before vertex i is written. Returns its pinned vertices.
+int place(const RodStepTarget& t, Vec3f* y, float h, float drag, float friction, const strand::HeadQuery* head,
+          float radius) {
+    const RodStrand& s = *t.strand;
+    const int n = s.vertices;
+    const float damp = strand::dampingFactor(drag, h);
+    int pinned = 0;
+    for (int i = 0; i < n; ++i) {
+        const Vec3f old = t.x[i];
+        strand::Contact contact;
+        if (i > 0) {
+            const float l = s.restLength[i - 1];
+            contact = strand::placeSegment(y[i - 1], y[i], l, head, radius);
+            const bool lengthOk = std::abs((y[i] - y[i - 1]).norm() / l - 1.f) < 1e-4f;
+            const bool outside = !contact.active || head->distance(y[i], nullptr) > -0.1f * radius;
+            if (!lengthOk || !outside) {
+                // No place at its length outside the head: held at its length
+                // toward its last valid place, where it was at the step's
+                // start, carried along with the head's motion.
+                // If the head took that place too, straight out from the
+                // surface under the parent (outside whenever the head is
+                // locally convex there).
+                const Vec3f last = head ? Vec3f(head->toPrevious.inverse() * old) : old;
+                y[i] = strand::followTheLeader(y[i - 1], last, l);
+                Vec3f normal;
+                if (head && head->distance(y[i], nullptr) < 0.f) {
+                    head->distance(y[i - 1], &normal);
+                    y[i] = y[i - 1] + l * normal.normalized();
+                }
+                contact = strand::Contact{};
+                ++pinned;
+            }
+        }
+        Vec3f vel = (y[i] - old) / h;
+        if (i > 0) {
+            if (contact.active) vel = strand::contactFriction(vel, head->surfaceVelocity(y[i], h), contact, friction, h);
+            vel *= damp;
+        }
+        t.x[i] = y[i];
+        t.v[i] = vel;
+    }
+    return pinned;
+}
+
+}  // namespace
+
+int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, float h, float drag, float friction,
+             const strand::HeadQuery* head, float radius, RodScratch& sc) {
+    const int n = targets[0].strand->vertices, N = 3 * (n - 1);
+    sc.y.resize(size_t(n));
+    sc.grad.resize(size_t(N) * 3);
+    sc.band.assign(size_t(N) * kRowLen, D4{});
+    sc.rhs.resize(size_t(N));
+    sc.invD.resize(size_t(N));
+    sc.w.resize(size_t(n));
+    sc.rest.resize(size_t(n));
+    sc.diag.resize(size_t(n));
+    sc.lambda.resize(size_t(n));
+    sc.dir.resize(size_t(n));
+    sc.cosine.resize(size_t(n));
+    sc.a.resize(size_t(n));
+    int src[kLanes];
+    for (int l = 0; l < kLanes; ++l) src[l] = l < count ? l : 0;  // idle lanes repeat lane 0
+
+    assemble(targets, src, gravity, h, sc);
+    bandedSolve(sc.band.data(), sc.invD.data(), sc.rhs.data(), N);
+    // 2. y += W Jᵀ Δλ: row r of joint r/3 moves its vertices j-1, j, j+1.
+    V3* y = sc.y.data();
+    const F4* w = sc.w.data();
+    for (int r = 0; r < N; ++r) {
+        const F4 dl = lanes::narrow(sc.rhs[size_t(r)]);
+        for (int slot = 0; slot < 3; ++slot) {
+            const int vtx = r / 3 - 1 + slot;
+            if (vtx >= 1) y[vtx] = y[vtx] + (w[vtx] * dl) * sc.grad[size_t(3 * r + slot)];
+        }
+    }
+    stretchSolve(y, w, sc.rest.data(), n, sc.diag.data(), sc.lambda.data(), sc.dir.data(), sc.cosine.data());
+
+    int pinned = 0;
+    Vec3f* lanePos = sc.a.data();
+    for (int l = 0; l < count; ++l) {
+        for (int i = 0; i < n; ++i) lanePos[i] = lane(y[i], l);
+        pinned += place(targets[l], lanePos, h, drag, friction, head, radius);
+    }
+    return pinned;
+}
+
+int rodStep(const RodStrand& s, Vec3f* x, Vec3f* v, const Vec3f& rootPos, const Mat3f& rootFrame,
+            const Vec3f& gravity, float h, float drag, float friction, const strand::HeadQuery* head, float radius,
+            RodScratch& sc) {
+    const RodStepTarget t{&s, x, v, rootPos, rootFrame};
+    return rodSteps(&t, 1, gravity, h, drag, friction, head, radius, sc);
+}
+
+}  // namespace hp::rod
