@@ -13,6 +13,7 @@
 // strands is band[r·(kBand+1) + k] (a D4). Idle lanes (fewer than four
 // strands) repeat lane 0's strand and are dropped at the end.
 #include "sim/guides/rod_kernels.h"
+#include "sim/guides/rod_band.h"
 
 #include <algorithm>
 #include <cmath>
@@ -29,54 +30,6 @@ using V3 = lanes::V3<F4>;
 namespace {
 
 static_assert(kLanes == 4, "rod_lanes.h packs four strands per SIMD register");
-
-/// Bandwidth of the XPBD system: rows ordered (bend a, bend b, stretch) per
-/// joint; joints j and k share a vertex iff |j - k| ≤ 2, so A(r, s) = 0 for
-/// |r - s| > 3·2 + 2.
-constexpr int kBand = 8;
-constexpr int kRowLen = kBand + 1;
-
-/// First column of row i's envelope: a bend row of joint j shares vertex
-/// j-1 with the rows of joint j-2 (first column 3(j-2)); a stretch row
-/// (vertices j, j+1) meets joint j-1 at the earliest (3(j-1)). LDLᵀ fills
-/// only inside this envelope, so the factorization skips the zeros of the
-/// band (the same sums, without the terms that are exactly zero).
-inline int envelopeStart(int i) {
-    const int j = i / 3;
-    return std::max(0, i - 3 * j == 2 ? 3 * j - 3 : 3 * j - 6);
-}
-
-/// Banded LDLᵀ in place, four independent systems in lanes: L(i, i-k)
-/// (k > 0) replaces A(i, i-k), invD receives 1/D(i), then L D Lᵀ z = rhs is
-/// solved in place:
-///   D_i = A_ii - Σ_m L_im² D_m,  L_ij = (A_ij - Σ_m L_im D_m L_jm) / D_j,
-/// the sums over the envelope (envelopeStart).
-void bandedSolve(D4* band, D4* invD, D4* rhs, int n) {
-    D4 t[kBand];  // t[m - lo] = L_im·D_m of the current row
-    for (int i = 0; i < n; ++i) {
-        const int lo = envelopeStart(i);
-        D4* Li = band + size_t(i) * kRowLen;
-        D4 d = Li[0];
-        for (int j = lo; j < i; ++j) {
-            const D4* Lj = band + size_t(j) * kRowLen;
-            D4 sum = Li[i - j];
-            for (int m = std::max(lo, envelopeStart(j)); m < j; ++m) sum -= t[m - lo] * Lj[j - m];
-            t[j - lo] = sum;
-            const D4 lij = sum * invD[j];
-            Li[i - j] = lij;
-            d -= sum * lij;
-        }
-        invD[i] = 1.0 / d;
-    }
-    for (int i = 0; i < n; ++i) {
-        const D4* Li = band + size_t(i) * kRowLen;
-        for (int m = envelopeStart(i); m < i; ++m) rhs[i] -= Li[i - m] * rhs[m];
-    }
-    for (int i = 0; i < n; ++i) rhs[i] *= invD[i];
-    for (int i = n - 1; i >= 0; --i)
-        for (int k = i + 1; k <= std::min(n - 1, i + kBand); ++k)
-            if (envelopeStart(k) <= i) rhs[i] -= band[size_t(k) * kRowLen + size_t(k - i)] * rhs[k];
-}
 
 /// One mass-weighted Newton step on the stretch constraints alone,
 /// C_j = |x_{j+1} - x_j| - l_j: J W Jᵀ is tridiagonal,
@@ -217,50 +170,45 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
     }
 }
 
-/// Step 3–4 for the strand in lane l: exact lengths and head clearance root
-/// to tip, pinning where both cannot hold, then velocities. y: its positions
-/// after the solves (overwritten); t.x still holds the step's start, read at vertex i just
-/// before vertex i is written. Returns its pinned vertices.
-int place(const RodStepTarget& t, Vec3f* y, float h, float drag, float friction, const strand::HeadQuery* head,
-          float radius) {
-    const RodStrand& s = *t.strand;
-    const int n = s.vertices;
-    const float damp = strand::dampingFactor(drag, h);
-    int pinned = 0;
-    for (int i = 0; i < n; ++i) {
-        const Vec3f old = t.x[i];
-        strand::Contact contact;
-        if (i > 0) {
-            const float l = s.restLength[i - 1];
-            contact = strand::placeSegment(y[i - 1], y[i], l, head, radius);
-            const bool lengthOk = std::abs((y[i] - y[i - 1]).norm() / l - 1.f) < 1e-4f;
-            const bool outside = !contact.active || head->distance(y[i], nullptr) > -0.1f * radius;
-            if (!lengthOk || !outside) {
-                // No place at its length outside the head: held at its length
-                // toward its last valid place, where it was at the step's
-                // start, carried along with the head's motion.
-                // If the head took that place too, straight out from the
-                // surface under the parent (outside whenever the head is
-                // locally convex there).
-                const Vec3f last = head ? Vec3f(head->toPrevious.inverse() * old) : old;
-                y[i] = strand::followTheLeader(y[i - 1], last, l);
-                Vec3f normal;
-                if (head && head->distance(y[i], nullptr) < 0.f) {
-                    head->distance(y[i - 1], &normal);
-                    y[i] = y[i - 1] + l * normal.normalized();
-                }
-                contact = strand::Contact{};
-                ++pinned;
+/// Steps 3–4 at vertex i of one strand: exact length and head clearance
+/// (pinned where both cannot hold: returns true), then its velocity. y: the
+/// strand's positions after the solves, placed up to i-1 (y[i] is placed
+/// here); t.x[i] still holds the step's start and receives y[i].
+bool placeVertex(const RodStepTarget& t, int i, Vec3f* y, float h, float damp, float friction,
+                 const strand::HeadQuery* head, float radius) {
+    const Vec3f old = t.x[i];
+    strand::Contact contact;
+    bool pinned = false;
+    if (i > 0) {
+        const float l = t.strand->restLength[i - 1];
+        contact = strand::placeSegment(y[i - 1], y[i], l, head, radius);
+        const bool lengthOk = std::abs((y[i] - y[i - 1]).norm() / l - 1.f) < 1e-4f;
+        const bool outside = !contact.active || head->distance(y[i], nullptr) > -0.1f * radius;
+        if (!lengthOk || !outside) {
+            // No place at its length outside the head: held at its length
+            // toward its last valid place, where it was at the step's
+            // start, carried along with the head's motion.
+            // If the head took that place too, straight out from the
+            // surface under the parent (outside whenever the head is
+            // locally convex there).
+            const Vec3f last = head ? Vec3f(head->toPrevious.inverse() * old) : old;
+            y[i] = strand::followTheLeader(y[i - 1], last, l);
+            Vec3f normal;
+            if (head && head->distance(y[i], nullptr) < 0.f) {
+                head->distance(y[i - 1], &normal);
+                y[i] = y[i - 1] + l * normal.normalized();
             }
+            contact = strand::Contact{};
+            pinned = true;
         }
-        Vec3f vel = (y[i] - old) / h;
-        if (i > 0) {
-            if (contact.active) vel = strand::contactFriction(vel, head->surfaceVelocity(y[i], h), contact, friction, h);
-            vel *= damp;
-        }
-        t.x[i] = y[i];
-        t.v[i] = vel;
     }
+    Vec3f vel = (y[i] - old) / h;
+    if (i > 0) {
+        if (contact.active) vel = strand::contactFriction(vel, head->surfaceVelocity(y[i], h), contact, friction, h);
+        vel *= damp;
+    }
+    t.x[i] = y[i];
+    t.v[i] = vel;
     return pinned;
 }
 
@@ -280,7 +228,7 @@ int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, floa
     sc.lambda.resize(size_t(n));
     sc.dir.resize(size_t(n));
     sc.cosine.resize(size_t(n));
-    sc.a.resize(size_t(n));
+    sc.a.resize(size_t(n) * kLanes);
     int src[kLanes];
     for (int l = 0; l < kLanes; ++l) src[l] = l < count ? l : 0;  // idle lanes repeat lane 0
 
@@ -298,12 +246,18 @@ int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, floa
     }
     stretchSolve(y, w, sc.rest.data(), n, sc.diag.data(), sc.lambda.data(), sc.dir.data(), sc.cosine.data());
 
-    int pinned = 0;
+    // 3–4. Placement root to tip, strand by strand but the strands'
+    // vertices interleaved: each strand's placement is a chain of dependent
+    // square roots and divisions, and the processor overlaps independent
+    // chains.
     Vec3f* lanePos = sc.a.data();
-    for (int l = 0; l < count; ++l) {
-        for (int i = 0; i < n; ++i) lanePos[i] = lane(y[i], l);
-        pinned += place(targets[l], lanePos, h, drag, friction, head, radius);
-    }
+    for (int l = 0; l < count; ++l)
+        for (int i = 0; i < n; ++i) lanePos[size_t(l) * size_t(n) + size_t(i)] = lane(y[i], l);
+    const float damp = strand::dampingFactor(drag, h);
+    int pinned = 0;
+    for (int i = 0; i < n; ++i)
+        for (int l = 0; l < count; ++l)
+            pinned += placeVertex(targets[l], i, lanePos + size_t(l) * size_t(n), h, damp, friction, head, radius);
     return pinned;
 }
 
