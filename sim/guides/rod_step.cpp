@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 // See rod_lanes.h: D4 values never cross a library boundary.
 #pragma GCC diagnostic ignored "-Wpsabi"
@@ -219,7 +220,8 @@ int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, floa
     const int n = targets[0].strand->vertices, N = 3 * (n - 1);
     sc.y.resize(size_t(n));
     sc.grad.resize(size_t(N) * 3);
-    sc.band.assign(size_t(N) * kRowLen, D4{});
+    sc.band.resize(size_t(N) * kRowLen);
+    std::memset(static_cast<void*>(sc.band.data()), 0, sc.band.size() * sizeof(D4));  // A accumulates from 0
     sc.rhs.resize(size_t(N));
     sc.invD.resize(size_t(N));
     sc.w.resize(size_t(n));
