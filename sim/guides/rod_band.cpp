@@ -91,7 +91,7 @@ template <int K, int B>
 
 }  // namespace
 
-void bandedSolve(D4* __restrict band, D4* __restrict invD, D4* __restrict rhs, int n) {
+HP_ROD_LANES_CLONES void bandedSolve(D4* __restrict band, D4* __restrict invD, D4* __restrict rhs, int n) {
     // Factorization: rows of the three kinds in turn once steady.
     int i = 0;
     for (; i < std::min(n, kSteadyFrom); ++i) factorRow(band, invD, i);

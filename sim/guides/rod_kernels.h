@@ -72,9 +72,9 @@ struct RodScratch {
     std::vector<lanes::V3<lanes::F4>> grad;  ///< constraint gradients, per row × 3 vertices
     std::vector<lanes::V3<lanes::F4>> dir;   ///< stretch pass: segment directions
     std::vector<lanes::F4> w, rest, cosine;  ///< inverse masses, rest lengths, d_j·d_{j+1}
-    std::vector<lanes::D4> band;             ///< banded systems, (bandwidth + 1) per row
-    std::vector<lanes::D4> rhs, invD;        ///< right-hand sides (then Δλ), 1/pivots
-    std::vector<lanes::D4> diag, lambda;     ///< stretch pass: pivots and right-hand side
+    std::vector<lanes::D4Store> band;             ///< banded systems, (bandwidth + 1) per row
+    std::vector<lanes::D4Store> rhs, invD;        ///< right-hand sides (then Δλ), 1/pivots
+    std::vector<lanes::D4Store> diag, lambda;     ///< stretch pass: pivots and right-hand side
     std::vector<Vec3f> a;                    ///< one lane's positions for the head placement
 };
 

@@ -14,7 +14,19 @@
 // are batched, or on the thread count, and matches the scalar kernels.
 #pragma once
 
+// HP_ROD_LANES_CLONES: a function built twice, for the x86-64 baseline
+// (SSE2: a D4 takes two instructions) and for AVX2 (one), the loader picking
+// the one the processor runs (GCC function multi-versioning). The results
+// are the same bit for bit: AVX2 adds wider registers, not other arithmetic
+// (no fused multiply-add: that is the separate FMA extension, not enabled).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define HP_ROD_LANES_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define HP_ROD_LANES_CLONES
+#endif
+
 #include <cmath>
+#include <vector>
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
@@ -28,7 +40,17 @@
 namespace hp::rod::lanes {
 
 typedef float F4 __attribute__((vector_size(16)));   ///< four strands' floats
-typedef double D4 __attribute__((vector_size(32)));  ///< four strands' doubles
+/// Four strands' doubles. Aligned to 16 bytes, not the vector's natural 32:
+/// they live in D4Store vectors (16-byte aligned), which code built for AVX
+/// (rod_step.cpp's clones) then reads with unaligned loads; may_alias
+/// because they view that storage.
+typedef double D4 __attribute__((vector_size(32), aligned(16), may_alias));
+/// Storage for D4 in containers (a template argument drops a typedef's
+/// attributes, so std::vector<D4> would not be the D4 above).
+struct alignas(16) D4Store {
+    double v[4];
+};
+inline D4* view(std::vector<D4Store>& s) { return reinterpret_cast<D4*>(s.data()); }
 
 template <class T>
 inline T splat(float v) {

@@ -87,8 +87,8 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
     const int n = s0.vertices, S = n - 1;
     V3* y = sc.y.data();
     V3* grad = sc.grad.data();
-    D4* band = sc.band.data();
-    D4* rhs = sc.rhs.data();
+    D4* band = lanes::view(sc.band);
+    D4* rhs = lanes::view(sc.rhs);
     F4* w = sc.w.data();
     F4* rest = sc.rest.data();
 
@@ -215,13 +215,13 @@ bool placeVertex(const RodStepTarget& t, int i, Vec3f* y, float h, float damp, f
 
 }  // namespace
 
-int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, float h, float drag, float friction,
-             const strand::HeadQuery* head, float radius, RodScratch& sc) {
+HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, float h,
+                                  float drag, float friction, const strand::HeadQuery* head, float radius, RodScratch& sc) {
     const int n = targets[0].strand->vertices, N = 3 * (n - 1);
     sc.y.resize(size_t(n));
     sc.grad.resize(size_t(N) * 3);
     sc.band.resize(size_t(N) * kRowLen);
-    std::memset(static_cast<void*>(sc.band.data()), 0, sc.band.size() * sizeof(D4));  // A accumulates from 0
+    std::memset(static_cast<void*>(sc.band.data()), 0, sc.band.size() * sizeof(lanes::D4Store));  // A accumulates from 0
     sc.rhs.resize(size_t(N));
     sc.invD.resize(size_t(N));
     sc.w.resize(size_t(n));
@@ -235,18 +235,18 @@ int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, floa
     for (int l = 0; l < kLanes; ++l) src[l] = l < count ? l : 0;  // idle lanes repeat lane 0
 
     assemble(targets, src, gravity, h, sc);
-    bandedSolve(sc.band.data(), sc.invD.data(), sc.rhs.data(), N);
+    bandedSolve(lanes::view(sc.band), lanes::view(sc.invD), lanes::view(sc.rhs), N);
     // 2. y += W Jᵀ Δλ: row r of joint r/3 moves its vertices j-1, j, j+1.
     V3* y = sc.y.data();
     const F4* w = sc.w.data();
     for (int r = 0; r < N; ++r) {
-        const F4 dl = lanes::narrow(sc.rhs[size_t(r)]);
+        const F4 dl = lanes::narrow(lanes::view(sc.rhs)[r]);
         for (int slot = 0; slot < 3; ++slot) {
             const int vtx = r / 3 - 1 + slot;
             if (vtx >= 1) y[vtx] = y[vtx] + (w[vtx] * dl) * sc.grad[size_t(3 * r + slot)];
         }
     }
-    stretchSolve(y, w, sc.rest.data(), n, sc.diag.data(), sc.lambda.data(), sc.dir.data(), sc.cosine.data());
+    stretchSolve(y, w, sc.rest.data(), n, lanes::view(sc.diag), lanes::view(sc.lambda), sc.dir.data(), sc.cosine.data());
 
     // 3–4. Placement root to tip, strand by strand but the strands'
     // vertices interleaved: each strand's placement is a chain of dependent
