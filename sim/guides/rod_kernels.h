@@ -75,7 +75,6 @@ struct RodScratch {
     std::vector<lanes::D4Store> band;             ///< banded systems, (bandwidth + 1) per row
     std::vector<lanes::D4Store> rhs, invD;        ///< right-hand sides (then Δλ), 1/pivots
     std::vector<lanes::D4Store> diag, lambda;     ///< stretch pass: pivots and right-hand side
-    std::vector<Vec3f> a;                    ///< one lane's positions for the head placement
 };
 
 /// One strand's state and root target for rodSteps.

@@ -1,11 +1,12 @@
 // rod::rodSteps: one XPBD step (sim/guides/rod_kernels.h gives its four
 // stages and equations) for up to four strands at once, each strand in one
 // SIMD lane (sim/guides/rod_lanes.h) from the prediction through the
-// assembly, the banded solve and the stretch pass; only the last stage, the
-// placement against the head (a virtual signed-distance query per vertex,
-// with branches), runs strand by strand. Each lane computes what the
-// single-strand arithmetic does, operation for operation, so a strand's
-// result is the same whatever the batch, the lane or the thread count.
+// assembly, the banded solve, the stretch pass and the placement of the
+// vertices clear of the head; a vertex that meets the head (or cannot keep
+// its length) takes the scalar path, and the signed-distance queries (a
+// virtual call) are one per lane. Each lane computes what the single-strand
+// arithmetic does, operation for operation, so a strand's result is the
+// same whatever the batch, the lane or the thread count.
 //
 // Layout: lane-major structure of arrays. y[i] holds vertex i of the four
 // strands (V3 of F4), grad[3r + slot] the gradient of row r on the row's
@@ -171,20 +172,20 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
     }
 }
 
-/// Steps 3–4 at vertex i of one strand: exact length and head clearance
-/// (pinned where both cannot hold: returns true), then its velocity. y: the
-/// strand's positions after the solves, placed up to i-1 (y[i] is placed
-/// here); t.x[i] still holds the step's start and receives y[i].
-bool placeVertex(const RodStepTarget& t, int i, Vec3f* y, float h, float damp, float friction,
+/// Steps 3–4 at vertex i > 0 of one strand: exact length and head
+/// clearance (pinned where both cannot hold: returns true), then its
+/// velocity. parent: vertex i-1, placed; y: vertex i after the solves, placed
+/// here; t.x[i] still holds the step's start and receives y.
+bool placeVertex(const RodStepTarget& t, int i, const Vec3f& parent, Vec3f& y, float h, float damp, float friction,
                  const strand::HeadQuery* head, float radius) {
     const Vec3f old = t.x[i];
     strand::Contact contact;
     bool pinned = false;
-    if (i > 0) {
+    {
         const float l = t.strand->restLength[i - 1];
-        contact = strand::placeSegment(y[i - 1], y[i], l, head, radius);
-        const bool lengthOk = std::abs((y[i] - y[i - 1]).norm() / l - 1.f) < 1e-4f;
-        const bool outside = !contact.active || head->distance(y[i], nullptr) > -0.1f * radius;
+        contact = strand::placeSegment(parent, y, l, head, radius);
+        const bool lengthOk = std::abs((y - parent).norm() / l - 1.f) < 1e-4f;
+        const bool outside = !contact.active || head->distance(y, nullptr) > -0.1f * radius;
         if (!lengthOk || !outside) {
             // No place at its length outside the head: held at its length
             // toward its last valid place, where it was at the step's
@@ -193,22 +194,20 @@ bool placeVertex(const RodStepTarget& t, int i, Vec3f* y, float h, float damp, f
             // surface under the parent (outside whenever the head is
             // locally convex there).
             const Vec3f last = head ? Vec3f(head->toPrevious.inverse() * old) : old;
-            y[i] = strand::followTheLeader(y[i - 1], last, l);
+            y = strand::followTheLeader(parent, last, l);
             Vec3f normal;
-            if (head && head->distance(y[i], nullptr) < 0.f) {
-                head->distance(y[i - 1], &normal);
-                y[i] = y[i - 1] + l * normal.normalized();
+            if (head && head->distance(y, nullptr) < 0.f) {
+                head->distance(parent, &normal);
+                y = parent + l * normal.normalized();
             }
             contact = strand::Contact{};
             pinned = true;
         }
     }
-    Vec3f vel = (y[i] - old) / h;
-    if (i > 0) {
-        if (contact.active) vel = strand::contactFriction(vel, head->surfaceVelocity(y[i], h), contact, friction, h);
-        vel *= damp;
-    }
-    t.x[i] = y[i];
+    Vec3f vel = (y - old) / h;
+    if (contact.active) vel = strand::contactFriction(vel, head->surfaceVelocity(y, h), contact, friction, h);
+    vel *= damp;
+    t.x[i] = y;
     t.v[i] = vel;
     return pinned;
 }
@@ -230,7 +229,6 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
     sc.lambda.resize(size_t(n));
     sc.dir.resize(size_t(n));
     sc.cosine.resize(size_t(n));
-    sc.a.resize(size_t(n) * kLanes);
     int src[kLanes];
     for (int l = 0; l < kLanes; ++l) src[l] = l < count ? l : 0;  // idle lanes repeat lane 0
 
@@ -248,18 +246,47 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
     }
     stretchSolve(y, w, sc.rest.data(), n, lanes::view(sc.diag), lanes::view(sc.lambda), sc.dir.data(), sc.cosine.data());
 
-    // 3–4. Placement root to tip, strand by strand but the strands'
-    // vertices interleaved: each strand's placement is a chain of dependent
-    // square roots and divisions, and the processor overlaps independent
-    // chains.
-    Vec3f* lanePos = sc.a.data();
-    for (int l = 0; l < count; ++l)
-        for (int i = 0; i < n; ++i) lanePos[size_t(l) * size_t(n) + size_t(i)] = lane(y[i], l);
+    // 3–4. Placement root to tip, vertex by vertex in lanes: where the
+    // follow-the-leader point of every lane is clear of the head (no
+    // contact, its length exact), the lanes finish together (placeSegment's
+    // own first test and result); a lane that meets the head or fails its
+    // length takes the scalar path (placeVertex) from its unplaced vertex.
+    // The signed-distance queries stay one per lane (a virtual call).
     const float damp = strand::dampingFactor(drag, h);
+    const bool collides = head && head->collider;
     int pinned = 0;
-    for (int i = 0; i < n; ++i)
-        for (int l = 0; l < count; ++l)
-            pinned += placeVertex(targets[l], i, lanePos + size_t(l) * size_t(n), h, damp, friction, head, radius);
+    for (int i = 0; i < n; ++i) {
+        const Vec3f* o[kLanes] = {&targets[src[0]].x[i], &targets[src[1]].x[i], &targets[src[2]].x[i],
+                                  &targets[src[3]].x[i]};
+        const V3 old = {F4{o[0]->x(), o[1]->x(), o[2]->x(), o[3]->x()}, F4{o[0]->y(), o[1]->y(), o[2]->y(), o[3]->y()},
+                        F4{o[0]->z(), o[1]->z(), o[2]->z(), o[3]->z()}};
+        bool scalar[kLanes] = {};
+        if (i > 0) {
+            // followTheLeader: parent + e·(l/|e|), or straight up from a collapsed segment.
+            const V3& parent = y[i - 1];
+            const V3 e = y[i] - parent;
+            const F4 len = lanes::norm(e), l = sc.rest[size_t(i - 1)];
+            const V3 up = {parent.x + 0.f * l, parent.y + 1.f * l, parent.z + 0.f * l};
+            V3 placed = lanes::select(len > 1e-12f, parent + (l / len) * e, up);
+            const F4 q = lanes::norm(placed - parent) / l - 1.f;
+            const auto exact = lanes::select(q < 0.f, -q, q) < 1e-4f;
+            for (int k = 0; k < count; ++k) {
+                scalar[k] = !exact[k] || (collides && !(head->distance(lane(placed, k), nullptr) >= radius));
+                if (!scalar[k]) continue;
+                Vec3f child = lane(y[i], k);
+                pinned += placeVertex(targets[k], i, lane(parent, k), child, h, damp, friction, head, radius);
+                setLane(placed, k, child);
+            }
+            y[i] = placed;
+        }
+        V3 vel = (y[i] - old) / h;
+        if (i > 0) vel = damp * vel;
+        for (int k = 0; k < count; ++k)
+            if (!scalar[k]) {
+                targets[k].x[i] = lane(y[i], k);
+                targets[k].v[i] = lane(vel, k);
+            }
+    }
     return pinned;
 }
 
