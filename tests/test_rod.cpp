@@ -80,7 +80,8 @@ TEST(Rod, StrandsBatchedInLanesStepExactlyAsOneAtATime) {
         x[k].assign(size_t(n), Vec3f::Zero());
         for (int i = 1; i < n; ++i) {
             const float a = 0.3f * float(k + 1) * float(i) / float(n);
-            x[k][size_t(i)] = x[k][size_t(i - 1)] + l * Vec3f(std::cos(a), 0.3f * std::sin(a), 0.1f * float(k)).normalized();
+            const Vec3f d = Vec3f(std::cos(a), 0.3f * std::sin(a), 0.1f * float(k)).normalized();
+            x[k][size_t(i)] = x[k][size_t(i - 1)] + l * d;
         }
         v[k].assign(size_t(n), Vec3f(0.f, 0.f, 0.1f * float(k)));
         curvature[k].resize(size_t(n - 1));
@@ -99,8 +100,8 @@ TEST(Rod, StrandsBatchedInLanesStepExactlyAsOneAtATime) {
     for (int step = 0; step < 60; ++step) {
         rod::RodStepTarget t[3];
         for (int k = 0; k < 3; ++k) {
-            pinnedLone += size_t(rod::rodStep(strands[k], x[k].data(), v[k].data(), Vec3f::Zero(), rod::Mat3f::Identity(), g,
-                                              0.01f, 1.f, 0.3f, &head, 1e-3f, lone));
+            pinnedLone += size_t(rod::rodStep(strands[k], x[k].data(), v[k].data(), Vec3f::Zero(),
+                                              rod::Mat3f::Identity(), g, 0.01f, 1.f, 0.3f, &head, 1e-3f, lone));
             t[k] = rod::RodStepTarget{&strands[k], xb[k].data(), vb[k].data(), Vec3f::Zero(), rod::Mat3f::Identity()};
         }
         pinnedBatch += size_t(rod::rodSteps(t, 3, g, 0.01f, 1.f, 0.3f, &head, 1e-3f, batch));

@@ -134,7 +134,8 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
             const int r = 3 * j + k;
             // A strand without bending stiffness has inert bend rows
             // (A = 1, C = 0, no gradient: Δλ = 0).
-            for (int slot = j == 0 ? 1 : 0; slot < 3; ++slot) grad[3 * r + slot] = lanes::select(bends, g[k][slot], V3{});
+            for (int slot = j == 0 ? 1 : 0; slot < 3; ++slot)
+                grad[3 * r + slot] = lanes::select(bends, g[k][slot], V3{});
             rhs[r] = lanes::widen(lanes::select(bends, -C[k], F4{}));
             for (int l = 0; l < kLanes; ++l) band[size_t(r) * kRowLen][l] = bendLane[l] != 0.f ? alpha[l] : 1.0;
         }
@@ -215,12 +216,14 @@ bool placeVertex(const RodStepTarget& t, int i, const Vec3f& parent, Vec3f& y, f
 }  // namespace
 
 HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, float h,
-                                  float drag, float friction, const strand::HeadQuery* head, float radius, RodScratch& sc) {
+                                  float drag, float friction, const strand::HeadQuery* head, float radius,
+                                  RodScratch& sc) {
     const int n = targets[0].strand->vertices, N = 3 * (n - 1);
     sc.y.resize(size_t(n));
     sc.grad.resize(size_t(N) * 3);
     sc.band.resize(size_t(N) * kRowLen);
-    std::memset(static_cast<void*>(sc.band.data()), 0, sc.band.size() * sizeof(lanes::D4Store));  // A accumulates from 0
+    // A accumulates from 0.
+    std::memset(static_cast<void*>(sc.band.data()), 0, sc.band.size() * sizeof(lanes::D4Store));
     sc.rhs.resize(size_t(N));
     sc.invD.resize(size_t(N));
     sc.w.resize(size_t(n));
@@ -244,7 +247,8 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
             if (vtx >= 1) y[vtx] = y[vtx] + (w[vtx] * dl) * sc.grad[size_t(3 * r + slot)];
         }
     }
-    stretchSolve(y, w, sc.rest.data(), n, lanes::view(sc.diag), lanes::view(sc.lambda), sc.dir.data(), sc.cosine.data());
+    stretchSolve(y, w, sc.rest.data(), n, lanes::view(sc.diag), lanes::view(sc.lambda), sc.dir.data(),
+                 sc.cosine.data());
 
     // 3–4. Placement root to tip, vertex by vertex in lanes: where the
     // follow-the-leader point of every lane is clear of the head (no
