@@ -19,8 +19,9 @@
 // of the guides"): the direct banded solve is exact per linearisation, so
 // the static elastica comes out within 0.3% of L at 0.01 s steps; one XPBD
 // step per 0.02 s is unstable (a hanging chain's tip oscillation grows), two
-// are the default; a 23-segment strand costs ~9.5 µs of CPU per XPBD step
-// (B-sim, 845 guides, loaded machine), about 2× the rope's step.
+// are the default; a 23-segment strand costs ~4.6 µs of CPU per XPBD step
+// with four strands per SIMD batch (B-sim, 845 guides, loaded machine;
+// sim/guides/rod_step.cpp), about 1.1× the rope's step.
 // Gauss-Seidel XPBD (cheaper per sweep, softer than its EI when
 // under-converged) was not measured.
 #include "sim/guides/guide_group.h"

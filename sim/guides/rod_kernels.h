@@ -11,9 +11,12 @@
 // (the clamped boundary condition θ(0) = 0 of a follicle).
 #pragma once
 
+#include "sim/guides/rod_lanes.h"
 #include "sim/guides/strand_constraints.h"
 
 #include <Eigen/Core>
+
+#include <vector>
 
 namespace hp::rod {
 
@@ -50,19 +53,28 @@ struct RodStrand {
     double bendStiffness = 0;              ///< EI, N·m²
 };
 
-/// Strands advanced together by rodSteps: their banded solves run side by
-/// side in SIMD lanes (each lane's arithmetic is that of a lone strand, so
-/// the result does not depend on how strands are batched).
+/// Voronoi length of joint j: l̄_0 = l_0/2 (the clamped end's half
+/// segment), else (l_{j-1} + l_j)/2.
+inline float voronoiLength(const RodStrand& s, int j) {
+    return j == 0 ? 0.5f * s.restLength[0] : 0.5f * (s.restLength[j - 1] + s.restLength[j]);
+}
+
+/// Strands advanced together by rodSteps: each in one SIMD lane
+/// (sim/guides/rod_lanes.h) through the assembly and the solves; a lane's
+/// arithmetic is that of a lone strand, so the result does not depend on
+/// how strands are batched.
 constexpr int kLanes = 4;
 
-/// Scratch for rodStep, reused between strands (one per thread).
+/// Scratch for rodSteps, reused between calls (one per thread), lane-major
+/// (sim/guides/rod_step.cpp): entry k holds the four lanes' values.
 struct RodScratch {
-    std::vector<Vec3f> grad;      ///< per lane: 3 rows per joint × 3 vertices
-    std::vector<double> band;     ///< banded systems, (bandwidth + 1) per row, lanes interleaved
-    std::vector<double> rhs, invD;
-    std::vector<Vec3f> a;         ///< per lane: positions, predicted and at the step's start
-    std::vector<double> diag, lambda;  ///< stretchSolve's pivots and right-hand side
-    std::vector<Vec3f> dir;            ///< stretchSolve's segment directions
+    std::vector<lanes::V3<lanes::F4>> y;     ///< positions, per vertex
+    std::vector<lanes::V3<lanes::F4>> grad;  ///< constraint gradients, per row × 3 vertices
+    std::vector<lanes::V3<lanes::F4>> dir;   ///< stretch pass: segment directions
+    std::vector<lanes::F4> w, rest, cosine;  ///< inverse masses, rest lengths, d_j·d_{j+1}
+    std::vector<lanes::D4Store> band;             ///< banded systems, (bandwidth + 1) per row
+    std::vector<lanes::D4Store> rhs, invD;        ///< right-hand sides (then Δλ), 1/pivots
+    std::vector<lanes::D4Store> diag, lambda;     ///< stretch pass: pivots and right-hand side
 };
 
 /// One strand's state and root target for rodSteps.
@@ -132,10 +144,10 @@ int rodStep(const RodStrand& s, Vec3f* x, Vec3f* v, const Vec3f& rootPos, const 
             const Vec3f& gravity, float h, float drag, float friction, const strand::HeadQuery* head, float radius,
             RodScratch& scratch);
 
-/// rodStep for `count` (1..kLanes) strands of the same vertex count at once:
-/// the same result per strand, bit for bit (B-sim: 1.3–1.4× the throughput
-/// of one strand at a time). Returns the
-/// number of pinned vertices of all of them.
+/// rodStep for `count` (1..kLanes) strands of the same vertex count at once,
+/// in SIMD lanes up to the head placement: the same result per strand, bit
+/// for bit, as one at a time. Returns the number of pinned vertices of all
+/// of them.
 int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, float h, float drag, float friction,
              const strand::HeadQuery* head, float radius, RodScratch& scratch);
 

@@ -12,12 +12,18 @@
 //   bench_sim [--guides 94,845] [--formulation rod,rope,rigid] [--strand-collision off,on]
 //             [--threads 1,2] [--runs 3] [--warmup 20] [--steps 250]
 //             [--substeps 1] [--iterations 20] [--rod-substeps 2] [--per-world 16] [--rate 90]
-//             [--preload on|off]
+//             [--preload on|off] [--digest]
+//
+// --digest adds a column: an FNV-1a hash of the final state bytes
+// (GuideSolver::saveState; rod and rope), the same for every run and thread
+// count when the solver is deterministic, and unchanged by an optimisation
+// that keeps the results bit for bit.
 #include "sim/strands/fibonacci.h"
 #include "sim/guides/guides.h"
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <ctime>
 #include <cstdio>
 #include <cstdlib>
@@ -64,9 +70,17 @@ struct RunResult {
     double stepsPerSecond = 0;
     double cpuMsPerStep = 0;
     GuideStats stats;
+    uint64_t digest = 0;
 };
 
-RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int warmup, int steps) {
+/// FNV-1a over bytes.
+uint64_t fnv1a(const std::vector<char>& bytes) {
+    uint64_t h = 1469598103934665603ull;
+    for (char c : bytes) h = (h ^ uint64_t(uint8_t(c))) * 1099511628211ull;
+    return h;
+}
+
+RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int warmup, int steps, bool digest) {
     const float radius = 0.1f;
     SpinningSphere head(radius, rate);
     const std::vector<Vec3f> dirs = fibonacciCap(guides);
@@ -93,6 +107,7 @@ RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int 
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     r.stepsPerSecond = steps / seconds;
     r.cpuMsPerStep = 1000.0 * (processCpuSeconds() - cpu0) / steps;
+    if (digest) r.digest = fnv1a(solver.saveState());
     return r;
 }
 
@@ -103,7 +118,7 @@ int main(int argc, char** argv) {
         threadList{"1", "2"};
     int runs = 3, warmup = 20, steps = 250, substeps = 1, iterations = 20, perWorld = 16, rodSubsteps = 2;
     float rate = 90.f;
-    bool preload = true;
+    bool preload = true, digest = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string {
@@ -126,6 +141,7 @@ int main(int argc, char** argv) {
         else if (a == "--rod-substeps") rodSubsteps = std::stoi(next());
         else if (a == "--rate") rate = std::stof(next());
         else if (a == "--preload") preload = next() != "off";
+        else if (a == "--digest") digest = true;
         else {
             std::fprintf(stderr, "bench_sim: unknown option %s\n", a.c_str());
             return 1;
@@ -136,8 +152,9 @@ int main(int argc, char** argv) {
                 "median of %d runs (min-max)\n\n",
                 rate, warmup, steps, substeps, iterations, perWorld, runs);
     std::printf("| guides | formulation | strand coll. | threads | steps/s median (min-max) | CPU ms/step (min) | "
-                "max stretch | max penetration mm | NaN | strand contacts/step (max) | load avg |\n");
-    std::printf("|---:|---|---|---:|---|---:|---:|---:|---:|---:|---:|\n");
+                "max stretch | max penetration mm | NaN | strand contacts/step (max) | load avg |%s\n",
+                digest ? " state digest |" : "");
+    std::printf("|---:|---|---|---:|---|---:|---:|---:|---:|---:|---:|%s\n", digest ? "---|" : "");
     for (const std::string& gs : guideList)
         for (const std::string& form : formList)
             for (const std::string& coll : collList)
@@ -152,7 +169,7 @@ int main(int argc, char** argv) {
                     s.rodSubsteps = rodSubsteps;
                     s.preload = preload;
                     std::vector<RunResult> results;
-                    for (int r = 0; r < runs; ++r) results.push_back(runOnce(s, std::stoul(gs), rate, warmup, steps));
+                    for (int r = 0; r < runs; ++r) results.push_back(runOnce(s, std::stoul(gs), rate, warmup, steps, digest));
                     std::vector<double> sps, cpu;
                     GuideStats worst = results[0].stats;
                     for (const RunResult& r : results) {
@@ -165,10 +182,18 @@ int main(int argc, char** argv) {
                     const double median = sps[sps.size() / 2];
                     double load[1] = {0};
                     getloadavg(load, 1);
-                    std::printf("| %s | %s | %s | %s | %.1f (%.1f-%.1f) | %.2f (%.2f) | %.2e | %.3f | %zu | %zu | %.2f |\n",
+                    std::printf("| %s | %s | %s | %s | %.1f (%.1f-%.1f) | %.2f (%.2f) | %.2e | %.3f | %zu | %zu | %.2f |",
                                 gs.c_str(), form.c_str(), coll.c_str(), th.c_str(), median, sps.front(), sps.back(),
                                 cpu[cpu.size() / 2], cpu.front(), worst.maxLengthError,
                                 worst.maxPenetration * 1000.0, worst.nanCount, worst.strandContacts, load[0]);
+                    if (digest) {
+                        // Every run's digest must agree; a mismatch is printed as such.
+                        bool same = true;
+                        for (const RunResult& r : results) same = same && r.digest == results[0].digest;
+                        std::printf(same ? " %016llx |" : " %016llx (runs differ) |",
+                                    (unsigned long long)results[0].digest);
+                    }
+                    std::printf("\n");
                     std::fflush(stdout);
                 }
     return 0;

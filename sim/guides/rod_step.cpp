@@ -1,0 +1,304 @@
+// rod::rodSteps: one XPBD step (sim/guides/rod_kernels.h gives its four
+// stages and equations) for up to four strands at once, each strand in one
+// SIMD lane (sim/guides/rod_lanes.h) from the prediction through the
+// assembly, the banded solve, the stretch pass and the placement of the
+// vertices clear of the head; a vertex that meets the head (or cannot keep
+// its length) takes the scalar path, and the signed-distance queries (a
+// virtual call) are one per lane. Each lane computes what the single-strand
+// arithmetic does, operation for operation, so a strand's result is the
+// same whatever the batch, the lane or the thread count.
+//
+// Layout: lane-major structure of arrays. y[i] holds vertex i of the four
+// strands (V3 of F4), grad[3r + slot] the gradient of row r on the row's
+// vertex `slot`, and the banded system's entry A(r, r-k) of the four
+// strands is band[r·(kBand+1) + k] (a D4). Idle lanes (fewer than four
+// strands) repeat lane 0's strand and are dropped at the end.
+#include "sim/guides/rod_kernels.h"
+#include "sim/guides/rod_band.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+// See rod_lanes.h: D4 values never cross a library boundary.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace hp::rod {
+
+using lanes::D4;
+using lanes::F4;
+using V3 = lanes::V3<F4>;
+
+namespace {
+
+static_assert(kLanes == 4, "rod_lanes.h packs four strands per SIMD register");
+
+/// One mass-weighted Newton step on the stretch constraints alone,
+/// C_j = |x_{j+1} - x_j| - l_j: J W Jᵀ is tridiagonal,
+///   A_jj = w_j + w_{j+1},  A_{j,j+1} = -w_{j+1} d_j·d_{j+1},
+/// solved by the Thomas algorithm; x_j -= w_j d_j Δλ_j, x_{j+1} += w_{j+1} d_j Δλ_j.
+/// Momentum-conserving, unlike follow-the-leader; it leaves a stretch error
+/// of the second order, which the final exact placement then removes
+/// without visible bias.
+void stretchSolve(V3* x, const F4* w, const F4* rest, int n, D4* diag, D4* rhs, V3* dir, F4* cosine) {
+    const int S = n - 1;
+    for (int j = 0; j < S; ++j) {
+        const V3 e = x[j + 1] - x[j];
+        const F4 len = lanes::norm(e);
+        dir[j] = e / len;
+        rhs[j] = -(lanes::widen(len) - lanes::widen(rest[j]));
+    }
+    for (int j = 0; j + 1 < S; ++j) cosine[j] = lanes::dot(dir[j], dir[j + 1]);
+    // Forward elimination: diag holds the modified pivots.
+    for (int j = 0; j < S; ++j) {
+        D4 a = lanes::widen(w[j]) + lanes::widen(w[j + 1]);
+        if (j > 0) {
+            const D4 off = -lanes::widen(w[j]) * lanes::widen(cosine[j - 1]);
+            const D4 f = off / diag[j - 1];
+            a -= f * off;
+            rhs[j] -= f * rhs[j - 1];
+        }
+        diag[j] = a;
+    }
+    for (int j = S - 1; j >= 0; --j) {
+        if (j + 1 < S) rhs[j] -= -lanes::widen(w[j + 1]) * lanes::widen(cosine[j]) * rhs[j + 1];
+        rhs[j] /= diag[j];
+    }
+    for (int j = 0; j < S; ++j) {
+        const V3 dl = lanes::narrow(rhs[j]) * dir[j];
+        x[j] = x[j] - w[j] * dl;
+        x[j + 1] = x[j + 1] + w[j + 1] * dl;
+    }
+}
+
+/// Lane l of a lane vector, and writing it.
+inline Vec3f lane(const V3& v, int l) { return Vec3f(v.x[l], v.y[l], v.z[l]); }
+inline void setLane(V3& v, int l, const Vec3f& p) {
+    v.x[l] = p.x();
+    v.y[l] = p.y();
+    v.z[l] = p.z();
+}
+
+/// Steps 1–2 of rodStep up to the solve: predicts y, writes the constraint
+/// gradients (rows a, b, stretch of joint j at 3j..3j+2, slots j-1, j, j+1)
+/// and the system A = J W Jᵀ + α̃ with right-hand side -C(y), for the four
+/// lanes (src[l]: the target in lane l).
+void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, float h, RodScratch& sc) {
+    const RodStrand& s0 = *t[0].strand;
+    const int n = s0.vertices, S = n - 1;
+    V3* y = sc.y.data();
+    V3* grad = sc.grad.data();
+    D4* band = lanes::view(sc.band);
+    D4* rhs = lanes::view(sc.rhs);
+    F4* w = sc.w.data();
+    F4* rest = sc.rest.data();
+
+    // Per-lane constants: masses, rest lengths, the start of the frame, α̃.
+    V3 u, a;
+    F4 bendLane{};  // nonzero where the strand bends (EI > 0)
+    D4 alphaScale{};
+    for (int l = 0; l < kLanes; ++l) {
+        const RodStepTarget& tl = t[src[l]];
+        const RodStrand& s = *tl.strand;
+        for (int i = 0; i < n; ++i) w[i][l] = s.invMass[i];
+        for (int j = 0; j < S; ++j) rest[j][l] = s.restLength[j];
+        const Vec3f ul = (tl.rootFrame * s.ghostDir).normalized();
+        setLane(u, l, ul);
+        setLane(a, l, frameStart(tl.rootFrame, ul));
+        bendLane[l] = s.bendStiffness > 0 ? 1.f : 0.f;
+        alphaScale[l] = s.bendStiffness * double(h) * h;
+        // 1. Prediction y = x + h·v + h²·g; the root at its target.
+        setLane(y[0], l, tl.rootPos);
+        for (int i = 1; i < n; ++i) setLane(y[i], l, tl.x[i] + h * tl.v[i] + (h * h) * gravity);
+    }
+    const auto bends = bendLane != 0.f;
+    F4 ulen = lanes::splat<F4>(1.f);
+
+    // Constraint rows and gradients at y, joint by joint along the transported frame.
+    for (int j = 0; j < S; ++j) {
+        const V3 e = y[j + 1] - y[j];
+        const Vec2f* rc[kLanes];  // rest curvatures of joint j
+        D4 alpha{};
+        for (int l = 0; l < kLanes; ++l) {
+            const RodStrand& s = *t[src[l]].strand;
+            rc[l] = &s.restCurvature[j];
+            alpha[l] = double(voronoiLength(s, j));
+        }
+        const F4 c[2] = {F4{(*rc[0])[0], (*rc[1])[0], (*rc[2])[0], (*rc[3])[0]},
+                         F4{(*rc[0])[1], (*rc[1])[1], (*rc[2])[1], (*rc[3])[1]}};
+        F4 C[2];
+        V3 g[2][3];
+        lanes::bendRows(u, ulen, e, a, c, j == 0, C, g);
+        alpha /= alphaScale;  // α̃ = l̄/(EI h²)
+        for (int k = 0; k < 2; ++k) {
+            const int r = 3 * j + k;
+            // A strand without bending stiffness has inert bend rows
+            // (A = 1, C = 0, no gradient: Δλ = 0).
+            for (int slot = j == 0 ? 1 : 0; slot < 3; ++slot)
+                grad[3 * r + slot] = lanes::select(bends, g[k][slot], V3{});
+            rhs[r] = lanes::widen(lanes::select(bends, -C[k], F4{}));
+            for (int l = 0; l < kLanes; ++l) band[size_t(r) * kRowLen][l] = bendLane[l] != 0.f ? alpha[l] : 1.0;
+        }
+        const F4 len = lanes::norm(e);
+        const V3 d = e / len;
+        const int r = 3 * j + 2;
+        grad[3 * r] = V3{};  // the stretch row does not touch vertex j-1
+        grad[3 * r + 1] = -d;
+        grad[3 * r + 2] = d;
+        rhs[r] = lanes::widen(-(len - rest[j]));
+        lanes::advanceFrame(u, ulen, a, e);
+    }
+
+    // A = J W Jᵀ (+ α̃ already on the diagonal), lower band, vertex by
+    // vertex: the rows touching free vertex v are the bend rows of joints
+    // v-1, v, v+1 and the stretch rows of joints v-1, v (at most 8, rows
+    // within 7 of each other); each pair adds w_v·g_a·g_b.
+    for (int vtx = 1; vtx < n; ++vtx) {
+        int rows[8];
+        const V3* grads[8];
+        int count = 0;
+        for (int j = vtx - 1; j <= std::min(vtx + 1, S - 1); ++j) {
+            const int slot = vtx - j + 1;
+            const int kinds = j <= vtx ? 3 : 2;  // joint v+1's stretch row does not touch v
+            for (int k = 0; k < kinds; ++k) {
+                rows[count] = 3 * j + k;
+                grads[count++] = &grad[3 * (3 * j + k) + slot];
+            }
+        }
+        for (int p = 0; p < count; ++p) {
+            const V3 ga = w[vtx] * *grads[p];
+            D4* row = band + size_t(rows[p]) * kRowLen;
+            for (int q = 0; q <= p; ++q) row[rows[p] - rows[q]] += lanes::widen(lanes::dot(ga, *grads[q]));
+        }
+    }
+}
+
+/// Steps 3–4 at vertex i > 0 of one strand: exact length and head
+/// clearance (pinned where both cannot hold: returns true), then its
+/// velocity. parent: vertex i-1, placed; y: vertex i after the solves, placed
+/// here; t.x[i] still holds the step's start and receives y.
+bool placeVertex(const RodStepTarget& t, int i, const Vec3f& parent, Vec3f& y, float h, float damp, float friction,
+                 const strand::HeadQuery* head, float radius) {
+    const Vec3f old = t.x[i];
+    strand::Contact contact;
+    bool pinned = false;
+    {
+        const float l = t.strand->restLength[i - 1];
+        contact = strand::placeSegment(parent, y, l, head, radius);
+        const bool lengthOk = std::abs((y - parent).norm() / l - 1.f) < 1e-4f;
+        const bool outside = !contact.active || head->distance(y, nullptr) > -0.1f * radius;
+        if (!lengthOk || !outside) {
+            // No place at its length outside the head: held at its length
+            // toward its last valid place, where it was at the step's
+            // start, carried along with the head's motion.
+            // If the head took that place too, straight out from the
+            // surface under the parent (outside whenever the head is
+            // locally convex there).
+            const Vec3f last = head ? Vec3f(head->toPrevious.inverse() * old) : old;
+            y = strand::followTheLeader(parent, last, l);
+            Vec3f normal;
+            if (head && head->distance(y, nullptr) < 0.f) {
+                head->distance(parent, &normal);
+                y = parent + l * normal.normalized();
+            }
+            contact = strand::Contact{};
+            pinned = true;
+        }
+    }
+    Vec3f vel = (y - old) / h;
+    if (contact.active) vel = strand::contactFriction(vel, head->surfaceVelocity(y, h), contact, friction, h);
+    vel *= damp;
+    t.x[i] = y;
+    t.v[i] = vel;
+    return pinned;
+}
+
+}  // namespace
+
+HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, float h,
+                                  float drag, float friction, const strand::HeadQuery* head, float radius,
+                                  RodScratch& sc) {
+    const int n = targets[0].strand->vertices, N = 3 * (n - 1);
+    sc.y.resize(size_t(n));
+    sc.grad.resize(size_t(N) * 3);
+    sc.band.resize(size_t(N) * kRowLen);
+    // A accumulates from 0.
+    std::memset(static_cast<void*>(sc.band.data()), 0, sc.band.size() * sizeof(lanes::D4Store));
+    sc.rhs.resize(size_t(N));
+    sc.invD.resize(size_t(N));
+    sc.w.resize(size_t(n));
+    sc.rest.resize(size_t(n));
+    sc.diag.resize(size_t(n));
+    sc.lambda.resize(size_t(n));
+    sc.dir.resize(size_t(n));
+    sc.cosine.resize(size_t(n));
+    int src[kLanes];
+    for (int l = 0; l < kLanes; ++l) src[l] = l < count ? l : 0;  // idle lanes repeat lane 0
+
+    assemble(targets, src, gravity, h, sc);
+    bandedSolve(lanes::view(sc.band), lanes::view(sc.invD), lanes::view(sc.rhs), N);
+    // 2. y += W Jᵀ Δλ: row r of joint r/3 moves its vertices j-1, j, j+1.
+    V3* y = sc.y.data();
+    const F4* w = sc.w.data();
+    for (int r = 0; r < N; ++r) {
+        const F4 dl = lanes::narrow(lanes::view(sc.rhs)[r]);
+        for (int slot = 0; slot < 3; ++slot) {
+            const int vtx = r / 3 - 1 + slot;
+            if (vtx >= 1) y[vtx] = y[vtx] + (w[vtx] * dl) * sc.grad[size_t(3 * r + slot)];
+        }
+    }
+    stretchSolve(y, w, sc.rest.data(), n, lanes::view(sc.diag), lanes::view(sc.lambda), sc.dir.data(),
+                 sc.cosine.data());
+
+    // 3–4. Placement root to tip, vertex by vertex in lanes: where the
+    // follow-the-leader point of every lane is clear of the head (no
+    // contact, its length exact), the lanes finish together (placeSegment's
+    // own first test and result); a lane that meets the head or fails its
+    // length takes the scalar path (placeVertex) from its unplaced vertex.
+    // The signed-distance queries stay one per lane (a virtual call).
+    const float damp = strand::dampingFactor(drag, h);
+    const bool collides = head && head->collider;
+    int pinned = 0;
+    for (int i = 0; i < n; ++i) {
+        const Vec3f* o[kLanes] = {&targets[src[0]].x[i], &targets[src[1]].x[i], &targets[src[2]].x[i],
+                                  &targets[src[3]].x[i]};
+        const V3 old = {F4{o[0]->x(), o[1]->x(), o[2]->x(), o[3]->x()}, F4{o[0]->y(), o[1]->y(), o[2]->y(), o[3]->y()},
+                        F4{o[0]->z(), o[1]->z(), o[2]->z(), o[3]->z()}};
+        bool scalar[kLanes] = {};
+        if (i > 0) {
+            // followTheLeader: parent + e·(l/|e|), or straight up from a collapsed segment.
+            const V3& parent = y[i - 1];
+            const V3 e = y[i] - parent;
+            const F4 len = lanes::norm(e), l = sc.rest[size_t(i - 1)];
+            const V3 up = {parent.x + 0.f * l, parent.y + 1.f * l, parent.z + 0.f * l};
+            V3 placed = lanes::select(len > 1e-12f, parent + (l / len) * e, up);
+            const F4 q = lanes::norm(placed - parent) / l - 1.f;
+            const auto exact = lanes::select(q < 0.f, -q, q) < 1e-4f;
+            for (int k = 0; k < count; ++k) {
+                scalar[k] = !exact[k] || (collides && !(head->distance(lane(placed, k), nullptr) >= radius));
+                if (!scalar[k]) continue;
+                Vec3f child = lane(y[i], k);
+                pinned += placeVertex(targets[k], i, lane(parent, k), child, h, damp, friction, head, radius);
+                setLane(placed, k, child);
+            }
+            y[i] = placed;
+        }
+        V3 vel = (y[i] - old) / h;
+        if (i > 0) vel = damp * vel;
+        for (int k = 0; k < count; ++k)
+            if (!scalar[k]) {
+                targets[k].x[i] = lane(y[i], k);
+                targets[k].v[i] = lane(vel, k);
+            }
+    }
+    return pinned;
+}
+
+int rodStep(const RodStrand& s, Vec3f* x, Vec3f* v, const Vec3f& rootPos, const Mat3f& rootFrame,
+            const Vec3f& gravity, float h, float drag, float friction, const strand::HeadQuery* head, float radius,
+            RodScratch& sc) {
+    const RodStepTarget t{&s, x, v, rootPos, rootFrame};
+    return rodSteps(&t, 1, gravity, h, drag, friction, head, radius, sc);
+}
+
+}  // namespace hp::rod
