@@ -53,7 +53,7 @@ class GuideModel {
     /// Time of the next step's end.
     virtual double nextTime() const = 0;
     virtual double time() const = 0;
-    virtual GuideStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) = 0;
+    virtual StepStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) = 0;
     virtual void write(StrandFrame& frame, double time) const = 0;
     virtual size_t guideCount() const = 0;
     /// -1 unless the model has a saturation.
@@ -77,7 +77,7 @@ class RigidChainModel final : public GuideModel {
     }
     double nextTime() const override { return solver_.nextTime(); }
     double time() const override { return solver_.time(); }
-    GuideStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
+    StepStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
         return solver_.step(roots, head);
     }
     void write(StrandFrame& frame, double time) const override { solver_.write(frame, time); }
@@ -102,24 +102,15 @@ class CurlyWetModel final : public GuideModel {
     }
     double nextTime() const override { return solver_.nextTime(); }
     double time() const override { return solver_.time(); }
-    GuideStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
+    StepStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
         solver_.setSaturation(sceneSaturation(scene_, head.time));
-        const CurlyWetStats& c = solver_.step(roots, head);
+        const StepStats& c = solver_.step(roots, head);
         if (c.implicitFailures > 0)
             logWarning("curly-wet: at t = ", head.time, " s the implicit spring step of ", c.implicitFailures,
                        " strand-substep(s) was not finite; those strands skipped their curl, bending and core "
                        "forces for it (try a smaller simulation.time_step, more substeps or softer hair.curly "
                        "stiffnesses)");
-        GuideStats g;
-        g.maxLengthError = c.maxLengthError;
-        g.meanLengthError = c.meanLengthError;
-        g.penetrationCount = c.penetrationCount;
-        g.maxPenetration = c.maxPenetration;
-        g.kineticEnergy = c.kineticEnergy;
-        g.nanCount = c.nanCount;
-        g.msPerStep = c.msPerStep;
-        g.reset = c.reset;
-        return g;
+        return c;
     }
     void write(StrandFrame& frame, double time) const override { solver_.write(frame, time); }
     size_t guideCount() const override { return solver_.guideCount(); }
@@ -309,7 +300,7 @@ const StrandFrame& ShotSimulation::advanceTo(int frame) {
         const HeadPose pose = head_.motion->sample(t);
         evaluateRoots(pose.mesh, roots_.guides, guideFrames_);
         pendingHeadMs_ += msSince(headStart);
-        const GuideStats s = model_->step(guideFrames_, pose);
+        const StepStats s = model_->step(guideFrames_, pose);
         if (pendingSteps_++ == 0) pending_ = s;
         else pending_.accumulate(s);
         if (s.nanCount > 0)
@@ -345,7 +336,7 @@ void ShotSimulation::produceFrame(double time) {
     stats_ = SimFrameStats{};
     stats_.frame = frame_;
     stats_.time = time;
-    stats_.guides = pendingSteps_ ? pending_ : GuideStats{};
+    stats_.guides = pendingSteps_ ? pending_ : StepStats{};
     stats_.guides.steps = pendingSteps_;
     stats_.followerProjected = fs.projected;
     const Followers::LengthError lengthError = followers_->lengthError(strands_);
@@ -356,7 +347,7 @@ void ShotSimulation::produceFrame(double time) {
     stats_.vertices = strands_.vertexCount();
     stats_.saturation = model_->saturation();
     stats_.totalMs = msSince(start) + pending_.msPerStep * double(pendingSteps_);
-    pending_ = GuideStats{};
+    pending_ = StepStats{};
     pendingSteps_ = 0;
     pendingHeadMs_ = 0;
 }
@@ -427,7 +418,7 @@ void ShotSimulation::restoreCheckpoint(const fs::path& file, const StrandFrame& 
     stats_.time = strands.time;
     stats_.strands = strands_.strandCount();
     stats_.vertices = strands_.vertexCount();
-    pending_ = GuideStats{};
+    pending_ = StepStats{};
     pendingSteps_ = 0;
     pendingHeadMs_ = 0;
 }

@@ -21,9 +21,13 @@
 // parallel with TBB; cohesion reads the previous step's positions of all
 // strands, so the result does not depend on the thread count.
 //
-// Bullet stays inside sim/*.cpp; this header is plain C++ and Eigen.
+// The stepping itself (time, head interpolation, scene cuts, written frames,
+// statistics) is the skeleton every strand model shares
+// (sim/solver/strand_solver.h). Bullet stays inside sim/*.cpp; this header
+// is plain C++ and Eigen.
 #pragma once
 
+#include "sim/solver/step_stats.h"
 #include "sim/strands/head.h"
 #include "sim/strands/strand.h"
 
@@ -98,32 +102,6 @@ struct CurlyWetSettings {
     void validate() const;
 };
 
-/// Measurements of one step (same fields as the rigid-chain GuideStats, plus
-/// the wet ones).
-struct CurlyWetStats {
-    double maxLengthError = 0;      ///< max |edge length / rest - 1|
-    double meanLengthError = 0;     ///< mean |edge length / rest - 1|
-    size_t penetrationCount = 0;    ///< particles inside the head (signed distance < 0)
-    double maxPenetration = 0;      ///< deepest particle below the head surface, m
-    double kineticEnergy = 0;       ///< J, end of step
-    size_t nanCount = 0;            ///< non-finite positions or velocities
-    double msPerStep = 0;           ///< wall-clock milliseconds of step()
-    bool reset = false;             ///< a teleport / scene cut reset the guides this step
-    double meanSaturation = 0;      ///< mean σ over the free particles
-    double meanCohesionNeighbours = 0; ///< mean other-strand neighbours within the cohesion radius
-    size_t adhesionCount = 0;       ///< particles held by adhesion in the last Bullet step
-    /// Strand-substeps whose linearly implicit spring system was not finite:
-    /// those strands moved under gravity and constraints alone for that
-    /// substep (their seed forces were skipped). Non-zero means the settings
-    /// are too stiff for the step; the pipeline warns.
-    size_t implicitFailures = 0;
-    size_t steps = 1;               ///< steps folded in (accumulate)
-
-    /// Folds `s` into running maxima (kinetic energy, saturation: the last
-    /// value; ms: the mean).
-    void accumulate(const CurlyWetStats& s);
-};
-
 /// Drives all curly guides of a shot. Not thread-safe itself; parallel inside.
 class CurlyWetSolver {
   public:
@@ -154,7 +132,7 @@ class CurlyWetSolver {
     /// the end of the step (head.time must be time() + timeStep; its collider
     /// may be null: no collision, no adhesion). A jump beyond the teleport
     /// limits resets the guides to rest on the new roots.
-    const CurlyWetStats& step(const std::vector<SurfaceFrame>& roots, const HeadPose& head);
+    const StepStats& step(const std::vector<SurfaceFrame>& roots, const HeadPose& head);
 
     /// Writes the guides at time() into `frame` (cleared first): positions,
     /// velocities, tapered radii, ids 0..N-1, guideCount = N.
@@ -179,9 +157,9 @@ class CurlyWetSolver {
     void restoreState(const std::vector<char>& state);
     const CurlyWetSettings& settings() const;
     /// Statistics of the last step (all zero before the first).
-    const CurlyWetStats& lastStats() const;
+    const StepStats& lastStats() const;
     /// Statistics of the current state without stepping.
-    CurlyWetStats measure(const Collider* collider) const;
+    StepStats measure(const Collider* collider) const;
 
     /// Curl radius and pitch fitted to each guide (sim/curly/curly_kernels.h
     /// fitHelix, leaving out the first `skip` edges), medians over the guides;

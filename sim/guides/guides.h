@@ -12,7 +12,7 @@
 //   sim/guides/rod_group.cpp); no Bullet world, Bullet only for strand-strand pairs.
 // - `Rope` (the previous production formulation): each guide is a Bullet btSoftBody rope;
 //   Bullet integrates gravity and solves the stretch links, interleaved with
-//   the bend limits; the kernels of sim/guides/strand_constraints.h turn the joints
+//   the bend limits; the kernels of sim/guides/joint_kernels.h turn the joints
 //   toward the (gravity pre-loaded) rest shape on Bullet's prediction and,
 //   after the step, restore exact lengths and push vertices out of the
 //   head's signed distance with Coulomb friction. Meets the length,
@@ -23,9 +23,13 @@
 //   springs toward the rest pose, a projection limit; the head is a kinematic
 //   Bullet triangle-mesh body.
 //
-// Bullet stays inside sim/*.cpp; this header is plain C++ and Eigen.
+// The stepping itself (time, head interpolation, scene cuts, written frames,
+// statistics) is the skeleton every strand model shares
+// (sim/solver/strand_solver.h). Bullet stays inside sim/*.cpp; this header
+// is plain C++ and Eigen.
 #pragma once
 
+#include "sim/solver/step_stats.h"
 #include "sim/strands/head.h"
 #include "sim/strands/strand.h"
 
@@ -104,29 +108,6 @@ struct GuideSettings {
     void validate() const;
 };
 
-/// Measurements of one step (or accumulated over many: see accumulate()).
-struct GuideStats {
-    double maxLengthError = 0;      ///< max |segment length / rest - 1|
-    double meanLengthError = 0;     ///< mean |segment length / rest - 1|
-    size_t penetrationCount = 0;    ///< vertices inside the head (signed distance < 0)
-    double maxPenetration = 0;      ///< deepest vertex below the head surface, m (0 = none)
-    double kineticEnergy = 0;       ///< J, end of step
-    size_t nanCount = 0;            ///< non-finite vertex positions or velocities
-    long firstNonFinite = -1;       ///< lowest guide index with a non-finite value (-1: none)
-    size_t clampedCount = 0;        ///< vertex velocities scaled back to maxSpeed
-    size_t strandContacts = 0;      ///< strand-strand contacts resolved in the step
-    size_t pinnedCount = 0;         ///< rod: vertices pinned (no place outside the head at their length)
-    double msPerStep = 0;           ///< wall-clock milliseconds of step()
-    bool reset = false;             ///< a teleport / scene cut reset the guides this step
-
-    size_t steps = 1;               ///< steps folded in (for the running mean of msPerStep)
-
-    /// Folds `s` into running maxima (kinetic energy: the last value; ms: the mean).
-    void accumulate(const GuideStats& s);
-    /// One JSON object on one line (for a per-frame statistics file, JSON lines).
-    std::string json(int frame, double time) const;
-};
-
 /// Drives all guides of a shot. Not thread-safe itself; parallel inside.
 class GuideSolver {
   public:
@@ -148,7 +129,7 @@ class GuideSolver {
     /// may be null; its mesh is used only by the rigid formulation). A jump of
     /// the head transform or of a root beyond the teleport limits resets the
     /// guides to their rest shape at the new roots.
-    const GuideStats& step(const std::vector<SurfaceFrame>& roots, const HeadPose& head);
+    const StepStats& step(const std::vector<SurfaceFrame>& roots, const HeadPose& head);
 
     /// Writes the guides at time() into `frame` (cleared first): positions,
     /// velocities, tapered radii, ids 0..N-1, guideCount = N.
@@ -164,9 +145,9 @@ class GuideSolver {
     size_t guideCount() const;
     const GuideSettings& settings() const;
     /// Statistics of the last step (all zero before the first).
-    const GuideStats& lastStats() const;
+    const StepStats& lastStats() const;
     /// Statistics of the current state without stepping (used after initialize).
-    GuideStats measure(const Collider* collider) const;
+    StepStats measure(const Collider* collider) const;
 
     /// The dynamic state (positions, velocities, root targets, time) as
     /// bytes, for checkpoints. Rope only: the rigid formulation keeps state

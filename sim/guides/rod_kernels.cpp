@@ -89,13 +89,8 @@ void bandedSolve(double* band, double* invD, double* rhs, int n) {
                 for (int l = 0; l < L; ++l) rhs[i * L + l] -= band[(size_t(k) * W + size_t(k - i)) * L + l] * rhs[k * L + l];
 }
 
-/// One mass-weighted Newton step on the stretch constraints alone,
-/// C_j = |x_{j+1} - x_j| - l_j: J W Jᵀ is tridiagonal,
-///   A_jj = w_j + w_{j+1},  A_{j,j+1} = -w_{j+1} d_j·d_{j+1},
-/// solved by the Thomas algorithm; x_j -= w_j d_j Δλ_j, x_{j+1} += w_{j+1} d_j Δλ_j.
-/// Momentum-conserving, unlike follow-the-leader; it leaves a stretch error
-/// of the second order, which the final exact placement then removes
-/// without visible bias.
+}  // namespace
+
 void stretchSolve(Vec3f* x, const float* w, const float* rest, int n, double* diag, double* rhs, Vec3f* dir) {
     const int S = n - 1;
     for (int j = 0; j < S; ++j) {
@@ -125,8 +120,6 @@ void stretchSolve(Vec3f* x, const float* w, const float* rest, int n, double* di
         x[j + 1] += w[j + 1] * dl;
     }
 }
-
-}  // namespace
 
 Vec3f frameStart(const Mat3f& R, const Vec3f& d) {
     Vec3f a = R.col(0) - R.col(0).dot(d) * d;

@@ -11,7 +11,10 @@
 // (the clamped boundary condition θ(0) = 0 of a follicle).
 #pragma once
 
-#include "sim/guides/strand_constraints.h"
+#include "sim/solver/damping.h"
+#include "sim/solver/head_contact.h"
+#include "sim/solver/length_kernels.h"
+#include "sim/solver/strand_state.h"
 
 #include <Eigen/Core>
 
@@ -138,6 +141,18 @@ int rodStep(const RodStrand& s, Vec3f* x, Vec3f* v, const Vec3f& rootPos, const 
 /// number of pinned vertices of all of them.
 int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, float h, float drag, float friction,
              const strand::HeadQuery* head, float radius, RodScratch& scratch);
+
+/// One mass-weighted Newton step on the stretch constraints alone,
+/// C_j = |x_{j+1} - x_j| - l_j: J W Jᵀ is tridiagonal,
+///   A_jj = w_j + w_{j+1},  A_{j,j+1} = -w_{j+1} d_j·d_{j+1},
+/// solved by the Thomas algorithm; x_j -= w_j d_j Δλ_j, x_{j+1} += w_{j+1} d_j Δλ_j.
+/// Momentum-conserving, unlike follow-the-leader; it leaves a stretch error
+/// of the second order, which the final exact placement then removes
+/// without visible bias.
+/// `w` the inverse masses (n entries), `rest` the rest lengths (n - 1);
+/// diag, rhs (n - 1 doubles) and dir (n - 1) are scratch. The length pass of
+/// rodStep, before its exact-length finish.
+void stretchSolve(Vec3f* x, const float* w, const float* rest, int n, double* diag, double* rhs, Vec3f* dir);
 
 /// Total bending energy Σ EI/(2 l̄_j)|C_j|² of a strand, J.
 double bendEnergy(const RodStrand& s, const Vec3f* x, const Mat3f& rootFrame);

@@ -4,7 +4,9 @@
 // closest points, and the contacts are resolved at position level in a fixed
 // order. It couples all guides, so it runs serially between the parallel
 // per-world steps (that is its cost; the switch is off by default).
+#include "sim/collision/bullet_adapter.h"
 #include "sim/guides/guide_group.h"
+#include "sim/guides/segment_contact.h"
 
 #include <btBulletCollisionCommon.h>
 
@@ -15,8 +17,8 @@
 namespace hp::guides {
 namespace {
 
-inline btVector3 bt(const Vec3f& v) { return btVector3(v.x(), v.y(), v.z()); }
-inline Vec3f ei(const btVector3& v) { return Vec3f(v.x(), v.y(), v.z()); }
+using bullet::bt;
+using bullet::ei;
 
 /// Rejects pairs of one guide's neighbouring segments (they share a vertex).
 struct NeighbourFilter final : btOverlapFilterCallback {
