@@ -11,7 +11,7 @@
 
 #include "sim/curly/curly_dynamics.h"
 #include "sim/curly/curly_wet.h"
-#include "sim/solver/strand_solver.h"
+#include "sim/solver/skeleton.h"
 
 #include <memory>
 #include <vector>

@@ -1,6 +1,6 @@
 // CurlyWetSolver: rest shapes, saturation and the curly guides' own step
 // (cohesion pass, substeps over the Bullet worlds) plugged into the solver
-// skeleton (sim/solver/strand_solver.h: time, head interpolation, scene cuts,
+// skeleton (sim/solver/skeleton.h: time, head interpolation, scene cuts,
 // written frames, statistics). The Bullet side is sim/curly/curly_world.cpp.
 #include "sim/curly/curly_wet.h"
 
@@ -56,13 +56,13 @@ struct CurlyWetSolver::Impl final : solver::StrandModel {
     std::vector<std::unique_ptr<curly::CurlyWorld>> groups;
     std::vector<uint32_t> strandOf;
     curly::SpatialGrid grid;
-    solver::StrandSolver skeleton;
+    solver::Skeleton skeleton;
     // Counters of the current step.
     std::vector<curly::GroupCounters> counters;  ///< per group, of the last substep
     size_t failures = 0;
     double neighbours = 0;
 
-    explicit Impl(const CurlyWetSettings& s) : skeleton(*this, set, solver::skeletonSettings("curly/wet solver", s)) {
+    explicit Impl(const CurlyWetSettings& s) : skeleton(*this, set, "curly/wet solver", s) {
         set.settings = s;
     }
 
@@ -142,6 +142,7 @@ struct CurlyWetSolver::Impl final : solver::StrandModel {
 CurlyWetSolver::CurlyWetSolver(const CurlyWetSettings& settings) {
     settings.validate();
     impl_ = std::make_unique<Impl>(settings);
+    skeleton_ = &impl_->skeleton;
 }
 
 CurlyWetSolver::~CurlyWetSolver() = default;
@@ -266,10 +267,6 @@ void CurlyWetSolver::setSaturation(const std::vector<float>& perParticle) {
 
 const std::vector<float>& CurlyWetSolver::saturation() const { return impl_->set.sigma; }
 
-const StepStats& CurlyWetSolver::step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) {
-    return impl_->skeleton.step(roots, head);
-}
-
 StepStats CurlyWetSolver::Impl::measure(const Collider* collider) const {
     struct Partial {
         double maxErr = 0, sumErr = 0, maxDepth = 0, energy = 0, sigma = 0;
@@ -323,13 +320,6 @@ StepStats CurlyWetSolver::Impl::measure(const Collider* collider) const {
     return s;
 }
 
-void CurlyWetSolver::write(StrandFrame& frame) const { write(frame, impl_->skeleton.time()); }
-
-void CurlyWetSolver::write(StrandFrame& frame, double time) const { impl_->skeleton.write(frame, time); }
-
-double CurlyWetSolver::time() const { return impl_->skeleton.time(); }
-double CurlyWetSolver::nextTime() const { return impl_->skeleton.nextTime(); }
-
 std::vector<char> CurlyWetSolver::saveState() const {
     const Impl& m = *impl_;
     const CurlySet& set = m.set;
@@ -351,10 +341,8 @@ void CurlyWetSolver::restoreState(const std::vector<char>& state) {
     r.finish();
     m.updateWet();
 }
-size_t CurlyWetSolver::guideCount() const { return impl_->set.count; }
 int CurlyWetSolver::particlesPerGuide() const { return impl_->set.n; }
 const CurlyWetSettings& CurlyWetSolver::settings() const { return impl_->set.settings; }
-const StepStats& CurlyWetSolver::lastStats() const { return impl_->skeleton.lastStats(); }
 StepStats CurlyWetSolver::measure(const Collider* collider) const { return impl_->measure(collider); }
 
 Eigen::Vector2f CurlyWetSolver::measureCurl(size_t skip) const {

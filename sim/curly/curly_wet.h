@@ -23,11 +23,12 @@
 //
 // The stepping itself (time, head interpolation, scene cuts, written frames,
 // statistics) is the skeleton every strand model shares
-// (sim/solver/strand_solver.h). Bullet stays inside sim/*.cpp; this header
+// (sim/solver/skeleton.h). Bullet stays inside sim/*.cpp; this header
 // is plain C++ and Eigen.
 #pragma once
 
-#include "sim/solver/step_stats.h"
+#include "sim/solver/step_settings.h"
+#include "sim/solver/strand_solver.h"
 #include "sim/strands/head.h"
 #include "sim/strands/strand.h"
 
@@ -36,9 +37,10 @@
 
 namespace hp {
 
-/// Everything the curly/wet solver needs. Units: metres, seconds, kg,
-/// degrees for angles. Defaults are the seed's values where it gives one.
-struct CurlyWetSettings {
+/// Everything the curly/wet solver needs (the step, scene cuts, render radii
+/// and partition: StepSettings). Units: metres, seconds, kg, degrees for
+/// angles. Defaults are the seed's values where it gives one.
+struct CurlyWetSettings : StepSettings {
     // Shape of a guide. Rest shape: a helix along the root normal (unless a
     // groom is given to initialize), so a curly guide is curly at rest.
     int particles = 24;             ///< particles per guide (edges = particles - 1)
@@ -46,12 +48,8 @@ struct CurlyWetSettings {
     float curlRadius = 0.01f;       ///< rest helix radius, m (0: straight)
     float curlPitch = 0.04f;        ///< rest helix advance per turn, m
     float collisionRadius = 0.001f; ///< clearance kept from the head, m
-    float rootRadius = 0.00004f;    ///< render radius at the root (StrandFrame), m
-    float tipRadius = 0.00001f;     ///< render radius at the tip, m
 
-    // Time stepping.
-    float timeStep = 0.02f;         ///< one step, s
-    int substeps = 1;               ///< Bullet steps per step
+    // Time stepping (the step and substeps: StepSettings).
     int iterations = 8;             ///< Bullet link (inextensibility) iterations per Bullet step
 
     // Material and springs (seed eq. 1, 4, 5).
@@ -90,25 +88,19 @@ struct CurlyWetSettings {
     float dryStiffness = 1.0f;      ///< γ1, ζ at σ = 0 (seed: 1.0)
     float stiffnessStep = 1e-4f;    ///< reference step of ξ and ζ, s: v ← v(ξζ)^(h/this)
 
-    // Scene cuts: a root or head jump beyond these in one step resets to rest.
-    float teleportDistance = 0.1f;  ///< m per step
-    float teleportAngle = 45.f;     ///< deg per step
 
-    // Parallelism: fixed groups of this many guides, one Bullet world each.
-    int strandsPerWorld = 16;
-    int threads = 0;                ///< 0 = the ambient TBB limit
 
     /// Throws hp::Error naming the first setting out of range.
     void validate() const;
 };
 
-/// Drives all curly guides of a shot. Not thread-safe itself; parallel inside.
-class CurlyWetSolver {
+/// Drives all curly guides of a shot (stepping, written frames, time,
+/// statistics: StrandSolver; a step's collider may be null: no collision, no
+/// adhesion). Not thread-safe itself; parallel inside.
+class CurlyWetSolver : public StrandSolver {
   public:
     explicit CurlyWetSolver(const CurlyWetSettings& settings);
     ~CurlyWetSolver();
-    CurlyWetSolver(const CurlyWetSolver&) = delete;
-    CurlyWetSolver& operator=(const CurlyWetSolver&) = delete;
 
     /// Creates the guides at `head.time`: one per root frame. The rest shape
     /// is `groom` (world-space particles at head.time, `particles` per guide)
@@ -127,25 +119,6 @@ class CurlyWetSolver {
     /// The per-particle saturations in use.
     const std::vector<float>& saturation() const;
 
-    /// Advances one step to time() + timeStep. `roots`: the root frames at the
-    /// end of the step (same order as initialize); `head`: the head posed at
-    /// the end of the step (head.time must be time() + timeStep; its collider
-    /// may be null: no collision, no adhesion). A jump beyond the teleport
-    /// limits resets the guides to rest on the new roots.
-    const StepStats& step(const std::vector<SurfaceFrame>& roots, const HeadPose& head);
-
-    /// Writes the guides at time() into `frame` (cleared first): positions,
-    /// velocities, tapered radii, ids 0..N-1, guideCount = N.
-    void write(StrandFrame& frame) const;
-    /// Same at `time` in [time() - timeStep, time()]: positions and
-    /// velocities interpolated between the last two steps, edge lengths
-    /// restored to the interpolated lengths.
-    void write(StrandFrame& frame, double time) const;
-
-    double time() const;
-    /// End time of the next step.
-    double nextTime() const;
-    size_t guideCount() const;
     int particlesPerGuide() const;
 
     /// The dynamic state (positions, velocities, saturation, root targets,
@@ -156,8 +129,6 @@ class CurlyWetSolver {
     std::vector<char> saveState() const;
     void restoreState(const std::vector<char>& state);
     const CurlyWetSettings& settings() const;
-    /// Statistics of the last step (all zero before the first).
-    const StepStats& lastStats() const;
     /// Statistics of the current state without stepping.
     StepStats measure(const Collider* collider) const;
 

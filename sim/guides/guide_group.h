@@ -97,17 +97,22 @@ class GuideGroup {
     virtual ~GuideGroup() = default;
 
     /// Puts the group's guides at rest at the roots' end-of-step pose, at rest
-    /// (zero velocity), in the world too.
-    virtual void reset() = 0;
+    /// (zero velocity), in the world too. By default in the shared arrays
+    /// only (a group that reloads its world from them when set.version moves).
+    virtual void reset() { set_.resetGuides(begin_, end_); }
     /// With the guides at rest and the head still, fixes the spring pre-load
     /// so the rest shape is an equilibrium under gravity.
     virtual void preload(const SubstepContext& ctx) = 0;
     /// One Bullet step: reads and writes set.x / set.v of its guides.
     virtual void substep(const SubstepContext& ctx) = 0;
-    /// Kinetic energy of its guides, J.
-    virtual double kineticEnergy() const = 0;
-    /// Largest bend (and twist) angle relative to the rest shape, radians.
-    virtual void jointAngles(float& bend, float& twist) const = 0;
+    /// Kinetic energy of its guides, J (by default from the shared arrays).
+    virtual double kineticEnergy() const { return set_.kineticEnergy(begin_, end_); }
+    /// Largest bend (and twist) angle relative to the rest shape, radians (by
+    /// default the bend of the shared arrays, no twist).
+    virtual void jointAngles(float& bend, float& twist) const {
+        bend = set_.maxBend(begin_, end_);
+        twist = 0.f;
+    }
     /// Vertices pinned in the last substeps (no place outside the head at
     /// their length), then cleared. Only the rod formulation pins.
     virtual size_t takePinned() { return 0; }

@@ -1,6 +1,6 @@
 // GuideSolver: rest shapes and the guides' own step (substeps over the
 // formulation's groups, strand-strand contacts, the velocity guard) plugged
-// into the solver skeleton (sim/solver/strand_solver.h: time, head
+// into the solver skeleton (sim/solver/skeleton.h: time, head
 // interpolation, scene cuts, written frames, statistics), parallelism over
 // the groups. The Bullet side of each formulation is in
 // sim/guides/rope_group.cpp and sim/guides/rigid_group.cpp.
@@ -8,7 +8,7 @@
 
 #include "core/errors.h"
 #include "sim/guides/guide_group.h"
-#include "sim/solver/strand_solver.h"
+#include "sim/solver/skeleton.h"
 
 #include <algorithm>
 #include <cmath>
@@ -107,10 +107,10 @@ struct GuideSolver::Impl final : solver::StrandModel {
     std::unique_ptr<guides::Formulation> formulation;
     std::vector<std::unique_ptr<guides::GuideGroup>> groups;
     std::unique_ptr<guides::StrandContacts> contacts;
-    solver::StrandSolver skeleton;
+    solver::Skeleton skeleton;
     size_t strandContacts = 0;  ///< of the current step
 
-    explicit Impl(const GuideSettings& s) : skeleton(*this, set, solver::skeletonSettings("guide solver", s)) {
+    explicit Impl(const GuideSettings& s) : skeleton(*this, set, "guide solver", s) {
         set.settings = s;
     }
 
@@ -143,6 +143,7 @@ struct GuideSolver::Impl final : solver::StrandModel {
 GuideSolver::GuideSolver(const GuideSettings& settings) {
     settings.validate();
     impl_ = std::make_unique<Impl>(settings);
+    skeleton_ = &impl_->skeleton;
 }
 
 GuideSolver::~GuideSolver() = default;
@@ -240,10 +241,6 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
         m.forGroups([&](guides::GuideGroup& grp) { grp.preload(ctx); });
     }
     m.skeleton.start(head);
-}
-
-const StepStats& GuideSolver::step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) {
-    return impl_->skeleton.step(roots, head);
 }
 
 void GuideSolver::Impl::beginStep(const HeadPose& head, bool cut) {
@@ -358,10 +355,6 @@ StepStats GuideSolver::Impl::measure(const Collider* collider) const {
     return s;
 }
 
-void GuideSolver::write(StrandFrame& frame) const { write(frame, impl_->skeleton.time()); }
-
-void GuideSolver::write(StrandFrame& frame, double time) const { impl_->skeleton.write(frame, time); }
-
 std::vector<char> GuideSolver::saveState() const {
     const Impl& m = *impl_;
     const GuideSet& set = m.set;
@@ -390,11 +383,7 @@ void GuideSolver::restoreState(const std::vector<char>& state) {
     ++set.version;
 }
 
-double GuideSolver::time() const { return impl_->skeleton.time(); }
-double GuideSolver::nextTime() const { return impl_->skeleton.nextTime(); }
-size_t GuideSolver::guideCount() const { return impl_->set.count; }
 const GuideSettings& GuideSolver::settings() const { return impl_->set.settings; }
-const StepStats& GuideSolver::lastStats() const { return impl_->skeleton.lastStats(); }
 StepStats GuideSolver::measure(const Collider* collider) const { return impl_->measure(collider); }
 
 void GuideSolver::jointAngles(float& maxBend, float& maxTwist) const {

@@ -188,11 +188,8 @@ class RopeGroup final : public GuideGroup {
     RopeGroup(GuideSet& set, size_t begin, size_t end);
     ~RopeGroup() override;
 
-    void reset() override;
     void preload(const SubstepContext& ctx) override;
     void substep(const SubstepContext& ctx) override;
-    double kineticEnergy() const override;
-    void jointAngles(float& bend, float& twist) const override;
 
   private:
     void load(size_t g, float h, float alpha);
@@ -242,8 +239,6 @@ RopeGroup::RopeGroup(GuideSet& set, size_t begin, size_t end) : GuideGroup(set, 
 }
 
 RopeGroup::~RopeGroup() { world_.removeRope(body_.get()); }
-
-void RopeGroup::reset() { set_.resetGuides(begin_, end_); }
 
 void RopeGroup::load(size_t g, float h, float alpha) {
     const size_t b = g - begin_;
@@ -311,13 +306,6 @@ void RopeGroup::relax(size_t g, const SubstepContext& ctx) {
         node.m_x = bt(x_[i]);
         node.m_v = bt(v);
     }
-}
-
-double RopeGroup::kineticEnergy() const { return set_.kineticEnergy(begin_, end_); }
-
-void RopeGroup::jointAngles(float& bend, float& twist) const {
-    bend = set_.maxBend(begin_, end_);
-    twist = 0.f;
 }
 
 class RopeFormulation final : public Formulation {
