@@ -2,6 +2,7 @@
 
 #include "core/errors.h"
 #include "core/files.h"
+#include "sim/solver/state_blob.h"
 
 #include <zlib.h>
 
@@ -16,48 +17,14 @@ namespace {
 constexpr char kMagic[8] = {'H', 'P', 'S', 'T', 'R', 'A', 'N', 'D'};
 constexpr uint32_t kHasVelocities = 1u;
 
-/// Appends raw bytes to a buffer while keeping a running CRC.
-class Writer {
+/// The strand cache's reader: a malformed file is an AssetError naming it.
+class CacheReader final : public BlobReader {
   public:
-    template <typename T>
-    void put(const T& value) { bytes(&value, sizeof(T)); }
-    template <typename T>
-    void array(const std::vector<T>& v) { bytes(v.data(), v.size() * sizeof(T)); }
-    void bytes(const void* data, size_t n) {
-        const auto* p = static_cast<const char*>(data);
-        buffer.insert(buffer.end(), p, p + n);
-    }
-    std::vector<char> buffer;
-};
-
-class Reader {
-  public:
-    Reader(const std::vector<char>& data, const std::string& file) : data_(data), file_(file) {}
-    template <typename T>
-    T get() {
-        T value;
-        bytes(&value, sizeof(T));
-        return value;
-    }
-    template <typename T>
-    void array(std::vector<T>& v, uint64_t count) {
-        if (count > remaining() / sizeof(T)) fail("truncated (arrays extend past the end of the file)");
-        v.resize(count);
-        bytes(v.data(), count * sizeof(T));
-    }
-    void bytes(void* out, size_t n) {
-        if (n > remaining()) fail("truncated");
-        if (n == 0) return;  // an empty array's data() may be null: memcpy(nullptr, ..., 0) is UB (UBSan)
-        std::memcpy(out, data_.data() + pos_, n);
-        pos_ += n;
-    }
-    size_t remaining() const { return data_.size() - pos_; }
-    [[noreturn]] void fail(const std::string& why) const { throw AssetError(file_, "strand cache " + why); }
+    CacheReader(const std::vector<char>& data, const std::string& file) : BlobReader(data, file), file_(file) {}
+    [[noreturn]] void fail(const std::string& why) const override { throw AssetError(file_, "strand cache " + why); }
 
   private:
-    const std::vector<char>& data_;
     std::string file_;
-    size_t pos_ = 0;
 };
 
 uint32_t crc(const char* data, size_t n) {
@@ -76,7 +43,7 @@ uint32_t crc(const char* data, size_t n) {
 
 void writeStrandCache(const std::filesystem::path& path, const StrandFrame& frame) {
     frame.validate();
-    Writer w;
+    BlobWriter w;
     w.bytes(kMagic, sizeof kMagic);
     w.put(kStrandCacheVersion);
     const bool velocities = !frame.velocities.empty();
@@ -86,15 +53,15 @@ void writeStrandCache(const std::filesystem::path& path, const StrandFrame& fram
     w.put(double(frame.time));
     w.put(uint64_t(frame.strandCount()));
     w.put(uint64_t(frame.vertexCount()));
-    w.array(frame.offsets);
-    w.array(frame.ids);
+    w.raw(frame.offsets);
+    w.raw(frame.ids);
     static_assert(sizeof(Vec3f) == 3 * sizeof(float), "Vec3f must be packed");
-    w.array(frame.positions);
-    w.array(frame.radii);
-    if (velocities) w.array(frame.velocities);
-    w.put(crc(w.buffer.data(), w.buffer.size()));
+    w.raw(frame.positions);
+    w.raw(frame.radii);
+    if (velocities) w.raw(frame.velocities);
+    w.put(crc(w.data.data(), w.data.size()));
 
-    writeFileChecked(path, w.buffer.data(), w.buffer.size());
+    writeFileChecked(path, w.data.data(), w.data.size());
 }
 
 StrandFrame readStrandCache(const std::filesystem::path& path) {
@@ -102,7 +69,7 @@ StrandFrame readStrandCache(const std::filesystem::path& path) {
 }
 
 StrandFrame parseStrandCache(const std::vector<char>& data, const std::string& name) {
-    Reader r(data, name);
+    CacheReader r(data, name);
     char magic[8];
     r.bytes(magic, sizeof magic);
     if (std::memcmp(magic, kMagic, sizeof magic) != 0) r.fail("has a wrong magic number (not a hairpipe strand cache)");
@@ -127,11 +94,11 @@ StrandFrame parseStrandCache(const std::vector<char>& data, const std::string& n
                               ((flags & kHasVelocities) ? vertices * 12 : 0) + sizeof(uint32_t);
     if (strands > (1ull << 32) || vertices > (1ull << 32) || expected != r.remaining())
         r.fail(cat("sizes disagree with the file length (", strands, " strands, ", vertices, " vertices)"));
-    r.array(f.offsets, strands + 1);
-    r.array(f.ids, strands);
-    r.array(f.positions, vertices);
-    r.array(f.radii, vertices);
-    if (flags & kHasVelocities) r.array(f.velocities, vertices);
+    r.raw(f.offsets, strands + 1);
+    r.raw(f.ids, strands);
+    r.raw(f.positions, vertices);
+    r.raw(f.radii, vertices);
+    if (flags & kHasVelocities) r.raw(f.velocities, vertices);
     try {
         f.validate();
     } catch (const Error& e) {
