@@ -45,11 +45,11 @@ inline std::vector<SurfaceFrame> rootFrames(const std::vector<Vec3f>& dirs, cons
 
 /// Runs `steps` steps of `head`; calls `each` after every step.
 inline void simulate(CurlyWetSolver& solver, const HeadMotion& head, const std::vector<Vec3f>& dirs, float radius, int steps,
-              const std::function<void(const CurlyWetStats&)>& each = {}) {
+              const std::function<void(const StepStats&)>& each = {}) {
     const double dt = solver.settings().timeStep;
     for (int k = 0; k < steps; ++k) {
         const HeadPose pose = head.sample(solver.time() + dt);
-        const CurlyWetStats& s = solver.step(rootFrames(dirs, pose, radius), pose);
+        const StepStats& s = solver.step(rootFrames(dirs, pose, radius), pose);
         if (each) each(s);
     }
 }

@@ -52,7 +52,7 @@ inline float youngsFor(const GuideSettings& s, double beta) {
 struct Strand {
     GuideSolver solver;
     std::vector<SurfaceFrame> roots;
-    GuideStats worst;
+    StepStats worst;
     Strand(const GuideSettings& s, const std::vector<Vec3f>& shape, size_t copies = 1) : solver(s) {
         SurfaceFrame f;
         f.normal = Vec3f::UnitX();

@@ -111,7 +111,7 @@ TEST(CollisionWorld, HairOnAShoulderBoxStaysOnIt) {
         worstStretch = 0.0;
         for (int k = 0; k < 150; ++k) {
             pose.time = solver.nextTime();
-            const GuideStats& st = solver.step(roots, pose);
+            const StepStats& st = solver.step(roots, pose);
             worstStretch = std::max(worstStretch, st.maxLengthError);
             StrandFrame f;
             solver.write(f);

@@ -60,7 +60,7 @@ Hang hangOneCurl(const CurlyWetSettings& s) {
     start(solver, head, dirs, 0.1f);
     Hang h;
     h.rest = solver.measureCurl();
-    simulate(solver, head, dirs, 0.1f, 150, [&](const CurlyWetStats& st) {
+    simulate(solver, head, dirs, 0.1f, 150, [&](const StepStats& st) {
         EXPECT_EQ(st.nanCount, 0u);
         EXPECT_EQ(st.implicitFailures, 0u);
         h.energy = st.kineticEnergy;

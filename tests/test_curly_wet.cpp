@@ -62,7 +62,7 @@ TEST(CurlyWet, RestShapeIsCurlyAndHoldsStill) {
     EXPECT_NEAR(rest.y(), s.curlPitch, 1e-3f);
     const std::vector<Vec3f> before = positions(solver);
     double energy = 0;
-    simulate(solver, head, dirs, 0.1f, 25, [&](const CurlyWetStats& st) { energy = std::max(energy, st.kineticEnergy); });
+    simulate(solver, head, dirs, 0.1f, 25, [&](const StepStats& st) { energy = std::max(energy, st.kineticEnergy); });
     // The pre-load makes the groom an equilibrium under gravity.
     const std::vector<Vec3f> after = positions(solver);
     float drift = 0.f;
@@ -88,13 +88,13 @@ TEST(CurlyWet, CurlRadiusAndPitchSurviveABouncingHead) {
     const std::vector<Vec3f> dirs = fibonacciCap(40, Vec3f::UnitY(), 0.5f);
     start(solver, head, dirs, 0.1f);
     float worstRadius = 0.f, worstPitch = 0.f;
-    CurlyWetStats acc;
+    StepStats acc;
     int k = 0;
     // How far the hair moved relative to the head: the bounce must really
     // deform it (flop over), or the curl checks below prove nothing.
     const std::vector<Vec3f> rest = positions(solver);
     float deformed = 0.f;
-    simulate(solver, head, dirs, 0.1f, 75, [&](const CurlyWetStats& st) {
+    simulate(solver, head, dirs, 0.1f, 75, [&](const StepStats& st) {
         acc.accumulate(st);
         const double t = (k + 1) * double(s.timeStep);  // the head's path, as in `head` above
         const Vec3f offset(0.f, t < 1.0 ? 0.05f * float(std::sin(6.0 * M_PI * t)) : 0.f, 0.f);
@@ -206,7 +206,7 @@ TEST(CurlyWet, AdhesionHoldsWetHairOnTheHeadAndLetsDryHairGo) {
         CurlyWetSolver solver(s);
         start(solver, head, dirs, R, &groom);
         size_t held = 0;
-        simulate(solver, head, dirs, R, 20, [&](const CurlyWetStats& st) { held = std::max(held, st.adhesionCount); });
+        simulate(solver, head, dirs, R, 20, [&](const StepStats& st) { held = std::max(held, st.adhesionCount); });
         const HeadPose pose = head.sample(solver.time());
         StrandFrame f;
         solver.write(f);
@@ -238,10 +238,10 @@ TEST(CurlyWet, StableUnderFastRotationWithCohesion) {
     const double omega = rate * M_PI / 180.0;
     const double mass = double(dirs.size()) * s.length * solver.settings().massPerLength;
     const double bound = 0.5 * mass * std::pow(omega * (0.1 + s.length), 2);
-    CurlyWetStats acc;
+    StepStats acc;
     std::vector<double> energy;
     double neighbours = 0;
-    simulate(solver, head, dirs, 0.1f, 150, [&](const CurlyWetStats& st) {
+    simulate(solver, head, dirs, 0.1f, 150, [&](const StepStats& st) {
         acc.accumulate(st);
         energy.push_back(st.kineticEnergy);
         neighbours = std::max(neighbours, st.meanCohesionNeighbours);
@@ -344,7 +344,7 @@ TEST(CurlyWet, NonFiniteImplicitStepIsCountedNotSilent) {
     const std::vector<Vec3f> dirs = fibonacciCap(4);
     start(solver, head, dirs, 0.1f);
     size_t failures = 0, nans = 0;
-    simulate(solver, head, dirs, 0.1f, 2, [&](const CurlyWetStats& st) {
+    simulate(solver, head, dirs, 0.1f, 2, [&](const StepStats& st) {
         failures += st.implicitFailures;
         nans += st.nanCount;
     });
@@ -355,7 +355,7 @@ TEST(CurlyWet, NonFiniteImplicitStepIsCountedNotSilent) {
     CurlyWetSolver ordinary{CurlyWetSettings{}};
     start(ordinary, head, dirs, 0.1f);
     failures = 0;
-    simulate(ordinary, head, dirs, 0.1f, 2, [&](const CurlyWetStats& st) { failures += st.implicitFailures; });
+    simulate(ordinary, head, dirs, 0.1f, 2, [&](const StepStats& st) { failures += st.implicitFailures; });
     EXPECT_EQ(failures, 0u);
 }
 
@@ -457,7 +457,7 @@ TEST(CurlyWetScene, ExampleSceneGetsWetMidShot) {
         while (solver.time() < t - 1e-9) {
             const HeadPose pose = head.sample(solver.time() + dt);
             solver.setSaturation(sceneSaturation(scene, pose.time));
-            const CurlyWetStats& st = solver.step(rootFrames(dirs, pose, 0.1f), pose);
+            const StepStats& st = solver.step(rootFrames(dirs, pose, 0.1f), pose);
             ASSERT_EQ(st.nanCount, 0u);
         }
         StrandFrame f;

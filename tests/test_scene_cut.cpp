@@ -94,7 +94,7 @@ TEST(SceneCut, NoVertexInsideAnyColliderOnTheCutFrameAndAfter) {
         StrandFrame frame;
         for (int k = 1; k <= 30; ++k) {
             pose = headAt(solver.nextTime(), k < 10 ? high : low, radius);
-            const GuideStats& st = solver.step(roots(dirs, radius, pose), pose);
+            const StepStats& st = solver.step(roots(dirs, radius, pose), pose);
             ASSERT_EQ(st.reset, k == 10) << "step " << k;
             solver.write(frame);
             const float depth = deepest(frame, *pose.collider);
@@ -140,7 +140,7 @@ TEST(SceneCut, StressClipCutFrameHasNoVertexInsideAnyCollider) {
     ShotSimulation sim(scene, scene.number("fps"), 48);
     for (int frame = 49; frame <= 52; ++frame) {
         const StrandFrame& f = sim.advanceTo(frame);
-        const GuideStats& g = sim.stats().guides;
+        const StepStats& g = sim.stats().guides;
         EXPECT_EQ(g.reset, frame == 50) << "frame " << frame;
         if (frame == 50) {
             EXPECT_EQ(g.penetrationCount, 0u) << "guide vertices inside a collider on the cut frame";

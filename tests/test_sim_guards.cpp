@@ -70,7 +70,7 @@ TEST(SimGuards, LongViolentRunStaysBoundedAndFinite) {
     StrandFrame f;
     for (int k = 1; k <= 12000; ++k) {  // 240 s of shaking at 50 steps/s
         pose = shaken(solver.nextTime());
-        const GuideStats& st = solver.step(roots(dirs, pose), pose);
+        const StepStats& st = solver.step(roots(dirs, pose), pose);
         ASSERT_EQ(st.nanCount, 0u) << "step " << k;
         ASSERT_FALSE(st.reset) << "the motion stays below the teleport limits; step " << k;
         ASSERT_TRUE(std::isfinite(st.kineticEnergy)) << "step " << k;
@@ -136,10 +136,10 @@ TEST(SimGuards, NonFiniteRootIsReportedWithItsGuide) {
     pose = shaken(solver.nextTime());
     std::vector<SurfaceFrame> r = roots(dirs, pose);
     r[3].position.x() = std::numeric_limits<float>::quiet_NaN();
-    const GuideStats st = solver.step(r, pose);
+    const StepStats st = solver.step(r, pose);
     EXPECT_GT(st.nanCount, 0u);
     EXPECT_EQ(st.firstNonFinite, 3);
-    GuideStats total;
+    StepStats total;
     total.accumulate(st);
     EXPECT_EQ(total.firstNonFinite, 3) << "kept when frames' steps are folded together";
     EXPECT_NE(st.json(7, 0.1).find("\"nan\": "), std::string::npos);

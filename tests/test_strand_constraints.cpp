@@ -1,5 +1,12 @@
-// The guide solver's kernels (sim/guides/strand_constraints.h), without a physics world.
-#include "sim/guides/strand_constraints.h"
+// The strand kernels without a physics world: lengths (sim/solver/length_kernels.h),
+// head contact (sim/solver/head_contact.h), damping (sim/solver/damping.h),
+// the guides' joints (sim/guides/joint_kernels.h) and segment contact
+// (sim/guides/segment_contact.h).
+#include "sim/guides/joint_kernels.h"
+#include "sim/guides/segment_contact.h"
+#include "sim/solver/damping.h"
+#include "sim/solver/head_contact.h"
+#include "sim/solver/length_kernels.h"
 
 #include <gtest/gtest.h>
 

@@ -154,7 +154,7 @@ SettledGroom settleGroom(const GuideSettings& settings, const std::vector<Surfac
     int steps = 0;
     while (solver.nextTime() - start <= seconds + 1e-9) {
         still.time = solver.nextTime();
-        const GuideStats& st = solver.step(roots, still);
+        const StepStats& st = solver.step(roots, still);
         ++steps;
         if (st.nanCount > 0)
             throw FrameError(cat("settling the groom diverged after ", solver.time() - start, " s (", st.nanCount,

@@ -44,18 +44,20 @@ float frameAlignedStep(double fps, double maxStep) {
 }
 
 /// The two strand models behind one interface: the rigid chain
-/// (sim/guides/guides.h: rod, rope or rigid formulation) and curly-wet (sim/curly/curly_wet.h).
+/// (sim/guides/guides.h: rod, rope or rigid formulation) and curly-wet
+/// (sim/curly/curly_wet.h). Both solvers step, keep time and write frames
+/// as a StrandSolver (sim/solver/strand_solver.h); a model adds how it is
+/// initialised, what it does around a step, and its checkpoints.
 class GuideModel {
   public:
+    explicit GuideModel(StrandSolver& solver) : solver(solver) {}
     virtual ~GuideModel() = default;
     virtual void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head,
                             const std::vector<std::vector<Vec3f>>* groom) = 0;
-    /// Time of the next step's end.
-    virtual double nextTime() const = 0;
-    virtual double time() const = 0;
-    virtual GuideStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) = 0;
-    virtual void write(StrandFrame& frame, double time) const = 0;
-    virtual size_t guideCount() const = 0;
+    /// One step of the solver (a model may set inputs before it or report after it).
+    virtual StepStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) {
+        return solver.step(roots, head);
+    }
     /// -1 unless the model has a saturation.
     virtual double saturation() const { return -1; }
     /// False when the model's state cannot be saved exactly (then a stopped
@@ -64,24 +66,19 @@ class GuideModel {
     virtual std::vector<char> saveState() const = 0;
     virtual void restoreState(const std::vector<char>& state) = 0;
     virtual const char* name() const = 0;
+
+    StrandSolver& solver;  ///< the derived model's own solver
 };
 
 namespace {
 
 class RigidChainModel final : public GuideModel {
   public:
-    explicit RigidChainModel(const GuideSettings& s) : solver_(s) {}
+    explicit RigidChainModel(const GuideSettings& s) : GuideModel(solver_), solver_(s) {}
     void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head,
                     const std::vector<std::vector<Vec3f>>* groom) override {
         solver_.initialize(roots, head, groom);
     }
-    double nextTime() const override { return solver_.nextTime(); }
-    double time() const override { return solver_.time(); }
-    GuideStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
-        return solver_.step(roots, head);
-    }
-    void write(StrandFrame& frame, double time) const override { solver_.write(frame, time); }
-    size_t guideCount() const override { return solver_.guideCount(); }
     bool canCheckpoint() const override { return solver_.settings().formulation != GuideFormulation::Rigid; }
     std::vector<char> saveState() const override { return solver_.saveState(); }
     void restoreState(const std::vector<char>& state) override { solver_.restoreState(state); }
@@ -93,36 +90,23 @@ class RigidChainModel final : public GuideModel {
 
 class CurlyWetModel final : public GuideModel {
   public:
-    CurlyWetModel(const Scene& scene, const CurlyWetSettings& s) : scene_(scene), solver_(s) {}
+    CurlyWetModel(const Scene& scene, const CurlyWetSettings& s) : GuideModel(solver_), scene_(scene), solver_(s) {}
     void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head,
                     const std::vector<std::vector<Vec3f>>*) override {
         // The curly model grooms its own helices.
         solver_.setSaturation(sceneSaturation(scene_, head.time));
         solver_.initialize(roots, head);
     }
-    double nextTime() const override { return solver_.nextTime(); }
-    double time() const override { return solver_.time(); }
-    GuideStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
+    StepStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) override {
         solver_.setSaturation(sceneSaturation(scene_, head.time));
-        const CurlyWetStats& c = solver_.step(roots, head);
+        const StepStats& c = solver_.step(roots, head);
         if (c.implicitFailures > 0)
             logWarning("curly-wet: at t = ", head.time, " s the implicit spring step of ", c.implicitFailures,
                        " strand-substep(s) was not finite; those strands skipped their curl, bending and core "
                        "forces for it (try a smaller simulation.time_step, more substeps or softer hair.curly "
                        "stiffnesses)");
-        GuideStats g;
-        g.maxLengthError = c.maxLengthError;
-        g.meanLengthError = c.meanLengthError;
-        g.penetrationCount = c.penetrationCount;
-        g.maxPenetration = c.maxPenetration;
-        g.kineticEnergy = c.kineticEnergy;
-        g.nanCount = c.nanCount;
-        g.msPerStep = c.msPerStep;
-        g.reset = c.reset;
-        return g;
+        return c;
     }
-    void write(StrandFrame& frame, double time) const override { solver_.write(frame, time); }
-    size_t guideCount() const override { return solver_.guideCount(); }
     double saturation() const override { return solver_.lastStats().meanSaturation; }
     std::vector<char> saveState() const override { return solver_.saveState(); }
     void restoreState(const std::vector<char>& state) override { solver_.restoreState(state); }
@@ -214,7 +198,7 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame, c
 
     // Followers learn the guides' rest shapes from the guides at t0.
     StrandFrame rest;
-    model_->write(rest, t0);
+    model_->solver.write(rest, t0);
     FollowerGroom groom;
     groom.guideRoots = guideFrames_;
     groom.guideShapes = restShapes(rest, guideFrames_);
@@ -235,8 +219,8 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame, c
         followerOptions.tipRadius = curly.tipRadius;
     }
     followers_ = std::make_unique<Followers>(groom, followerOptions);
-    logInfo("simulation: ", model_->guideCount(), " guides (", model_->name(), "), ", followers_->followerCount(),
-            " followers, from frame ", startFrame);
+    logInfo("simulation: ", model_->solver.guideCount(), " guides (", model_->name(), "), ",
+            followers_->followerCount(), " followers, from frame ", startFrame);
     produceFrame(t0);
     stats_.settleSeconds = settleRan_ ? settled_.seconds : -1;
     stats_.settleEnergy = settled_.kineticEnergy;
@@ -292,7 +276,7 @@ void ShotSimulation::initializeGuides(const GuideSettings& settings, const Impor
 
 ShotSimulation::~ShotSimulation() = default;
 
-size_t ShotSimulation::guideCount() const { return model_->guideCount(); }
+size_t ShotSimulation::guideCount() const { return model_->solver.guideCount(); }
 bool ShotSimulation::canCheckpoint() const { return model_->canCheckpoint(); }
 size_t ShotSimulation::followerCount() const { return followers_->followerCount(); }
 
@@ -303,13 +287,13 @@ const StrandFrame& ShotSimulation::advanceTo(int frame) {
     // Steps are frame-aligned, so the frame is a step's end; the tolerance
     // absorbs the rounding of a float step accumulated over the shot.
     const double tolerance = 1e-4 / fps_;
-    while (model_->time() < target - tolerance) {
-        const double t = model_->nextTime();
+    while (model_->solver.time() < target - tolerance) {
+        const double t = model_->solver.nextTime();
         const auto headStart = std::chrono::steady_clock::now();
         const HeadPose pose = head_.motion->sample(t);
         evaluateRoots(pose.mesh, roots_.guides, guideFrames_);
         pendingHeadMs_ += msSince(headStart);
-        const GuideStats s = model_->step(guideFrames_, pose);
+        const StepStats s = model_->step(guideFrames_, pose);
         if (pendingSteps_++ == 0) pending_ = s;
         else pending_.accumulate(s);
         if (s.nanCount > 0)
@@ -319,7 +303,7 @@ const StrandFrame& ShotSimulation::advanceTo(int frame) {
                                  "; try a smaller simulation.time_step or more substeps"));
     }
     frame_ = frame;
-    produceFrame(std::min(target, model_->time()));
+    produceFrame(std::min(target, model_->solver.time()));
     return strands_;
 }
 
@@ -336,7 +320,7 @@ void ShotSimulation::produceFrame(double time) {
     // previous frame, which the buffer still holds).
     const double dt = stats_.strands > 0 ? time - stats_.time : 0.0;
     StrandFrame guides;
-    model_->write(guides, time);
+    model_->solver.write(guides, time);
     const auto followerStart = std::chrono::steady_clock::now();
     const FollowerStats fs = followers_->update({guides, guideFrames_, followerFrames_, pose_.collider.get(), dt}, strands_);
     strands_.frame = frame_;
@@ -345,7 +329,7 @@ void ShotSimulation::produceFrame(double time) {
     stats_ = SimFrameStats{};
     stats_.frame = frame_;
     stats_.time = time;
-    stats_.guides = pendingSteps_ ? pending_ : GuideStats{};
+    stats_.guides = pendingSteps_ ? pending_ : StepStats{};
     stats_.guides.steps = pendingSteps_;
     stats_.followerProjected = fs.projected;
     const Followers::LengthError lengthError = followers_->lengthError(strands_);
@@ -356,7 +340,7 @@ void ShotSimulation::produceFrame(double time) {
     stats_.vertices = strands_.vertexCount();
     stats_.saturation = model_->saturation();
     stats_.totalMs = msSince(start) + pending_.msPerStep * double(pendingSteps_);
-    pending_ = GuideStats{};
+    pending_ = StepStats{};
     pendingSteps_ = 0;
     pendingHeadMs_ = 0;
 }
@@ -427,7 +411,7 @@ void ShotSimulation::restoreCheckpoint(const fs::path& file, const StrandFrame& 
     stats_.time = strands.time;
     stats_.strands = strands_.strandCount();
     stats_.vertices = strands_.vertexCount();
-    pending_ = GuideStats{};
+    pending_ = StepStats{};
     pendingSteps_ = 0;
     pendingHeadMs_ = 0;
 }

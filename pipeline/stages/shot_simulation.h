@@ -33,7 +33,7 @@ float frameAlignedStep(double fps, double maxStep);
 struct SimFrameStats {
     int frame = 0;
     double time = 0.0;
-    GuideStats guides;             ///< folded over the guide steps since the previous frame
+    StepStats guides;             ///< folded over the guide steps since the previous frame
     size_t followerProjected = 0;  ///< follower vertices pushed out of the head
     /// Followers at the output frame (they are rebuilt per frame, not per step).
     struct FollowerFigures {
@@ -106,7 +106,7 @@ class ShotSimulation {
     HeadPose pose_;
     StrandFrame strands_;
     SimFrameStats stats_;
-    GuideStats pending_;  ///< steps since the last output frame
+    StepStats pending_;  ///< steps since the last output frame
     double pendingHeadMs_ = 0;
     size_t pendingSteps_ = 0;
     SettledGroom settled_;  ///< the settling's report (strands moved into the model)

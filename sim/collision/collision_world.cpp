@@ -1,6 +1,7 @@
 #include "sim/collision/collision_world.h"
 
 #include "core/errors.h"
+#include "sim/collision/bullet_adapter.h"
 
 #include <btBulletCollisionCommon.h>
 #include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
@@ -12,14 +13,8 @@ namespace hp {
 
 namespace {
 
-btVector3 bt(const Vec3f& v) { return btVector3(v.x(), v.y(), v.z()); }
-Vec3f hv(const btVector3& v) { return Vec3f(float(v.x()), float(v.y()), float(v.z())); }
-
-btTransform bt(const Eigen::Isometry3f& t) {
-    const Eigen::Matrix3f& r = t.linear();
-    btMatrix3x3 basis(r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1), r(2, 2));
-    return btTransform(basis, bt(Vec3f(t.translation())));
-}
+using bullet::bt;
+using bullet::ei;
 
 /// Margin of boxes and hulls: GJK treats a shape as its core grown by the
 /// margin (rounded edges of this radius), so keep it far below hair scale.
@@ -191,7 +186,7 @@ class PosedWorld final : public Collider {
             }
             if (d < best) {
                 best = d;
-                bestNormal = hv(n);
+                bestNormal = ei(n);
             }
         };
         if (nearby.more) {

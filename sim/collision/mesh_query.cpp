@@ -35,14 +35,13 @@ TrianglePoint vertexPoint(TriangleFeature f) {
     return r;
 }
 
-/// Closest point on segment (p0, p1) as a parameter in [0, 1].
+}  // namespace
+
 float segmentParameter(const Vec3f& p, const Vec3f& p0, const Vec3f& p1) {
     const Vec3f d = p1 - p0;
     const float len2 = d.squaredNorm();
     return len2 > 0.f ? std::clamp((p - p0).dot(d) / len2, 0.f, 1.f) : 0.f;
 }
-
-}  // namespace
 
 TrianglePoint closestPointOnTriangle(const Vec3f& p, const Vec3f& a, const Vec3f& b, const Vec3f& c) {
     const Vec3f ab = b - a, ac = c - a, ap = p - a;

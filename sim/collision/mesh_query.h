@@ -23,6 +23,10 @@ struct TrianglePoint {
     TriangleFeature feature = TriangleFeature::Face;
 };
 
+/// @brief Closest point of segment (p0, p1) to p as a parameter in [0, 1]:
+///   t = clamp((p - p0)·d / |d|², 0, 1),  d = p1 - p0  (0 for a point segment).
+float segmentParameter(const Vec3f& p, const Vec3f& p0, const Vec3f& p1);
+
 /// @brief Closest point of triangle (a, b, c) to p (Ericson, Real-Time
 /// Collision Detection 5.1.5): Voronoi regions of the corners and edges
 /// first, the face interior last. Degenerate triangles give an edge or corner.

@@ -54,17 +54,6 @@ void transportFrames(const Vec3f* d, size_t edges, const Mat3f& root, Mat3f* fra
     }
 }
 
-Mat3f rootFrame(const SurfaceFrame& frame) {
-    const Vec3f n = unitOr(frame.normal, Vec3f::UnitY());
-    Vec3f t = frame.tangent - n * n.dot(frame.tangent);
-    t = t.squaredNorm() > 1e-12f ? Vec3f(t.normalized()) : Vec3f(n.unitOrthogonal());
-    Mat3f r;
-    r.col(0) = t;
-    r.col(1) = n;
-    r.col(2) = t.cross(n);
-    return r;
-}
-
 PairForce stretchSpring(const Vec3f& e, const Vec3f& dv, float restLength, float ks, float cs) {
     PairForce p;
     const float len = e.norm();
@@ -131,34 +120,6 @@ float perStepFactor(float factor, float h, float hRef) { return std::pow(factor,
 
 float strainLimited(float length, float restLength, float maxStrain) {
     return std::clamp(length, (1.f - maxStrain) * restLength, (1.f + maxStrain) * restLength);
-}
-
-Contact placeParticle(const Vec3f& parent, Vec3f& child, float length, const ObstacleQuery& head, float radius) {
-    auto place = [&] {
-        const Vec3f e = child - parent;
-        const float len = e.norm();
-        // A collapsed edge keeps its length along an arbitrary, deterministic axis.
-        child = parent + (len > 1e-12f ? Vec3f(e / len) : Vec3f::UnitY()) * length;
-    };
-    place();
-    Contact total;
-    if (!head.collider) return total;
-    const Vec3f start = child;
-    for (int iter = 0; iter < 16; ++iter) {
-        const Contact c = projectOut(head, radius, child);
-        if (!c.active) break;
-        total.active = true;
-        total.normal = c.normal;
-        place();
-    }
-    if (total.active) {
-        // A last projection guarantees the clearance; it can only cost length
-        // when the parent itself sits inside the clearance band.
-        const Contact c = projectOut(head, radius, child);
-        if (c.active) total.normal = c.normal;
-        total.push = std::max(0.f, (child - start).dot(total.normal));
-    }
-    return total;
 }
 
 void helixPoints(float radius, float pitch, float segment, size_t n, Vec3f* out) {

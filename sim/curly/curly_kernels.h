@@ -11,7 +11,7 @@
 #pragma once
 
 #include "sim/strands/head.h"
-#include "sim/guides/strand_constraints.h"
+#include "sim/solver/head_contact.h"
 
 #include <Eigen/Geometry>
 
@@ -65,10 +65,6 @@ void smoothedCurve(const Vec3f* lambda, size_t n, float beta, Vec3f* out);
 /// rest edge expressed in them (t̄_i = F̄_iᵀ ē_i) is the curl's shape relative
 /// to the strand: Iben et al.'s bending targets t_i = F_i t̄_i.
 void transportFrames(const Vec3f* d, size_t edges, const Mat3f& rootFrame, Mat3f* frames);
-
-/// The root's orthonormal right-handed frame as columns (tangent, normal,
-/// tangent × normal), the tangent re-orthogonalised against the normal.
-Mat3f rootFrame(const SurfaceFrame& frame);
 
 // ---- Springs (seed eq. 1, 4, 5) ---------------------------------------------
 
@@ -125,7 +121,7 @@ float perStepFactor(float factor, float h, float hRef);
 /// The head during one Bullet step and what a contact did to one particle:
 /// the same query, contact and projection out of the signed distance
 /// (Bridson et al.'s collision handling, which the seed uses) as the rope
-/// guides' (sim/guides/strand_constraints.h).
+/// guides' (sim/solver/head_contact.h).
 using ObstacleQuery = strand::HeadQuery;
 using strand::Contact;
 using strand::projectOut;
@@ -134,15 +130,15 @@ using strand::projectOut;
 float strainLimited(float length, float restLength, float maxStrain);
 
 /// Places a child particle at distance `length` from its (already placed)
-/// parent, along their current direction, and outside the head: if it is
-/// inside, projectOut and back onto the sphere of that radius about the
-/// parent, a few times; the two sets (the sphere, the outside of the head)
-/// intersect whenever the parent is outside, so this converges. If it cannot
-/// (parent deep inside), the head wins. The returned push is the total
-/// outward motion along the last contact normal. Used root to tip with the
-/// strain-limited lengths Bullet's link solve left, so moving a parent out of
-/// the head carries its child instead of stretching the edge between them.
-Contact placeParticle(const Vec3f& parent, Vec3f& child, float length, const ObstacleQuery& head, float radius);
+/// parent, along their current direction, and outside the head:
+/// strand::placeOutside with the radial rule (projectOut, then back along
+/// the parent-child direction). Used root to tip with the strain-limited
+/// lengths Bullet's link solve left, so moving a parent out of the head
+/// carries its child instead of stretching the edge between them.
+inline Contact placeParticle(const Vec3f& parent, Vec3f& child, float length, const ObstacleQuery& head,
+                             float radius) {
+    return strand::placeOutside(parent, child, length, &head, radius, strand::Reattach::Radial);
+}
 
 /// Friction after a contact: the same Coulomb update as the rope guides'
 /// (strand::contactFriction).

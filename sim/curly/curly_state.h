@@ -11,19 +11,20 @@
 
 #include "sim/curly/curly_dynamics.h"
 #include "sim/curly/curly_wet.h"
+#include "sim/solver/skeleton.h"
 
 #include <memory>
 #include <vector>
 
 namespace hp::curly {
 
-/// Rest shape, inputs and state of every guide, structure of arrays. Guide
-/// g's particle i is at g * n + i, its edge j at g * (n - 1) + j.
-struct CurlySet {
+/// Rest shape, inputs and state of every guide, structure of arrays (the
+/// state and root targets: solver::StrandState). Guide g's particle i is at
+/// g * n + i, its edge j at g * (n - 1) + j.
+struct CurlySet : solver::StrandState {
     CurlyWetSettings settings;
     StrandCoefficients coefficients;
-    size_t count = 0;
-    int n = 0;  ///< particles per guide
+    int n = 0;  ///< particles per guide (= vertices)
 
     // Rest (fixed after initialize).
     std::vector<Vec3f> restLocal;     ///< per particle: rest shape in root-local coordinates
@@ -38,17 +39,8 @@ struct CurlySet {
     bool wet = false;                     ///< some particle has σ > 0 (and wet effects are on)
     std::vector<CohesionTarget> cohesion; ///< per particle, from the previous step's positions (empty: none)
 
-    // State at the end of the last step and of the step before.
-    std::vector<Vec3f> x, v, xPrev, vPrev;
-
-    // Root targets of the current step: start (= end of the previous) and end.
-    std::vector<Vec3f> rootPos0, rootPos1;
-    std::vector<Quatf> rootRot0, rootRot1;
-
     size_t particle(size_t g, int i) const { return g * size_t(n) + size_t(i); }
     size_t edge(size_t g, int j) const { return g * size_t(n - 1) + size_t(j); }
-    Vec3f rootPosition(size_t g, float a) const { return (1.f - a) * rootPos0[g] + a * rootPos1[g]; }
-    Quatf rootRotation(size_t g, float a) const { return rootRot0[g].slerp(a, rootRot1[g]); }
     StrandRest rest(size_t g) const {
         StrandRest r;
         r.edgeLength = &edgeLength[edge(g, 0)];
@@ -62,12 +54,9 @@ struct CurlySet {
     void resetGuide(size_t g);
 };
 
-/// What one Bullet step needs.
-struct SubstepContext {
-    float h = 0.02f;        ///< Bullet step, s
-    float alpha = 1.f;      ///< fraction of the solver step at this Bullet step's end
-    ObstacleQuery head;     ///< the head at this Bullet step's end (collider may be null)
-};
+/// What one Bullet step needs: the skeleton's substep (h, alpha, the head
+/// at this Bullet step's end, its collider possibly null).
+using SubstepContext = solver::Substep;
 
 /// Counters of one group's Bullet step (summed in group order).
 struct GroupCounters {

@@ -1,18 +1,13 @@
-// CurlyWetSolver: rest shapes, saturation, the step loop (cohesion pass,
-// substeps, teleports), parallelism over Bullet worlds, statistics, output.
-// The Bullet side is sim/curly/curly_world.cpp.
+// CurlyWetSolver: rest shapes, saturation and the curly guides' own step
+// (cohesion pass, substeps over the Bullet worlds) plugged into the solver
+// skeleton (sim/solver/skeleton.h: time, head interpolation, scene cuts,
+// written frames, statistics). The Bullet side is sim/curly/curly_world.cpp.
 #include "sim/curly/curly_wet.h"
-#include "sim/solver/state_blob.h"
 
 #include "core/errors.h"
 #include "sim/curly/curly_state.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 namespace hp {
@@ -83,53 +78,24 @@ CurlyWetSettings CurlyWetSettings::seedSprings() {
     return s;
 }
 
-void CurlyWetStats::accumulate(const CurlyWetStats& s) {
-    maxLengthError = std::max(maxLengthError, s.maxLengthError);
-    meanLengthError = std::max(meanLengthError, s.meanLengthError);
-    penetrationCount = std::max(penetrationCount, s.penetrationCount);
-    maxPenetration = std::max(maxPenetration, s.maxPenetration);
-    kineticEnergy = s.kineticEnergy;
-    nanCount += s.nanCount;
-    msPerStep = (msPerStep * double(steps) + s.msPerStep * double(s.steps)) / double(steps + s.steps);
-    reset = reset || s.reset;
-    meanSaturation = s.meanSaturation;
-    meanCohesionNeighbours = s.meanCohesionNeighbours;
-    adhesionCount = std::max(adhesionCount, s.adhesionCount);
-    implicitFailures += s.implicitFailures;
-    steps += s.steps;
-}
-
-struct CurlyWetSolver::Impl {
+struct CurlyWetSolver::Impl final : solver::StrandModel {
     CurlySet set;
     std::vector<std::unique_ptr<curly::CurlyWorld>> groups;
     std::vector<uint32_t> strandOf;
     curly::SpatialGrid grid;
-    std::unique_ptr<tbb::task_arena> arena;
-    double time = 0, prevTime = 0;
-    Eigen::Isometry3f headTransform = Eigen::Isometry3f::Identity();
-    CurlyWetStats last;
-    bool initialized = false;
+    solver::Skeleton skeleton;
+    // Counters of the current step.
+    std::vector<curly::GroupCounters> counters;  ///< per group, of the last substep
+    size_t failures = 0;
+    double neighbours = 0;
+
+    explicit Impl(const CurlyWetSettings& s) : skeleton(*this, set, "curly/wet solver", s) {
+        set.settings = s;
+    }
 
     template <typename F>
     void parallel(size_t count, size_t grain, F&& f) {
-        auto loop = [&] {
-            tbb::parallel_for(
-                tbb::blocked_range<size_t>(0, count, grain),
-                [&](const tbb::blocked_range<size_t>& r) { f(r.begin(), r.end()); }, tbb::simple_partitioner());
-        };
-        if (arena) arena->execute(loop);
-        else loop();
-    }
-
-    void setRoots(const std::vector<SurfaceFrame>& roots, bool start) {
-        for (size_t g = 0; g < set.count; ++g) {
-            set.rootPos1[g] = roots[g].position;
-            set.rootRot1[g] = Quatf(curly::rootFrame(roots[g]));
-            if (start) {
-                set.rootPos0[g] = set.rootPos1[g];
-                set.rootRot0[g] = set.rootRot1[g];
-            }
-        }
+        skeleton.parallel(count, grain, std::forward<F>(f));
     }
 
     void updateWet() {
@@ -164,13 +130,46 @@ struct CurlyWetSolver::Impl {
         return free ? double(neighbours) / double(free) : 0.0;
     }
 
-    CurlyWetStats measure(const Collider* collider) const;
+    // solver::StrandModel: the curly guides' own step.
+    void beginStep(const HeadPose&, bool cut) override {
+        neighbours = cut ? 0.0 : cohesionPass();
+        failures = 0;
+        counters.assign(groups.size(), curly::GroupCounters{});
+    }
+    void resetToRest(const HeadPose&) override {
+        for (size_t g = 0; g < set.count; ++g) set.resetGuide(g);
+    }
+    void substep(const solver::Substep& sub) override {
+        parallel(groups.size(), 1, [&](size_t b, size_t e) {
+            for (size_t i = b; i < e; ++i) counters[i] = groups[i]->substep(sub);
+        });
+        for (const curly::GroupCounters& c : counters) failures += c.failed;
+    }
+    void endStep(bool, StepStats& c) override {
+        for (const curly::GroupCounters& g : counters) c.adhesionCount += g.adhesion;
+        c.implicitFailures = failures;
+        c.meanCohesionNeighbours = neighbours;
+    }
+    StepStats measure(const Collider* collider) const override;
+    /// Interpolated chords are shorter than the edges: restores each to the
+    /// interpolated length, root to tip.
+    void restoreLengths(size_t g, float a, Vec3f* x) const override {
+        for (int i = 0; i + 1 < set.n; ++i) {
+            const size_t k = set.particle(g, i);
+            const float len0 = (set.xPrev[k + 1] - set.xPrev[k]).norm();
+            const float len1 = (set.x[k + 1] - set.x[k]).norm();
+            const float want = (1.f - a) * len0 + a * len1;
+            const Vec3f e = x[i + 1] - x[i];
+            const float len = e.norm();
+            if (len > 1e-12f) x[i + 1] = x[i] + e * (want / len);
+        }
+    }
 };
 
-CurlyWetSolver::CurlyWetSolver(const CurlyWetSettings& settings) : impl_(std::make_unique<Impl>()) {
+CurlyWetSolver::CurlyWetSolver(const CurlyWetSettings& settings) {
     settings.validate();
-    impl_->set.settings = settings.resolved();
-    if (settings.threads > 0) impl_->arena = std::make_unique<tbb::task_arena>(settings.threads);
+    impl_ = std::make_unique<Impl>(settings.resolved());
+    skeleton_ = &impl_->skeleton;
 }
 
 CurlyWetSolver::~CurlyWetSolver() = default;
@@ -180,11 +179,11 @@ void CurlyWetSolver::initialize(const std::vector<SurfaceFrame>& roots, const He
     Impl& m = *impl_;
     CurlySet& set = m.set;
     const CurlyWetSettings& s = set.settings;
-    set.count = roots.size();
-    set.n = s.particles;
-    const int n = set.n;
     if (groom && groom->size() != roots.size())
         throw Error(cat("curly/wet solver: ", groom->size(), " groomed strands for ", roots.size(), " roots"));
+    set.resize(roots, s.particles);
+    set.n = s.particles;
+    const int n = set.n;
     const size_t np = set.count * size_t(n), ne = set.count * size_t(n - 1);
     set.restLocal.assign(np, Vec3f::Zero());
     set.helix.assign(np, Vec3f::Zero());
@@ -192,16 +191,9 @@ void CurlyWetSolver::initialize(const std::vector<SurfaceFrame>& roots, const He
     set.edgeLength.assign(ne, 0.f);
     set.bendTarget.assign(ne, Vec3f::Zero());
     set.coreLength.assign(ne, 0.f);
-    set.x.assign(np, Vec3f::Zero());
-    set.v.assign(np, Vec3f::Zero());
     set.sigma.assign(np, 0.f);
     set.cohesion.clear();
-    set.rootPos0.resize(set.count);
-    set.rootPos1.resize(set.count);
-    set.rootRot0.resize(set.count);
-    set.rootRot1.resize(set.count);
     m.strandOf.resize(np);
-    m.setRoots(roots, true);
 
     // Coefficients; β uses the mean rest edge length (Iben et al.'s l).
     curly::StrandCoefficients& k = set.coefficients;
@@ -268,18 +260,14 @@ void CurlyWetSolver::initialize(const std::vector<SurfaceFrame>& roots, const He
                         &set.coreLength[set.edge(g, 0)]);
         set.resetGuide(g);
     }
-    set.xPrev = set.x;
-    set.vPrev = set.v;
+    set.keepPrevious();
     setSaturation(s.saturation);
 
     m.groups.clear();
     const size_t perWorld = size_t(s.strandsPerWorld);
     for (size_t b = 0; b < set.count; b += perWorld)
         m.groups.push_back(curly::makeCurlyWorld(set, b, std::min(set.count, b + perWorld)));
-    m.time = m.prevTime = head.time;
-    m.headTransform = head.transform;
-    m.last = CurlyWetStats{};
-    m.initialized = true;
+    m.skeleton.start(head);
 }
 
 void CurlyWetSolver::setSaturation(float sigma) {
@@ -306,80 +294,7 @@ void CurlyWetSolver::setSaturation(const std::vector<float>& perParticle) {
 
 const std::vector<float>& CurlyWetSolver::saturation() const { return impl_->set.sigma; }
 
-const CurlyWetStats& CurlyWetSolver::step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) {
-    Impl& m = *impl_;
-    CurlySet& set = m.set;
-    const CurlyWetSettings& s = set.settings;
-    if (!m.initialized) throw Error("curly/wet solver: step() before initialize()");
-    if (roots.size() != set.count)
-        throw Error(cat("curly/wet solver: ", roots.size(), " root frames for ", set.count, " guides"));
-    const double expected = m.time + s.timeStep;
-    if (std::abs(head.time - expected) > 1e-6 * std::max(1.0, std::abs(expected)))
-        throw Error(cat("curly/wet solver: head pose at t = ", head.time, " s, expected the step's end t = ", expected,
-                        " s"));
-    const auto clock0 = std::chrono::steady_clock::now();
-    m.setRoots(roots, false);
-    set.xPrev = set.x;
-    set.vPrev = set.v;
-
-    const Eigen::Isometry3f& T0 = m.headTransform;
-    const Eigen::Isometry3f& T1 = head.transform;
-    const float headJump = (T1.translation() - T0.translation()).norm();
-    const float headTurn = Eigen::AngleAxisf(T1.linear() * T0.linear().transpose()).angle();
-    float rootJump = 0.f;
-    for (size_t g = 0; g < set.count; ++g) rootJump = std::max(rootJump, (set.rootPos1[g] - set.rootPos0[g]).norm());
-    const bool teleport = headJump > s.teleportDistance || rootJump > s.teleportDistance ||
-                          headTurn > s.teleportAngle * float(M_PI / 180.0);
-    size_t adhesion = 0, failures = 0;
-    double neighbours = 0;
-    if (teleport) {
-        for (size_t g = 0; g < set.count; ++g) set.resetGuide(g);
-        set.xPrev = set.x;
-        set.vPrev = set.v;
-    } else {
-        neighbours = m.cohesionPass();
-        const Quatf q0(T0.linear()), q1(T1.linear());
-        auto headAt = [&](float a) {
-            Eigen::Isometry3f t = Eigen::Isometry3f::Identity();
-            t.linear() = q0.slerp(a, q1).toRotationMatrix();
-            t.translation() = (1.f - a) * T0.translation() + a * T1.translation();
-            return t;
-        };
-        std::vector<curly::GroupCounters> counters(m.groups.size());
-        for (int k = 0; k < s.substeps; ++k) {
-            curly::SubstepContext ctx;
-            ctx.h = s.timeStep / float(s.substeps);
-            ctx.alpha = float(k + 1) / float(s.substeps);
-            const Eigen::Isometry3f now = headAt(ctx.alpha), before = headAt(float(k) / float(s.substeps));
-            ctx.head.collider = head.collider.get();
-            ctx.head.toCollider = T1 * now.inverse();
-            ctx.head.normalToWorld = now.linear() * T1.linear().transpose();
-            ctx.head.toPrevious = before * now.inverse();
-            m.parallel(m.groups.size(), 1, [&](size_t b, size_t e) {
-                for (size_t i = b; i < e; ++i) counters[i] = m.groups[i]->substep(ctx);
-            });
-            for (const curly::GroupCounters& c : counters) failures += c.failed;
-        }
-        for (const curly::GroupCounters& c : counters) adhesion += c.adhesion;
-    }
-    for (size_t g = 0; g < set.count; ++g) {
-        set.rootPos0[g] = set.rootPos1[g];
-        set.rootRot0[g] = set.rootRot1[g];
-    }
-    m.headTransform = head.transform;
-    m.prevTime = m.time;
-    m.time = expected;
-
-    m.last = m.measure(head.collider.get());
-    m.last.reset = teleport;
-    m.last.adhesionCount = adhesion;
-    m.last.implicitFailures = failures;
-    m.last.meanCohesionNeighbours = neighbours;
-    m.last.msPerStep = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - clock0).count();
-    return m.last;
-}
-
-CurlyWetStats CurlyWetSolver::Impl::measure(const Collider* collider) const {
+StepStats CurlyWetSolver::Impl::measure(const Collider* collider) const {
     struct Partial {
         double maxErr = 0, sumErr = 0, maxDepth = 0, energy = 0, sigma = 0;
         size_t inside = 0, nan = 0;
@@ -412,10 +327,10 @@ CurlyWetStats CurlyWetSolver::Impl::measure(const Collider* collider) const {
             }
         }
     };
-    auto loop = [&] { tbb::parallel_for(size_t(0), chunks, body); };
-    if (arena) arena->execute(loop);
-    else loop();
-    CurlyWetStats s;
+    skeleton.parallel(chunks, 1, [&](size_t b, size_t e) {
+        for (size_t c = b; c != e; ++c) body(c);
+    });
+    StepStats s;
     double sumErr = 0, sumSigma = 0;
     for (const Partial& p : parts) {  // fixed order: same sums whatever the threads
         s.maxLengthError = std::max(s.maxLengthError, p.maxErr);
@@ -432,60 +347,12 @@ CurlyWetStats CurlyWetSolver::Impl::measure(const Collider* collider) const {
     return s;
 }
 
-void CurlyWetSolver::write(StrandFrame& frame) const { write(frame, impl_->time); }
-
-void CurlyWetSolver::write(StrandFrame& frame, double time) const {
-    const Impl& m = *impl_;
-    const CurlySet& set = m.set;
-    const double span = m.time - m.prevTime;
-    if (time < m.prevTime - 1e-9 || time > m.time + 1e-9)
-        throw Error(cat("curly/wet solver: cannot write t = ", time, " s; the last step covers [", m.prevTime, ", ",
-                        m.time, "] s"));
-    const float a = span > 0 ? float(std::clamp((time - m.prevTime) / span, 0.0, 1.0)) : 1.f;
-    frame.clear();
-    frame.time = time;
-    frame.reserve(set.count, size_t(set.n));
-    std::vector<Vec3f> x(set.n), v(set.n);
-    std::vector<float> r(set.n);
-    const CurlyWetSettings& s = set.settings;
-    for (int i = 0; i < set.n; ++i) r[i] = taperedRadius(s.rootRadius, s.tipRadius, float(i) / float(set.n - 1));
-    for (size_t g = 0; g < set.count; ++g) {
-        for (int i = 0; i < set.n; ++i) {
-            const size_t k = set.particle(g, i);
-            x[i] = (1.f - a) * set.xPrev[k] + a * set.x[k];
-            v[i] = (1.f - a) * set.vPrev[k] + a * set.v[k];
-        }
-        if (a < 1.f) {
-            // Interpolated chords are shorter than the edges: restore each to
-            // the interpolated length, root to tip.
-            for (int i = 0; i + 1 < set.n; ++i) {
-                const size_t k = set.particle(g, i);
-                const float len0 = (set.xPrev[k + 1] - set.xPrev[k]).norm();
-                const float len1 = (set.x[k + 1] - set.x[k]).norm();
-                const float want = (1.f - a) * len0 + a * len1;
-                const Vec3f e = x[i + 1] - x[i];
-                const float len = e.norm();
-                if (len > 1e-12f) x[i + 1] = x[i] + e * (want / len);
-            }
-        }
-        frame.addStrand(uint32_t(g), x.data(), r.data(), x.size(), v.data());
-    }
-    frame.guideCount = uint32_t(set.count);
-}
-
-double CurlyWetSolver::time() const { return impl_->time; }
-double CurlyWetSolver::nextTime() const { return impl_->time + impl_->set.settings.timeStep; }
-
 std::vector<char> CurlyWetSolver::saveState() const {
     const Impl& m = *impl_;
     const CurlySet& set = m.set;
     BlobWriter w;
-    w.put(m.time);
-    w.put(m.prevTime);
-    w.put(m.headTransform.matrix());
-    for (const auto* a : {&set.x, &set.v, &set.xPrev, &set.vPrev, &set.rootPos0, &set.rootPos1}) w.array(*a);
-    w.array(set.rootRot0);
-    w.array(set.rootRot1);
+    m.skeleton.saveClock(w);
+    set.save(w);
     w.array(set.sigma);
     return std::move(w.data);
 }
@@ -493,26 +360,17 @@ std::vector<char> CurlyWetSolver::saveState() const {
 void CurlyWetSolver::restoreState(const std::vector<char>& state) {
     Impl& m = *impl_;
     CurlySet& set = m.set;
-    if (!m.initialized) throw Error("curly/wet solver: restoreState() before initialize()");
+    m.skeleton.requireStarted("restoreState()");
     BlobReader r(state, "curly/wet solver");
-    m.time = r.get<double>();
-    m.prevTime = r.get<double>();
-    m.headTransform.matrix() = r.get<Eigen::Matrix4f>();
-    const size_t particles = set.count * size_t(set.n);
-    for (auto* a : {&set.x, &set.v, &set.xPrev, &set.vPrev}) r.array(*a, particles);
-    r.array(set.rootPos0, set.count);
-    r.array(set.rootPos1, set.count);
-    r.array(set.rootRot0, set.count);
-    r.array(set.rootRot1, set.count);
-    r.array(set.sigma, particles);
+    m.skeleton.restoreClock(r);
+    set.restore(r);
+    r.array(set.sigma, set.count * size_t(set.n));
     r.finish();
     m.updateWet();
 }
-size_t CurlyWetSolver::guideCount() const { return impl_->set.count; }
 int CurlyWetSolver::particlesPerGuide() const { return impl_->set.n; }
 const CurlyWetSettings& CurlyWetSolver::settings() const { return impl_->set.settings; }
-const CurlyWetStats& CurlyWetSolver::lastStats() const { return impl_->last; }
-CurlyWetStats CurlyWetSolver::measure(const Collider* collider) const { return impl_->measure(collider); }
+StepStats CurlyWetSolver::measure(const Collider* collider) const { return impl_->measure(collider); }
 
 Eigen::Vector2f CurlyWetSolver::measureCurl(size_t skip) const {
     const CurlySet& set = impl_->set;

@@ -21,10 +21,15 @@
 // parallel with TBB; cohesion reads the previous step's positions of all
 // strands, so the result does not depend on the thread count.
 //
-// Bullet stays inside sim/*.cpp; this header is plain C++ and Eigen.
+// The stepping itself (time, head interpolation, scene cuts, written frames,
+// statistics) is the skeleton every strand model shares
+// (sim/solver/skeleton.h). Bullet stays inside sim/*.cpp; this header
+// is plain C++ and Eigen.
 #pragma once
 
 #include "sim/guides/rod_kernels.h"
+#include "sim/solver/step_settings.h"
+#include "sim/solver/strand_solver.h"
 #include "sim/strands/head.h"
 #include "sim/strands/strand.h"
 
@@ -37,9 +42,10 @@ namespace hp {
 /// (any negative value means the same).
 inline constexpr float kFromMaterial = -1.f;
 
-/// Everything the curly/wet solver needs. Units: metres, seconds, kg,
-/// degrees for angles. Defaults are the seed's values where it gives one.
-struct CurlyWetSettings {
+/// Everything the curly/wet solver needs (the step, scene cuts, render radii
+/// and partition: StepSettings). Units: metres, seconds, kg, degrees for
+/// angles. Defaults are the seed's values where it gives one.
+struct CurlyWetSettings : StepSettings {
     // Shape of a guide. Rest shape: a helix along the root normal (unless a
     // groom is given to initialize), so a curly guide is curly at rest.
     int particles = 24;             ///< particles per guide (edges = particles - 1)
@@ -47,12 +53,8 @@ struct CurlyWetSettings {
     float curlRadius = 0.01f;       ///< rest helix radius, m (0: straight)
     float curlPitch = 0.04f;        ///< rest helix advance per turn, m
     float collisionRadius = 0.001f; ///< clearance kept from the head, m
-    float rootRadius = 0.00004f;    ///< render radius at the root (StrandFrame), m
-    float tipRadius = 0.00001f;     ///< render radius at the tip, m
 
-    // Time stepping.
-    float timeStep = 0.02f;         ///< one step, s
-    int substeps = 1;               ///< Bullet steps per step
+    // Time stepping (the step and substeps: StepSettings).
     int iterations = 8;             ///< Bullet link (inextensibility) iterations per Bullet step
 
     // Material and springs (seed eq. 1, 4, 5). Mass and the stretch, bending
@@ -97,13 +99,7 @@ struct CurlyWetSettings {
     float dryStiffness = 1.0f;      ///< γ1, ζ at σ = 0 (seed: 1.0)
     float stiffnessStep = 1e-4f;    ///< reference step of ξ and ζ, s: v ← v(ξζ)^(h/this)
 
-    // Scene cuts: a root or head jump beyond these in one step resets to rest.
-    float teleportDistance = 0.1f;  ///< m per step
-    float teleportAngle = 45.f;     ///< deg per step
 
-    // Parallelism: fixed groups of this many guides, one Bullet world each.
-    int strandsPerWorld = 16;
-    int threads = 0;                ///< 0 = the ambient TBB limit
 
     /// Throws hp::Error naming the first setting out of range.
     void validate() const;
@@ -115,39 +111,13 @@ struct CurlyWetSettings {
     static CurlyWetSettings seedSprings();
 };
 
-/// Measurements of one step (same fields as the rigid-chain GuideStats, plus
-/// the wet ones).
-struct CurlyWetStats {
-    double maxLengthError = 0;      ///< max |edge length / rest - 1|
-    double meanLengthError = 0;     ///< mean |edge length / rest - 1|
-    size_t penetrationCount = 0;    ///< particles inside the head (signed distance < 0)
-    double maxPenetration = 0;      ///< deepest particle below the head surface, m
-    double kineticEnergy = 0;       ///< J, end of step
-    size_t nanCount = 0;            ///< non-finite positions or velocities
-    double msPerStep = 0;           ///< wall-clock milliseconds of step()
-    bool reset = false;             ///< a teleport / scene cut reset the guides this step
-    double meanSaturation = 0;      ///< mean σ over the free particles
-    double meanCohesionNeighbours = 0; ///< mean other-strand neighbours within the cohesion radius
-    size_t adhesionCount = 0;       ///< particles held by adhesion in the last Bullet step
-    /// Strand-substeps whose linearly implicit spring system was not finite:
-    /// those strands moved under gravity and constraints alone for that
-    /// substep (their seed forces were skipped). Non-zero means the settings
-    /// are too stiff for the step; the pipeline warns.
-    size_t implicitFailures = 0;
-    size_t steps = 1;               ///< steps folded in (accumulate)
-
-    /// Folds `s` into running maxima (kinetic energy, saturation: the last
-    /// value; ms: the mean).
-    void accumulate(const CurlyWetStats& s);
-};
-
-/// Drives all curly guides of a shot. Not thread-safe itself; parallel inside.
-class CurlyWetSolver {
+/// Drives all curly guides of a shot (stepping, written frames, time,
+/// statistics: StrandSolver; a step's collider may be null: no collision, no
+/// adhesion). Not thread-safe itself; parallel inside.
+class CurlyWetSolver : public StrandSolver {
   public:
     explicit CurlyWetSolver(const CurlyWetSettings& settings);
     ~CurlyWetSolver();
-    CurlyWetSolver(const CurlyWetSolver&) = delete;
-    CurlyWetSolver& operator=(const CurlyWetSolver&) = delete;
 
     /// Creates the guides at `head.time`: one per root frame. The rest shape
     /// is `groom` (world-space particles at head.time, `particles` per guide)
@@ -166,25 +136,6 @@ class CurlyWetSolver {
     /// The per-particle saturations in use.
     const std::vector<float>& saturation() const;
 
-    /// Advances one step to time() + timeStep. `roots`: the root frames at the
-    /// end of the step (same order as initialize); `head`: the head posed at
-    /// the end of the step (head.time must be time() + timeStep; its collider
-    /// may be null: no collision, no adhesion). A jump beyond the teleport
-    /// limits resets the guides to rest on the new roots.
-    const CurlyWetStats& step(const std::vector<SurfaceFrame>& roots, const HeadPose& head);
-
-    /// Writes the guides at time() into `frame` (cleared first): positions,
-    /// velocities, tapered radii, ids 0..N-1, guideCount = N.
-    void write(StrandFrame& frame) const;
-    /// Same at `time` in [time() - timeStep, time()]: positions and
-    /// velocities interpolated between the last two steps, edge lengths
-    /// restored to the interpolated lengths.
-    void write(StrandFrame& frame, double time) const;
-
-    double time() const;
-    /// End time of the next step.
-    double nextTime() const;
-    size_t guideCount() const;
     int particlesPerGuide() const;
 
     /// The dynamic state (positions, velocities, saturation, root targets,
@@ -195,10 +146,8 @@ class CurlyWetSolver {
     std::vector<char> saveState() const;
     void restoreState(const std::vector<char>& state);
     const CurlyWetSettings& settings() const;
-    /// Statistics of the last step (all zero before the first).
-    const CurlyWetStats& lastStats() const;
     /// Statistics of the current state without stepping.
-    CurlyWetStats measure(const Collider* collider) const;
+    StepStats measure(const Collider* collider) const;
 
     /// Curl radius and pitch fitted to each guide (sim/curly/curly_kernels.h
     /// fitHelix, leaving out the first `skip` edges), medians over the guides;

@@ -30,21 +30,16 @@
 // garbage collection cost (STACK.md) buy nothing for a single smooth head.
 // Worlds have no broadphase pairs (collision mask 0), so a world's cost is
 // linear in its guides and worlds run in parallel.
+#include "sim/collision/bullet_adapter.h"
 #include "sim/curly/curly_state.h"
-
-#include <BulletSoftBody/btDefaultSoftBodySolver.h>
-#include <BulletSoftBody/btSoftBody.h>
-#include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
-#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
-#include <btBulletDynamicsCommon.h>
 
 #include <cmath>
 
 namespace hp::curly {
 namespace {
 
-inline btVector3 bt(const Vec3f& v) { return btVector3(v.x(), v.y(), v.z()); }
-inline Vec3f ei(const btVector3& v) { return Vec3f(v.x(), v.y(), v.z()); }
+using bullet::bt;
+using bullet::ei;
 
 class BulletCurlyWorld final : public CurlyWorld {
   public:
@@ -60,12 +55,8 @@ class BulletCurlyWorld final : public CurlyWorld {
 
     CurlySet& set_;
     size_t begin_, end_;
-    btSoftBodyRigidBodyCollisionConfiguration config_;
-    btCollisionDispatcher dispatcher_{&config_};
-    btDbvtBroadphase broadphase_;
-    btSequentialImpulseConstraintSolver solver_;
     btDefaultSoftBodySolver softSolver_;
-    btSoftRigidDynamicsWorld world_{&dispatcher_, &broadphase_, &solver_, &config_, &softSolver_};
+    bullet::RopeWorld world_{set_.settings.gravity, &softSolver_};
     std::vector<btSoftBody*> bodies_;
     // Scratch for one strand, reused (a group runs on one thread at a time).
     StrandScratch scratch_;
@@ -76,11 +67,6 @@ class BulletCurlyWorld final : public CurlyWorld {
 
 BulletCurlyWorld::BulletCurlyWorld(CurlySet& set, size_t begin, size_t end) : set_(set), begin_(begin), end_(end) {
     const CurlyWetSettings& s = set.settings;
-    btSoftBodyWorldInfo& info = world_.getWorldInfo();
-    info.m_gravity = bt(s.gravity);
-    info.air_density = 0;  // no aerodynamics: damping is the seed's, step-size independent
-    info.water_density = 0;
-    world_.setGravity(bt(s.gravity));
     const int n = set.n;
     std::vector<btVector3> pos(n);
     std::vector<btScalar> mass(n);
@@ -89,27 +75,12 @@ BulletCurlyWorld::BulletCurlyWorld(CurlySet& set, size_t begin, size_t end) : se
             pos[i] = bt(set.x[set.particle(g, i)]);
             mass[i] = i == 0 ? 0.f : set.mass[set.particle(g, i)];  // root: kinematic
         }
-        // Link rest lengths are taken from the nodes at the first step, which
-        // starts from the rest shape (initialize puts every guide there).
-        auto* body = new btSoftBody(&info, n, pos.data(), mass.data());
+        // Link rest lengths from the rest shape (initialize puts every guide
+        // there); damping is the seed's springs and ξ, ζ; head contact the
+        // signed-distance projection.
+        auto* body = new btSoftBody(&world_.info(), n, pos.data(), mass.data());
         for (int j = 0; j + 1 < n; ++j) body->appendLink(j, j + 1);
-        // Bullet fixes link rest lengths from the node positions at a body's
-        // first step (m_bUpdateRtCst); settle them now, from the rest shape,
-        // so a solver restored from a checkpoint before its first step keeps
-        // the rest lengths of the run that saved it.
-        body->updateConstants();
-        body->m_bUpdateRtCst = false;
-        btSoftBody::Config& cfg = body->m_cfg;
-        cfg.piterations = s.iterations;
-        cfg.viterations = 0;
-        cfg.diterations = 0;
-        cfg.kDP = 0;         // damping: the seed's springs and ξ, ζ
-        cfg.collisions = 0;  // head contact: the signed-distance projection
-        cfg.m_psequence.clear();
-        cfg.m_psequence.push_back(btSoftBody::ePSolver::Linear);
-        body->setActivationState(DISABLE_DEACTIVATION);
-        // Mask 0: the broadphase never pairs a rope with anything.
-        world_.addSoftBody(body, btBroadphaseProxy::DefaultFilter, 0);
+        world_.addRope(body, s.iterations);
         bodies_.push_back(body);
     }
     scratch_.resize(size_t(n));
@@ -123,7 +94,7 @@ BulletCurlyWorld::BulletCurlyWorld(CurlySet& set, size_t begin, size_t end) : se
 
 BulletCurlyWorld::~BulletCurlyWorld() {
     for (btSoftBody* b : bodies_) {
-        world_.removeSoftBody(b);
+        world_.removeRope(b);
         delete b;
     }
 }
@@ -193,12 +164,8 @@ void BulletCurlyWorld::finish(size_t g, const SubstepContext& ctx) {
     for (int i = 1; i < n; ++i)
         contact_[i] = placeParticle(x_[i - 1], x_[i], len_[i - 1], ctx.head, s.collisionRadius);
     // Velocities from positions, friction, velocity limiting, ξ and ζ.
-    for (int i = 0; i < n; ++i) {
-        Vec3f vi = (x_[i] - set_.x[k0 + size_t(i)]) / h;
-        if (i > 0 && contact_[i].active)
-            vi = contactFriction(vi, ctx.head.surfaceVelocity(x_[i], h), contact_[i], s.friction, h);
-        v_[i] = vi;
-    }
+    for (int i = 0; i < n; ++i)
+        v_[i] = strand::stepVelocity(set_.x[k0 + size_t(i)], x_[i], h, contact_[i], ctx.head, s.friction);
     limitRelativeVelocity(v_.data(), size_t(n), s.maxRelativeVelocity);
     const float xi = perStepFactor(s.globalStiffness, h, s.stiffnessStep);
     for (int i = 1; i < n; ++i) {
@@ -219,7 +186,7 @@ GroupCounters BulletCurlyWorld::substep(const SubstepContext& ctx) {
     GroupCounters c;
     for (size_t g = begin_; g < end_; ++g)
         if (!load(g, ctx, c.adhesion)) ++c.failed;
-    world_.stepSimulation(ctx.h, 0, ctx.h);
+    world_.step(ctx.h);
     for (size_t g = begin_; g < end_; ++g) finish(g, ctx);
     return c;
 }

@@ -10,7 +10,10 @@
 #pragma once
 
 #include "sim/guides/guides.h"
-#include "sim/guides/strand_constraints.h"
+#include "sim/guides/joint_kernels.h"
+#include "sim/solver/damping.h"
+#include "sim/solver/length_kernels.h"
+#include "sim/solver/strand_state.h"
 
 #include <cmath>
 #include <functional>
@@ -22,14 +25,13 @@ namespace hp::guides {
 using strand::Mat3f;
 using strand::Quatf;
 
-/// Rest shape, pre-load and state of every guide, structure of arrays.
-/// Per-segment arrays hold `segments` entries per guide, per-vertex arrays
-/// `segments + 1`; guide g's vertex i is at g * vertices + i.
-struct GuideSet {
+/// Rest shape, pre-load and state of every guide, structure of arrays (the
+/// state and root targets: solver::StrandState). Per-segment arrays hold
+/// `segments` entries per guide, per-vertex arrays `vertices` = `segments + 1`;
+/// guide g's vertex i is at g * vertices + i.
+struct GuideSet : solver::StrandState {
     GuideSettings settings;
-    size_t count = 0;
     int segments = 0;
-    int vertices = 0;
 
     // Rest shape in root-local coordinates (see strand::rootRotation).
     std::vector<float> restLength;    ///< per segment
@@ -48,21 +50,11 @@ struct GuideSet {
     /// reset, strand-strand contacts), so the groups reload their worlds.
     unsigned version = 0;
 
-    // State at the end of the last step and of the step before.
-    std::vector<Vec3f> x, v;
-    std::vector<Vec3f> xPrev, vPrev;
-
-    // Root targets of the current step: start (= end of the previous step) and end.
-    std::vector<Vec3f> rootPos0, rootPos1;
-    std::vector<Quatf> rootRot0, rootRot1;
     /// The head's rigid pose at the end of the current step.
     Eigen::Isometry3f headTransform = Eigen::Isometry3f::Identity();
 
     size_t vertex(size_t guide, int i) const { return guide * vertices + i; }
     size_t segment(size_t guide, int j) const { return guide * segments + j; }
-    /// Root position / rotation at fraction `alpha` of the current step.
-    Vec3f rootPosition(size_t g, float alpha) const { return (1.f - alpha) * rootPos0[g] + alpha * rootPos1[g]; }
-    Quatf rootRotation(size_t g, float alpha) const { return rootRot0[g].slerp(alpha, rootRot1[g]); }
     /// Joint parameters of guide g for strand::relaxJoints.
     strand::JointParams joints(size_t g) {
         strand::JointParams p;
@@ -89,7 +81,7 @@ struct GuideSet {
     float maxBend(size_t begin, size_t end) const;
 };
 
-/// What one Bullet step (a substep of the solver's step) needs.
+/// What one Bullet step (a substep of the solver's step, solver::Substep) needs.
 struct SubstepContext {
     float h = 0.02f;           ///< Bullet step, s
     float alpha = 1.f;         ///< fraction of the solver step at this Bullet step's end
@@ -105,17 +97,22 @@ class GuideGroup {
     virtual ~GuideGroup() = default;
 
     /// Puts the group's guides at rest at the roots' end-of-step pose, at rest
-    /// (zero velocity), in the world too.
-    virtual void reset() = 0;
+    /// (zero velocity), in the world too. By default in the shared arrays
+    /// only (a group that reloads its world from them when set.version moves).
+    virtual void reset() { set_.resetGuides(begin_, end_); }
     /// With the guides at rest and the head still, fixes the spring pre-load
     /// so the rest shape is an equilibrium under gravity.
     virtual void preload(const SubstepContext& ctx) = 0;
     /// One Bullet step: reads and writes set.x / set.v of its guides.
     virtual void substep(const SubstepContext& ctx) = 0;
-    /// Kinetic energy of its guides, J.
-    virtual double kineticEnergy() const = 0;
-    /// Largest bend (and twist) angle relative to the rest shape, radians.
-    virtual void jointAngles(float& bend, float& twist) const = 0;
+    /// Kinetic energy of its guides, J (by default from the shared arrays).
+    virtual double kineticEnergy() const { return set_.kineticEnergy(begin_, end_); }
+    /// Largest bend (and twist) angle relative to the rest shape, radians (by
+    /// default the bend of the shared arrays, no twist).
+    virtual void jointAngles(float& bend, float& twist) const {
+        bend = set_.maxBend(begin_, end_);
+        twist = 0.f;
+    }
     /// Vertices pinned in the last substeps (no place outside the head at
     /// their length), then cleared. Only the rod formulation pins.
     virtual size_t takePinned() { return 0; }

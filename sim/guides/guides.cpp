@@ -1,21 +1,17 @@
-// GuideSolver: rest shapes, the step loop (substeps, teleports, strand-strand
-// contacts), parallelism over Bullet worlds, statistics. The Bullet side of
-// each formulation is in sim/guides/rope_group.cpp and sim/guides/rigid_group.cpp.
+// GuideSolver: rest shapes and the guides' own step (substeps over the
+// formulation's groups, strand-strand contacts, the velocity guard) plugged
+// into the solver skeleton (sim/solver/skeleton.h: time, head
+// interpolation, scene cuts, written frames, statistics), parallelism over
+// the groups. The Bullet side of each formulation is in
+// sim/guides/rope_group.cpp and sim/guides/rigid_group.cpp.
 #include "sim/guides/guides.h"
-#include "sim/solver/scene_cut.h"
-#include "sim/solver/state_blob.h"
 
 #include "core/errors.h"
 #include "sim/guides/guide_group.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
+#include "sim/solver/skeleton.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <cstdio>
 
 namespace hp {
 
@@ -59,34 +55,6 @@ void GuideSettings::validate() const {
     check(strandsPerWorld >= 1, "strands per world must be ≥ 1");
     check(threads >= 0, "threads must be ≥ 0");
     check(gravity.allFinite(), "gravity must be finite");
-}
-
-void GuideStats::accumulate(const GuideStats& s) {
-    maxLengthError = std::max(maxLengthError, s.maxLengthError);
-    meanLengthError = std::max(meanLengthError, s.meanLengthError);
-    penetrationCount = std::max(penetrationCount, s.penetrationCount);
-    maxPenetration = std::max(maxPenetration, s.maxPenetration);
-    kineticEnergy = s.kineticEnergy;
-    nanCount += s.nanCount;
-    if (firstNonFinite < 0) firstNonFinite = s.firstNonFinite;
-    clampedCount += s.clampedCount;
-    pinnedCount = std::max(pinnedCount, s.pinnedCount);
-    strandContacts = std::max(strandContacts, s.strandContacts);
-    msPerStep = (msPerStep * double(steps) + s.msPerStep * double(s.steps)) / double(steps + s.steps);
-    steps += s.steps;
-    reset = reset || s.reset;
-}
-
-std::string GuideStats::json(int frame, double time) const {
-    char buf[512];
-    std::snprintf(buf, sizeof buf,
-                  "{\"frame\": %d, \"time\": %.6f, \"max_length_error\": %.3e, \"mean_length_error\": %.3e, "
-                  "\"penetrations\": %zu, \"max_penetration_m\": %.3e, \"kinetic_energy_j\": %.6e, "
-                  "\"nan\": %zu, \"clamped\": %zu, \"pinned\": %zu, \"strand_contacts\": %zu, \"ms_per_step\": %.3f, "
-                  "\"steps\": %zu, \"reset\": %s}",
-                  frame, time, maxLengthError, meanLengthError, penetrationCount, maxPenetration, kineticEnergy,
-                  nanCount, clampedCount, pinnedCount, strandContacts, msPerStep, steps, reset ? "true" : "false");
-    return buf;
 }
 
 namespace guides {
@@ -134,42 +102,23 @@ float maxBendAngle(const GuideSet& set, size_t g, const Vec3f* x, const Quatf& r
 
 }  // namespace guides
 
-struct GuideSolver::Impl {
+struct GuideSolver::Impl final : solver::StrandModel {
     GuideSet set;
     std::unique_ptr<guides::Formulation> formulation;
     std::vector<std::unique_ptr<guides::GuideGroup>> groups;
     std::unique_ptr<guides::StrandContacts> contacts;
-    std::unique_ptr<tbb::task_arena> arena;
-    double time = 0, prevTime = 0;
-    double startTime = 0;  ///< head.time at initialize
-    long steps = 0;        ///< steps since; time = startTime + steps·timeStep (no drift)
-    Eigen::Isometry3f headTransform = Eigen::Isometry3f::Identity();
-    GuideStats last;
-    bool initialized = false;
+    solver::Skeleton skeleton;
+    size_t strandContacts = 0;  ///< of the current step
+
+    explicit Impl(const GuideSettings& s) : skeleton(*this, set, "guide solver", s) {
+        set.settings = s;
+    }
 
     template <typename F>
     void forGroups(F&& f) {
-        auto loop = [&] {
-            tbb::parallel_for(
-                tbb::blocked_range<size_t>(0, groups.size(), 1),
-                [&](const tbb::blocked_range<size_t>& r) {
-                    for (size_t i = r.begin(); i != r.end(); ++i) f(*groups[i]);
-                },
-                tbb::simple_partitioner());
-        };
-        if (arena) arena->execute(loop);
-        else loop();
-    }
-
-    void setRoots(const std::vector<SurfaceFrame>& roots, bool start) {
-        for (size_t g = 0; g < set.count; ++g) {
-            set.rootPos1[g] = roots[g].position;
-            set.rootRot1[g] = Quatf(strand::rootRotation(roots[g]));
-            if (start) {
-                set.rootPos0[g] = set.rootPos1[g];
-                set.rootRot0[g] = set.rootRot1[g];
-            }
-        }
+        skeleton.parallel(groups.size(), 1, [&](size_t b, size_t e) {
+            for (size_t i = b; i != e; ++i) f(*groups[i]);
+        });
     }
 
     /// Lengths and head clearance of one guide after strand-strand pushes.
@@ -180,13 +129,21 @@ struct GuideSolver::Impl {
                                  set.settings.collisionRadius);
     }
 
-    GuideStats measure(const Collider* collider) const;
+    // solver::StrandModel: the guides' own step.
+    void beginStep(const HeadPose& head, bool cut) override;
+    void resetToRest(const HeadPose& head) override;
+    void substep(const solver::Substep& sub) override;
+    void endStep(bool cut, StepStats& counters) override;
+    StepStats measure(const Collider* collider) const override;
+    void restoreLengths(size_t g, float, Vec3f* x) const override {
+        strand::followTheLeader(x, &set.restLength[set.segment(g, 0)], size_t(set.vertices));
+    }
 };
 
-GuideSolver::GuideSolver(const GuideSettings& settings) : impl_(std::make_unique<Impl>()) {
+GuideSolver::GuideSolver(const GuideSettings& settings) {
     settings.validate();
-    impl_->set.settings = settings;
-    if (settings.threads > 0) impl_->arena = std::make_unique<tbb::task_arena>(settings.threads);
+    impl_ = std::make_unique<Impl>(settings);
+    skeleton_ = &impl_->skeleton;
 }
 
 GuideSolver::~GuideSolver() = default;
@@ -196,11 +153,10 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
     Impl& m = *impl_;
     GuideSet& set = m.set;
     const GuideSettings& s = set.settings;
-    set.count = roots.size();
-    set.segments = s.segments;
-    set.vertices = s.segments + 1;
     if (groom && groom->size() != roots.size())
         throw Error(cat("guide solver: ", groom->size(), " groomed strands for ", roots.size(), " roots"));
+    set.resize(roots, s.segments + 1);
+    set.segments = s.segments;
     const size_t nv = set.count * set.vertices, ns = set.count * set.segments;
     set.restLength.assign(ns, s.length / float(s.segments));
     set.groomDir.assign(ns, Vec3f::UnitY());
@@ -215,13 +171,6 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
     set.cosMostBend.assign(ns, 0.f);
     set.cosLeastBend.assign(ns, 0.f);
     set.mass.assign(nv, 0.f);
-    set.x.assign(nv, Vec3f::Zero());
-    set.v.assign(nv, Vec3f::Zero());
-    set.rootPos0.resize(set.count);
-    set.rootPos1.resize(set.count);
-    set.rootRot0.resize(set.count);
-    set.rootRot1.resize(set.count);
-    m.setRoots(roots, true);
 
     for (size_t g = 0; g < set.count; ++g) {
         const Mat3f R = set.rootRot1[g].toRotationMatrix();
@@ -268,8 +217,7 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
                               &set.maxSpan[set.segment(g, 0)]);
         set.restShape(g, set.rootPos1[g], R, &set.x[set.vertex(g, 0)]);
     }
-    set.xPrev = set.x;
-    set.vPrev = set.v;
+    set.keepPrevious();
 
     set.headTransform = head.transform;
     m.formulation = s.formulation == GuideFormulation::Rigid ? guides::makeRigidFormulation(set, head)
@@ -292,87 +240,53 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
         ctx.headCollision = false;
         m.forGroups([&](guides::GuideGroup& grp) { grp.preload(ctx); });
     }
-    m.time = m.prevTime = m.startTime = head.time;
-    m.steps = 0;
-    m.headTransform = head.transform;
-    m.last = GuideStats{};
-    m.initialized = true;
+    m.skeleton.start(head);
 }
 
-const GuideStats& GuideSolver::step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) {
-    Impl& m = *impl_;
-    GuideSet& set = m.set;
-    const GuideSettings& s = set.settings;
-    if (!m.initialized) throw Error("guide solver: step() before initialize()");
-    if (roots.size() != set.count)
-        throw Error(cat("guide solver: ", roots.size(), " root frames for ", set.count, " guides"));
-    const double expected = m.startTime + double(m.steps + 1) * double(s.timeStep);
-    if (std::abs(head.time - expected) > 1e-6 * std::max(1.0, std::abs(expected)))
-        throw Error(cat("guide solver: head pose at t = ", head.time, " s, expected the step's end t = ", expected,
-                        " s"));
-    const auto clock0 = std::chrono::steady_clock::now();
-    m.setRoots(roots, false);
-    set.xPrev = set.x;
-    set.vPrev = set.v;
+void GuideSolver::Impl::beginStep(const HeadPose& head, bool cut) {
+    set.headTransform = head.transform;
+    strandContacts = 0;
+    if (!cut) formulation->beginStep(head);
+}
 
-    // A scene cut or teleport: the head or a root jumps further in one step
-    // than the limits allow. The guides restart at rest on the new roots.
-    const Eigen::Isometry3f& T0 = m.headTransform;
-    const Eigen::Isometry3f& T1 = head.transform;
-    float rootJump = 0.f;
-    for (size_t g = 0; g < set.count; ++g) rootJump = std::max(rootJump, (set.rootPos1[g] - set.rootPos0[g]).norm());
-    const bool teleport = isCut(stepJump(T0, T1, rootJump), s.teleportDistance, s.teleportAngle);
-    size_t strandContacts = 0;
-    set.headTransform = T1;
-    if (teleport) {
-        m.forGroups([](guides::GuideGroup& grp) { grp.reset(); });
-        // The rest shape on the new pose may cross the head or another
-        // collider (the new pose is arbitrary): place it outside every one
-        // before the cut frame is written, lengths kept (strand::placeSegment).
-        if (s.headCollision && head.collider) {
-            strand::HeadQuery hq;
-            hq.collider = head.collider.get();
-            m.forGroups([&](guides::GuideGroup& grp) {
-                for (size_t g = grp.begin(); g < grp.end(); ++g) m.relax(g, &hq);
-            });
-        }
-        ++set.version;
-        set.xPrev = set.x;
-        set.vPrev = set.v;
-    } else {
-        m.formulation->beginStep(head);
-        const Quatf q0(T0.linear()), q1(T1.linear());
-        auto headAt = [&](float a) {
-            Eigen::Isometry3f t = Eigen::Isometry3f::Identity();
-            t.linear() = q0.slerp(a, q1).toRotationMatrix();
-            t.translation() = (1.f - a) * T0.translation() + a * T1.translation();
-            return t;
-        };
-        for (int k = 0; k < s.substeps; ++k) {
-            guides::SubstepContext ctx;
-            ctx.h = s.timeStep / float(s.substeps);
-            ctx.alpha = float(k + 1) / float(s.substeps);
-            ctx.headTransform = headAt(ctx.alpha);
-            const Eigen::Isometry3f prev = headAt(float(k) / float(s.substeps));
-            ctx.head.collider = head.collider.get();
-            ctx.head.toCollider = T1 * ctx.headTransform.inverse();
-            ctx.head.normalToWorld = ctx.headTransform.linear() * T1.linear().transpose();
-            ctx.head.toPrevious = prev * ctx.headTransform.inverse();
-            ctx.headCollision = s.headCollision;
-            m.forGroups([&](guides::GuideGroup& grp) { grp.substep(ctx); });
-            if (m.contacts) {
-                const strand::HeadQuery* hq = ctx.headCollision && ctx.head.collider ? &ctx.head : nullptr;
-                strandContacts += m.contacts->solve(set, ctx.h, [&](size_t g) { m.relax(g, hq); });
-                ++set.version;
-            }
-        }
+void GuideSolver::Impl::resetToRest(const HeadPose& head) {
+    forGroups([](guides::GuideGroup& grp) { grp.reset(); });
+    // The rest shape on the new pose may cross the head or another
+    // collider (the new pose is arbitrary): place it outside every one
+    // before the cut frame is written, lengths kept (strand::placeSegment).
+    if (set.settings.headCollision && head.collider) {
+        strand::HeadQuery hq;
+        hq.collider = head.collider.get();
+        forGroups([&](guides::GuideGroup& grp) {
+            for (size_t g = grp.begin(); g < grp.end(); ++g) relax(g, &hq);
+        });
     }
+    ++set.version;
+}
+
+void GuideSolver::Impl::substep(const solver::Substep& sub) {
+    guides::SubstepContext ctx;
+    ctx.h = sub.h;
+    ctx.alpha = sub.alpha;
+    ctx.headTransform = sub.headTransform;
+    ctx.head = sub.head;
+    ctx.headCollision = set.settings.headCollision;
+    forGroups([&](guides::GuideGroup& grp) { grp.substep(ctx); });
+    if (contacts) {
+        const strand::HeadQuery* hq = ctx.headCollision && ctx.head.collider ? &ctx.head : nullptr;
+        strandContacts += contacts->solve(set, ctx.h, [&](size_t g) { relax(g, hq); });
+        ++set.version;
+    }
+}
+
+void GuideSolver::Impl::endStep(bool cut, StepStats& counters) {
+    const GuideSettings& s = set.settings;
     // Velocity guard (GuideSettings::maxSpeed). A NaN speed fails the
     // comparison and is left for measure() to report. Rod and rope only: their groups
     // reload x / v from the set when the version moves, while the rigid
     // formulation's bodies keep their own state (set.v is a read-back).
     size_t clamped = 0;
-    if (s.maxSpeed > 0.f && !teleport && s.formulation != GuideFormulation::Rigid) {
+    if (s.maxSpeed > 0.f && !cut && s.formulation != GuideFormulation::Rigid) {
         for (Vec3f& v : set.v) {
             const float speed = v.norm();
             if (speed > s.maxSpeed) {
@@ -382,26 +296,12 @@ const GuideStats& GuideSolver::step(const std::vector<SurfaceFrame>& roots, cons
         }
         if (clamped) ++set.version;  // the groups reload the clamped state
     }
-    for (size_t g = 0; g < set.count; ++g) {
-        set.rootPos0[g] = set.rootPos1[g];
-        set.rootRot0[g] = set.rootRot1[g];
-    }
-    m.headTransform = head.transform;
-    m.prevTime = m.time;
-    m.time = expected;
-    ++m.steps;
-
-    m.last = m.measure(head.collider.get());
-    m.last.reset = teleport;
-    m.last.strandContacts = strandContacts;
-    m.last.clampedCount = clamped;
-    for (auto& grp : m.groups) m.last.pinnedCount += grp->takePinned();
-    m.last.msPerStep =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - clock0).count();
-    return m.last;
+    counters.clampedCount = clamped;
+    counters.strandContacts = strandContacts;
+    for (auto& grp : groups) counters.pinnedCount += grp->takePinned();
 }
 
-GuideStats GuideSolver::Impl::measure(const Collider* collider) const {
+StepStats GuideSolver::Impl::measure(const Collider* collider) const {
     struct Partial {
         double maxErr = 0, sumErr = 0, maxDepth = 0, energy = 0;
         size_t inside = 0, nan = 0;
@@ -436,12 +336,10 @@ GuideStats GuideSolver::Impl::measure(const Collider* collider) const {
         }
         p.energy = grp.kineticEnergy();
     };
-    auto loop = [&] {
-        tbb::parallel_for(size_t(0), groups.size(), body);
-    };
-    if (arena) arena->execute(loop);
-    else loop();
-    GuideStats s;
+    skeleton.parallel(groups.size(), 1, [&](size_t b, size_t e) {
+        for (size_t gi = b; gi != e; ++gi) body(gi);
+    });
+    StepStats s;
     double sum = 0;
     for (const Partial& p : parts) {  // fixed order: same sums whatever the threads
         s.maxLengthError = std::max(s.maxLengthError, p.maxErr);
@@ -457,96 +355,36 @@ GuideStats GuideSolver::Impl::measure(const Collider* collider) const {
     return s;
 }
 
-void GuideSolver::write(StrandFrame& frame) const { write(frame, impl_->time); }
-
-void GuideSolver::write(StrandFrame& frame, double time) const {
-    const Impl& m = *impl_;
-    const GuideSet& set = m.set;
-    const double span = m.time - m.prevTime;
-    if (time < m.prevTime - 1e-9 || time > m.time + 1e-9)
-        throw Error(cat("guide solver: cannot write t = ", time, " s; the last step covers [", m.prevTime, ", ", m.time,
-                        "] s"));
-    const float a = span > 0 ? float(std::clamp((time - m.prevTime) / span, 0.0, 1.0)) : 1.f;
-    frame.clear();
-    frame.time = time;
-    frame.reserve(set.count, set.vertices);
-    std::vector<Vec3f> x(set.vertices), v(set.vertices);
-    std::vector<float> r(set.vertices);
-    const GuideSettings& s = set.settings;
-    for (int i = 0; i < set.vertices; ++i)
-        r[i] = taperedRadius(s.rootRadius, s.tipRadius, float(i) / float(set.segments));
-    for (size_t g = 0; g < set.count; ++g) {
-        for (int i = 0; i < set.vertices; ++i) {
-            const size_t k = set.vertex(g, i);
-            x[i] = (1.f - a) * set.xPrev[k] + a * set.x[k];
-            v[i] = (1.f - a) * set.vPrev[k] + a * set.v[k];
-        }
-        // Interpolated chords are shorter than the segments: restore lengths.
-        if (a < 1.f) strand::followTheLeader(x.data(), &set.restLength[set.segment(g, 0)], set.vertices);
-        frame.addStrand(uint32_t(g), x.data(), r.data(), x.size(), v.data());
-    }
-    frame.guideCount = uint32_t(set.count);
-}
-
 std::vector<char> GuideSolver::saveState() const {
     const Impl& m = *impl_;
     const GuideSet& set = m.set;
     if (set.settings.formulation == GuideFormulation::Rigid)
         throw Error("guide solver: checkpoints need the rod or rope formulation (the rigid one keeps state inside Bullet)");
     BlobWriter w;
-    w.put(m.time);
-    w.put(m.prevTime);
-    w.put(m.startTime);
-    w.put(m.steps);
-    w.put(m.headTransform.matrix());
+    m.skeleton.saveClock(w);
     w.put(set.headTransform.matrix());
-    w.array(set.x);
-    w.array(set.v);
-    w.array(set.xPrev);
-    w.array(set.vPrev);
-    w.array(set.rootPos0);
-    w.array(set.rootPos1);
-    w.array(set.rootRot0);
-    w.array(set.rootRot1);
+    set.save(w);
     return std::move(w.data);
 }
 
 void GuideSolver::restoreState(const std::vector<char>& state) {
     Impl& m = *impl_;
     GuideSet& set = m.set;
-    if (!m.initialized) throw Error("guide solver: restoreState() before initialize()");
+    m.skeleton.requireStarted("restoreState()");
     if (set.settings.formulation == GuideFormulation::Rigid)
         throw Error("guide solver: checkpoints need the rod or rope formulation");
     BlobReader r(state, "guide solver");
-    m.time = r.get<double>();
-    m.prevTime = r.get<double>();
-    m.startTime = r.get<double>();
-    m.steps = r.get<long>();
-    m.headTransform.matrix() = r.get<Eigen::Matrix4f>();
+    m.skeleton.restoreClock(r);
     set.headTransform.matrix() = r.get<Eigen::Matrix4f>();
-    const size_t vertices = set.count * size_t(set.vertices);
-    r.array(set.x, vertices);
-    r.array(set.v, vertices);
-    r.array(set.xPrev, vertices);
-    r.array(set.vPrev, vertices);
-    r.array(set.rootPos0, set.count);
-    r.array(set.rootPos1, set.count);
-    r.array(set.rootRot0, set.count);
-    r.array(set.rootRot1, set.count);
+    set.restore(r);
     r.finish();
     // The Bullet nodes of every world reload x and v before the next step:
     // a rope node's whole state is its position and velocity.
     ++set.version;
 }
 
-double GuideSolver::time() const { return impl_->time; }
-double GuideSolver::nextTime() const {
-    return impl_->startTime + double(impl_->steps + 1) * double(impl_->set.settings.timeStep);
-}
-size_t GuideSolver::guideCount() const { return impl_->set.count; }
 const GuideSettings& GuideSolver::settings() const { return impl_->set.settings; }
-const GuideStats& GuideSolver::lastStats() const { return impl_->last; }
-GuideStats GuideSolver::measure(const Collider* collider) const { return impl_->measure(collider); }
+StepStats GuideSolver::measure(const Collider* collider) const { return impl_->measure(collider); }
 
 void GuideSolver::jointAngles(float& maxBend, float& maxTwist) const {
     maxBend = maxTwist = 0.f;

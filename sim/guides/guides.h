@@ -12,7 +12,7 @@
 //   sim/guides/rod_group.cpp); no Bullet world, Bullet only for strand-strand pairs.
 // - `Rope` (the previous production formulation): each guide is a Bullet btSoftBody rope;
 //   Bullet integrates gravity and solves the stretch links, interleaved with
-//   the bend limits; the kernels of sim/guides/strand_constraints.h turn the joints
+//   the bend limits; the kernels of sim/guides/joint_kernels.h turn the joints
 //   toward the (gravity pre-loaded) rest shape on Bullet's prediction and,
 //   after the step, restore exact lengths and push vertices out of the
 //   head's signed distance with Coulomb friction. Meets the length,
@@ -23,9 +23,14 @@
 //   springs toward the rest pose, a projection limit; the head is a kinematic
 //   Bullet triangle-mesh body.
 //
-// Bullet stays inside sim/*.cpp; this header is plain C++ and Eigen.
+// The stepping itself (time, head interpolation, scene cuts, written frames,
+// statistics) is the skeleton every strand model shares
+// (sim/solver/skeleton.h). Bullet stays inside sim/*.cpp; this header
+// is plain C++ and Eigen.
 #pragma once
 
+#include "sim/solver/step_settings.h"
+#include "sim/solver/strand_solver.h"
 #include "sim/strands/head.h"
 #include "sim/strands/strand.h"
 
@@ -42,21 +47,19 @@ const char* formulationName(GuideFormulation f);
 /// Inverse of formulationName; throws hp::Error naming the valid choices.
 GuideFormulation parseFormulation(const std::string& name);
 
-/// Everything the guide solver needs to know. Units: metres, seconds, kg,
-/// degrees for angles. Defaults are seed 000's values where the seed gives one.
-struct GuideSettings {
+/// Everything the guide solver needs to know (the step, scene cuts, render
+/// radii and partition: StepSettings). Units: metres, seconds, kg, degrees
+/// for angles. Defaults are seed 000's values where the seed gives one.
+struct GuideSettings : StepSettings {
     GuideFormulation formulation = GuideFormulation::Rod;
 
     // Shape of a guide.
     int segments = 23;              ///< segments per guide (vertices = segments + 1)
     float length = 0.25f;           ///< rest length of a guide, m
     float collisionRadius = 0.001f; ///< capsule radius for head and strand-strand contact, m
-    float rootRadius = 0.00004f;    ///< render radius at the root (written to StrandFrame), m
-    float tipRadius = 0.00001f;     ///< render radius at the tip, m
 
-    // Time stepping (seed: fixed step 0.02 s, 20 solver iterations).
-    float timeStep = 0.02f;         ///< one step, s
-    int substeps = 1;               ///< Bullet steps per step
+    // Time stepping (seed: fixed step 0.02 s, 20 solver iterations; the step
+    // and substeps: StepSettings).
     int iterations = 20;            ///< Bullet solver iterations per Bullet step
 
     // Material.
@@ -85,9 +88,6 @@ struct GuideSettings {
     bool headCollision = true;      ///< project vertices out of the head's signed distance each Bullet step
     bool strandCollision = false;   ///< strand-strand collision (seed table row 7); serialises contact solving
 
-    // Scene cuts: a root or head jump beyond these in one step resets the guides to rest.
-    float teleportDistance = 0.1f;  ///< m per step
-    float teleportAngle = 45.f;     ///< deg per step
 
     // Guard: a vertex faster than this after a step is numerical, not
     // physical (a violent head turn moves tips a few m/s); its velocity is
@@ -95,45 +95,18 @@ struct GuideSettings {
     // Rod and rope formulations; 0 disables the clamp.
     float maxSpeed = 50.f;          ///< m/s
 
-    // Parallelism. Guides are partitioned into Bullet worlds of this many
-    // strands (a fixed mapping, so results do not depend on the thread count).
-    int strandsPerWorld = 16;
-    int threads = 0;                ///< 0 = the ambient TBB limit
 
     /// Throws hp::Error naming the first setting out of range.
     void validate() const;
 };
 
-/// Measurements of one step (or accumulated over many: see accumulate()).
-struct GuideStats {
-    double maxLengthError = 0;      ///< max |segment length / rest - 1|
-    double meanLengthError = 0;     ///< mean |segment length / rest - 1|
-    size_t penetrationCount = 0;    ///< vertices inside the head (signed distance < 0)
-    double maxPenetration = 0;      ///< deepest vertex below the head surface, m (0 = none)
-    double kineticEnergy = 0;       ///< J, end of step
-    size_t nanCount = 0;            ///< non-finite vertex positions or velocities
-    long firstNonFinite = -1;       ///< lowest guide index with a non-finite value (-1: none)
-    size_t clampedCount = 0;        ///< vertex velocities scaled back to maxSpeed
-    size_t strandContacts = 0;      ///< strand-strand contacts resolved in the step
-    size_t pinnedCount = 0;         ///< rod: vertices pinned (no place outside the head at their length)
-    double msPerStep = 0;           ///< wall-clock milliseconds of step()
-    bool reset = false;             ///< a teleport / scene cut reset the guides this step
-
-    size_t steps = 1;               ///< steps folded in (for the running mean of msPerStep)
-
-    /// Folds `s` into running maxima (kinetic energy: the last value; ms: the mean).
-    void accumulate(const GuideStats& s);
-    /// One JSON object on one line (for a per-frame statistics file, JSON lines).
-    std::string json(int frame, double time) const;
-};
-
-/// Drives all guides of a shot. Not thread-safe itself; parallel inside.
-class GuideSolver {
+/// Drives all guides of a shot (stepping, written frames, time, statistics:
+/// StrandSolver; a step's head mesh is used only by the rigid formulation).
+/// Not thread-safe itself; parallel inside.
+class GuideSolver : public StrandSolver {
   public:
     explicit GuideSolver(const GuideSettings& settings);
     ~GuideSolver();
-    GuideSolver(const GuideSolver&) = delete;
-    GuideSolver& operator=(const GuideSolver&) = delete;
 
     /// Creates the guides at `head.time`: one per root frame. The rest shape
     /// is `groom` (world-space vertices at head.time, segments + 1 per guide)
@@ -142,31 +115,9 @@ class GuideSolver {
     void initialize(const std::vector<SurfaceFrame>& roots, const HeadPose& head,
                     const std::vector<std::vector<Vec3f>>* groom = nullptr);
 
-    /// Advances one step to nextTime(). `roots` are the root frames at the end
-    /// of the step (same order as initialize), `head` the head posed at the
-    /// end of the step (head.time must be nextTime() within 1e-6 s; its collider
-    /// may be null; its mesh is used only by the rigid formulation). A jump of
-    /// the head transform or of a root beyond the teleport limits resets the
-    /// guides to their rest shape at the new roots.
-    const GuideStats& step(const std::vector<SurfaceFrame>& roots, const HeadPose& head);
-
-    /// Writes the guides at time() into `frame` (cleared first): positions,
-    /// velocities, tapered radii, ids 0..N-1, guideCount = N.
-    void write(StrandFrame& frame) const;
-    /// Same at `time` in [time() - timeStep, time()]: positions interpolated
-    /// between the last two steps, segment lengths restored exactly.
-    void write(StrandFrame& frame, double time) const;
-
-    /// Time of the state now: start time + steps · timeStep (no accumulated rounding).
-    double time() const;
-    /// Time the next step ends at: where to sample the head and the roots.
-    double nextTime() const;
-    size_t guideCount() const;
     const GuideSettings& settings() const;
-    /// Statistics of the last step (all zero before the first).
-    const GuideStats& lastStats() const;
     /// Statistics of the current state without stepping (used after initialize).
-    GuideStats measure(const Collider* collider) const;
+    StepStats measure(const Collider* collider) const;
 
     /// The dynamic state (positions, velocities, root targets, time) as
     /// bytes, for checkpoints. Rope only: the rigid formulation keeps state

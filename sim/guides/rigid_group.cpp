@@ -32,6 +32,7 @@
 // does the holding and the chains jitter at its bounds — the seed's "chaotic
 // effects"; segment ends drift apart by up to ~0.6 segment between
 // projections; ~27 ms/step for 94 guides, ~155 for 845 on one core.
+#include "sim/collision/bullet_adapter.h"
 #include "sim/guides/guide_group.h"
 
 #include <btBulletDynamicsCommon.h>
@@ -43,11 +44,11 @@
 namespace hp::guides {
 namespace {
 
-inline btVector3 bt(const Vec3f& v) { return btVector3(v.x(), v.y(), v.z()); }
-inline Vec3f ei(const btVector3& v) { return Vec3f(v.x(), v.y(), v.z()); }
-inline btQuaternion bt(const Quatf& q) { return btQuaternion(q.x(), q.y(), q.z(), q.w()); }
-inline Quatf ei(const btQuaternion& q) { return Quatf(q.w(), q.x(), q.y(), q.z()); }
-inline btTransform bt(const Eigen::Isometry3f& t) {
+using bullet::bt;
+using bullet::ei;
+/// A rigid pose for Bullet's bodies: the rotation part as a quaternion
+/// (Eigen's rotation(), so a pose with scale keeps only its rotation).
+inline btTransform bodyPose(const Eigen::Isometry3f& t) {
     return btTransform(bt(Quatf(t.rotation())), bt(Vec3f(t.translation())));
 }
 
@@ -152,8 +153,8 @@ RigidGroup::RigidGroup(GuideSet& set, size_t begin, size_t end, RigidShared& sha
         head_->setCollisionFlags(head_->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
         head_->setActivationState(DISABLE_DEACTIVATION);
         head_->setFriction(friction);
-        head_->setWorldTransform(bt(set.headTransform));  // posed before insertion, like every body here
-        head_->setInterpolationWorldTransform(bt(set.headTransform));
+        head_->setWorldTransform(bodyPose(set.headTransform));  // posed before insertion, like every body here
+        head_->setInterpolationWorldTransform(bodyPose(set.headTransform));
         world_->addRigidBody(head_.get(), kHeadGroup, kStrandGroup);
     }
     for (size_t g = begin; g < end; ++g) {
@@ -261,8 +262,8 @@ void RigidGroup::placeAtRest(size_t g) {
 
 void RigidGroup::reset() {
     if (head_) {
-        head_->setWorldTransform(bt(set_.headTransform));
-        head_->setInterpolationWorldTransform(bt(set_.headTransform));
+        head_->setWorldTransform(bodyPose(set_.headTransform));
+        head_->setInterpolationWorldTransform(bodyPose(set_.headTransform));
     }
     for (size_t g = begin_; g < end_; ++g) placeAtRest(g);
 }
@@ -273,7 +274,7 @@ void RigidGroup::moveKinematic(const SubstepContext& ctx) {
     for (size_t g = begin_; g < end_; ++g)
         roots_[g - begin_]->setWorldTransform(
             btTransform(bt(set_.rootRotation(g, ctx.alpha)), bt(set_.rootPosition(g, ctx.alpha))));
-    if (head_) head_->setWorldTransform(bt(ctx.headTransform));
+    if (head_) head_->setWorldTransform(bodyPose(ctx.headTransform));
 }
 
 void RigidGroup::preload(const SubstepContext& ctx) {

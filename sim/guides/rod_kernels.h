@@ -12,7 +12,10 @@
 #pragma once
 
 #include "sim/guides/rod_lanes.h"
-#include "sim/guides/strand_constraints.h"
+#include "sim/solver/damping.h"
+#include "sim/solver/head_contact.h"
+#include "sim/solver/length_kernels.h"
+#include "sim/solver/strand_state.h"
 
 #include <Eigen/Core>
 
@@ -150,6 +153,18 @@ int rodStep(const RodStrand& s, Vec3f* x, Vec3f* v, const Vec3f& rootPos, const 
 /// of them.
 int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, float h, float drag, float friction,
              const strand::HeadQuery* head, float radius, RodScratch& scratch);
+
+/// One mass-weighted Newton step on the stretch constraints alone,
+/// C_j = |x_{j+1} - x_j| - l_j: J W Jᵀ is tridiagonal,
+///   A_jj = w_j + w_{j+1},  A_{j,j+1} = -w_{j+1} d_j·d_{j+1},
+/// solved by the Thomas algorithm; x_j -= w_j d_j Δλ_j, x_{j+1} += w_{j+1} d_j Δλ_j.
+/// Momentum-conserving, unlike follow-the-leader; it leaves a stretch error
+/// of the second order, which the final exact placement then removes
+/// without visible bias.
+/// `w` the inverse masses (n entries), `rest` the rest lengths (n - 1).
+/// The length pass of rodSteps, before its exact-length finish: one strand
+/// run through the same four-lane code the step uses (rod_step.cpp).
+void stretchSolve(Vec3f* x, const float* w, const float* rest, int n);
 
 /// Total bending energy Σ EI/(2 l̄_j)|C_j|² of a strand, J.
 double bendEnergy(const RodStrand& s, const Vec3f* x, const Mat3f& rootFrame);

@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <vector>
 
 // See rod_lanes.h: D4 values never cross a library boundary.
 #pragma GCC diagnostic ignored "-Wpsabi"
@@ -214,6 +215,21 @@ bool placeVertex(const RodStepTarget& t, int i, const Vec3f& parent, Vec3f& y, f
 }
 
 }  // namespace
+
+void stretchSolve(Vec3f* x, const float* w, const float* rest, int n) {
+    // The strand in every lane: lane 0 is what rodSteps computes for it.
+    const size_t m = size_t(n);
+    std::vector<V3> y(m), dir(m);
+    std::vector<F4> wl(m), rl(m), cosine(m);
+    std::vector<lanes::D4Store> diag(m), rhs(m);
+    for (int i = 0; i < n; ++i) {
+        for (int l = 0; l < kLanes; ++l) setLane(y[size_t(i)], l, x[i]);
+        wl[size_t(i)] = lanes::splat<F4>(w[i]);
+        if (i + 1 < n) rl[size_t(i)] = lanes::splat<F4>(rest[i]);
+    }
+    stretchSolve(y.data(), wl.data(), rl.data(), n, lanes::view(diag), lanes::view(rhs), dir.data(), cosine.data());
+    for (int i = 0; i < n; ++i) x[i] = lane(y[size_t(i)], 0);
+}
 
 HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, float h,
                                   float drag, float friction, const strand::HeadQuery* head, float radius,

@@ -1,7 +1,7 @@
 // The production formulation: each guide is a Bullet soft-body rope; the
 // ropes of a group are the disconnected chains of one btSoftBody (a bundle,
 // see Bundle below) in the group's own btSoftRigidDynamicsWorld, with the
-// kernels of sim/guides/strand_constraints.h at Bullet's solver extension point and
+// kernels of sim/guides/joint_kernels.h at Bullet's solver extension point and
 // after its step.
 //
 // One Bullet step h:
@@ -53,13 +53,8 @@
 //    Drive pass runs four ropes at a time, in lockstep (9.7 -> 7.9 CPU ms
 //    per step, min of five alternating runs each on a loaded machine) and
 //    then in SIMD lanes (strand::driveJoints; 8.2 -> 6.8): identical results.
+#include "sim/collision/bullet_adapter.h"
 #include "sim/guides/guide_group.h"
-
-#include <BulletSoftBody/btDefaultSoftBodySolver.h>
-#include <BulletSoftBody/btSoftBody.h>
-#include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
-#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
-#include <btBulletDynamicsCommon.h>
 
 #include <cmath>
 #include <memory>
@@ -67,17 +62,8 @@
 namespace hp::guides {
 namespace {
 
-inline btVector3 bt(const Vec3f& v) { return btVector3(v.x(), v.y(), v.z()); }
-inline Vec3f ei(const btVector3& v) { return Vec3f(v.x(), v.y(), v.z()); }
-
-/// Ropes never touch anything in their world, so its contact pools stay
-/// tiny (Bullet's default preallocates ~4 MB per world).
-btDefaultCollisionConstructionInfo smallPools() {
-    btDefaultCollisionConstructionInfo info;
-    info.m_defaultMaxPersistentManifoldPoolSize = 16;
-    info.m_defaultMaxCollisionAlgorithmPoolSize = 16;
-    return info;
-}
+using bullet::bt;
+using bullet::ei;
 
 /// The ropes of one group are one btSoftBody, a bundle of disconnected
 /// chains: node i of rope b is m_nodes[i·B + b] and link j of rope b is
@@ -202,23 +188,17 @@ class RopeGroup final : public GuideGroup {
     RopeGroup(GuideSet& set, size_t begin, size_t end);
     ~RopeGroup() override;
 
-    void reset() override;
     void preload(const SubstepContext& ctx) override;
     void substep(const SubstepContext& ctx) override;
-    double kineticEnergy() const override;
-    void jointAngles(float& bend, float& twist) const override;
 
   private:
     void load(size_t g, float h, float alpha);
     void loadAll(float h, float alpha);
     void relax(size_t g, const SubstepContext& ctx);
 
-    btSoftBodyRigidBodyCollisionConfiguration config_{smallPools()};
-    btCollisionDispatcher dispatcher_{&config_};
-    btDbvtBroadphase broadphase_;
-    btSequentialImpulseConstraintSolver solver_;
     StrandSoftBodySolver softSolver_{set_, begin_};
-    btSoftRigidDynamicsWorld world_{&dispatcher_, &broadphase_, &solver_, &config_, &softSolver_};
+    // Ropes never touch anything in their world, so its contact pools stay tiny.
+    bullet::RopeWorld world_{set_.settings.gravity, &softSolver_, bullet::smallPools()};
     std::unique_ptr<btSoftBody> body_;
     Bundle bundle_{nullptr, 0};
     // Scratch for one guide, reused (groups run one at a time per thread).
@@ -228,12 +208,6 @@ class RopeGroup final : public GuideGroup {
 };
 
 RopeGroup::RopeGroup(GuideSet& set, size_t begin, size_t end) : GuideGroup(set, begin, end) {
-    const GuideSettings& s = set.settings;
-    btSoftBodyWorldInfo& info = world_.getWorldInfo();
-    info.m_gravity = bt(s.gravity);
-    info.air_density = 0;  // no aerodynamics: damping is ours, step-size independent
-    info.water_density = 0;
-    world_.setGravity(bt(s.gravity));
     const int n = set.vertices;
     const int ropes = int(end - begin);
     x_.resize(n);
@@ -246,40 +220,25 @@ RopeGroup::RopeGroup(GuideSet& set, size_t begin, size_t end) : GuideGroup(set, 
             pos[size_t(i * ropes + b)] = bt(set.x[k]);
             mass[size_t(i * ropes + b)] = set.mass[k];  // root: 0 = kinematic
         }
-    body_ = std::make_unique<btSoftBody>(&info, n * ropes, pos.data(), mass.data());
+    body_ = std::make_unique<btSoftBody>(&world_.info(), n * ropes, pos.data(), mass.data());
     btSoftBody* body = body_.get();
     bundle_ = Bundle(body, size_t(ropes));
     // Links segment-major: consecutive links belong to different ropes.
     for (int j = 0; j < set.segments; ++j)
         for (int b = 0; b < ropes; ++b) body->appendLink(j * ropes + b, (j + 1) * ropes + b);
-    // Bullet fixes link rest lengths from the node positions at a body's
-    // first step (m_bUpdateRtCst); settle them now, from the rest shape, so
-    // a solver restored from a checkpoint before its first step keeps the
-    // rest lengths of the run that saved it.
-    body->updateConstants();
-    body->m_bUpdateRtCst = false;
-    btSoftBody::Config& cfg = body->m_cfg;
-    cfg.piterations = 0;  // the link iterations run in StrandSoftBodySolver, with the limits
-    cfg.viterations = 0;
-    cfg.diterations = 0;
-    cfg.kDP = 0;          // damping is applied by the kernels, exp(-c·h)
-    cfg.collisions = 0;   // head contact is the signed-distance projection
-    cfg.m_psequence.clear();
-    cfg.m_psequence.push_back(btSoftBody::ePSolver::Linear);
-    body->setActivationState(DISABLE_DEACTIVATION);
     // Bullet keeps a tree of node boxes per body, checked every step (no
     // collision uses it here). Its margin m pads each box by m and lets a node
     // move m/4 before its box is re-inserted: with 2 m that almost never
     // happens, where 5 cm re-inserted boxes of fast tips every few steps.
     body->getCollisionShape()->setMargin(2.f);
-    // Mask 0: the broadphase never pairs the bundle with anything.
-    world_.addSoftBody(body, btBroadphaseProxy::DefaultFilter, 0);
+    // The link iterations run in StrandSoftBodySolver, with the limits
+    // (Bullet's own position loop is off); damping is the kernels' exp(-c·h);
+    // head contact is the signed-distance projection.
+    world_.addRope(body, 0);
     softSolver_.setBundle(bundle_);
 }
 
-RopeGroup::~RopeGroup() { world_.removeSoftBody(body_.get()); }
-
-void RopeGroup::reset() { set_.resetGuides(begin_, end_); }
+RopeGroup::~RopeGroup() { world_.removeRope(body_.get()); }
 
 void RopeGroup::load(size_t g, float h, float alpha) {
     const size_t b = g - begin_;
@@ -312,14 +271,14 @@ void RopeGroup::preload(const SubstepContext& ctx) {
     loadedVersion_ = ~set_.version;  // force a full load
     loadAll(ctx.h, ctx.alpha);
     softSolver_.prepare(strand::JointPass::SolvePreload, ctx);
-    world_.stepSimulation(ctx.h, 0, ctx.h);
+    world_.step(ctx.h);
     loadedVersion_ = ~set_.version;  // the nodes hold the probe step, not the state
 }
 
 void RopeGroup::substep(const SubstepContext& ctx) {
     loadAll(ctx.h, ctx.alpha);
     softSolver_.prepare(strand::JointPass::Drive, ctx);
-    world_.stepSimulation(ctx.h, 0, ctx.h);
+    world_.step(ctx.h);
     for (size_t g = begin_; g < end_; ++g) relax(g, ctx);
 }
 
@@ -339,25 +298,14 @@ void RopeGroup::relax(size_t g, const SubstepContext& ctx) {
     const float damp = strand::dampingFactor(s.damping, h);
     for (int i = 0; i < n; ++i) {
         const size_t k = set_.vertex(g, i);
-        Vec3f v = (x_[i] - set_.x[k]) / h;
-        if (i > 0) {
-            if (contact_[i].active)
-                v = strand::contactFriction(v, ctx.head.surfaceVelocity(x_[i], h), contact_[i], s.friction, h);
-            v *= damp;
-        }
+        Vec3f v = strand::stepVelocity(set_.x[k], x_[i], h, contact_[i], ctx.head, s.friction);
+        if (i > 0) v *= damp;
         set_.x[k] = x_[i];
         set_.v[k] = v;
         btSoftBody::Node& node = bundle_.node(b, i);
         node.m_x = bt(x_[i]);
         node.m_v = bt(v);
     }
-}
-
-double RopeGroup::kineticEnergy() const { return set_.kineticEnergy(begin_, end_); }
-
-void RopeGroup::jointAngles(float& bend, float& twist) const {
-    bend = set_.maxBend(begin_, end_);
-    twist = 0.f;
 }
 
 class RopeFormulation final : public Formulation {

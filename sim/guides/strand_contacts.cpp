@@ -4,7 +4,10 @@
 // closest points, and the contacts are resolved at position level in a fixed
 // order. It couples all guides, so it runs serially between the parallel
 // per-world steps (that is its cost; the switch is off by default).
+#include "sim/collision/bullet_adapter.h"
+#include "sim/collision/mesh_query.h"
 #include "sim/guides/guide_group.h"
+#include "sim/guides/segment_contact.h"
 
 #include <btBulletCollisionCommon.h>
 
@@ -15,8 +18,8 @@
 namespace hp::guides {
 namespace {
 
-inline btVector3 bt(const Vec3f& v) { return btVector3(v.x(), v.y(), v.z()); }
-inline Vec3f ei(const btVector3& v) { return Vec3f(v.x(), v.y(), v.z()); }
+using bullet::bt;
+using bullet::ei;
 
 /// Rejects pairs of one guide's neighbouring segments (they share a vertex).
 struct NeighbourFilter final : btOverlapFilterCallback {
@@ -42,15 +45,10 @@ btTransform capsuleTransform(const Vec3f& a, const Vec3f& b) {
         len > 0.f ? strand::Quatf::FromTwoVectors(Vec3f::UnitY(), d / len) : strand::Quatf::Identity();
     btTransform t;
     t.setOrigin(bt(0.5f * (a + b)));
-    t.setRotation(btQuaternion(q.x(), q.y(), q.z(), q.w()));
+    t.setRotation(bt(q));
     return t;
 }
 
-float closestParameter(const Vec3f& p, const Vec3f& a, const Vec3f& b) {
-    const Vec3f e = b - a;
-    const float l2 = e.squaredNorm();
-    return l2 > 0.f ? std::clamp((p - a).dot(e) / l2, 0.f, 1.f) : 0.f;
-}
 
 }  // namespace
 
@@ -156,8 +154,8 @@ size_t StrandContacts::solve(GuideSet& set, float h, const std::function<void(si
         c.normal = toWorld * ei(pt.m_normalWorldOnB);
         const Vec3f pa = m.toLocal.inverse() * ei(pt.getPositionWorldOnA());
         const Vec3f pb = m.toLocal.inverse() * ei(pt.getPositionWorldOnB());
-        c.s = closestParameter(pa, set.x[set.vertex(c.guideA, c.segA)], set.x[set.vertex(c.guideA, c.segA + 1)]);
-        c.t = closestParameter(pb, set.x[set.vertex(c.guideB, c.segB)], set.x[set.vertex(c.guideB, c.segB + 1)]);
+        c.s = segmentParameter(pa, set.x[set.vertex(c.guideA, c.segA)], set.x[set.vertex(c.guideA, c.segA + 1)]);
+        c.t = segmentParameter(pb, set.x[set.vertex(c.guideB, c.segB)], set.x[set.vertex(c.guideB, c.segB + 1)]);
         if (std::tie(c.guideB, c.segB) < std::tie(c.guideA, c.segA)) {
             std::swap(c.guideA, c.guideB);
             std::swap(c.segA, c.segB);

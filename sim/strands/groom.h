@@ -14,8 +14,11 @@
 
 namespace hp {
 
+/// @brief The rest shape of a groomed strand: straight along the root
+/// normal, or combed toward a direction.
 enum class GroomStyle { Straight, Combed };
 
+/// @brief The groom's shape (scene keys hair.groom.*).
 struct GroomSettings {
     GroomStyle style = GroomStyle::Straight;
     int segments = 23;

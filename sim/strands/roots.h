@@ -23,8 +23,11 @@
 
 namespace hp {
 
+/// @brief How roots are spread over the scalp: the seed's Fibonacci lattice,
+/// or blue noise (Yuksel's sample elimination).
 enum class RootMethod { Fibonacci, BlueNoise };
 
+/// @brief Where and how many roots (scene keys hair.roots.*; pipeline/head/head_setup.h rootSettings).
 struct RootSettings {
     RootMethod method = RootMethod::Fibonacci;
     size_t count = 0;

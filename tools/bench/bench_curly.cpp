@@ -38,7 +38,7 @@ double cpuSeconds() {
 struct Result {
     double stepsPerSecond = 0;
     double cpuMsPerStep = 0;  ///< process CPU time (all threads) per timed step
-    CurlyWetStats stats;
+    StepStats stats;
     Eigen::Vector2f curl = Eigen::Vector2f::Zero();
 };
 
@@ -68,13 +68,13 @@ Result run(size_t guides, const std::string& mode, int threads, int warmup, int 
     HeadPose pose = head.sample(0.0);
     solver.initialize(rootFrames(dirs, pose, radius), pose);
     Result r;
-    CurlyWetStats acc;
+    StepStats acc;
     bool first = true;
     double ms = 0, cpu = 0;
     for (int k = 1; k <= warmup + timed; ++k) {
         if (k == warmup + 1) cpu = cpuSeconds();
         pose = head.sample(k * double(s.timeStep));
-        const CurlyWetStats& st = solver.step(rootFrames(dirs, pose, radius), pose);
+        const StepStats& st = solver.step(rootFrames(dirs, pose, radius), pose);
         if (k <= warmup) continue;
         ms += st.msPerStep;
         if (first) acc = st, first = false;

@@ -69,7 +69,7 @@ double processCpuSeconds() {
 struct RunResult {
     double stepsPerSecond = 0;
     double cpuMsPerStep = 0;
-    GuideStats stats;
+    StepStats stats;
     uint64_t digest = 0;
 };
 
@@ -96,7 +96,7 @@ RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int 
             cpu0 = processCpuSeconds();
         }
         pose = head.sample(double(k) * settings.timeStep);
-        const GuideStats& s = solver.step(rootsAt(dirs, radius, pose), pose);
+        const StepStats& s = solver.step(rootsAt(dirs, radius, pose), pose);
         if (k > warmup) {
             if (k == warmup + 1) r.stats = s;
             else r.stats.accumulate(s);
@@ -171,7 +171,7 @@ int main(int argc, char** argv) {
                     std::vector<RunResult> results;
                     for (int r = 0; r < runs; ++r) results.push_back(runOnce(s, std::stoul(gs), rate, warmup, steps, digest));
                     std::vector<double> sps, cpu;
-                    GuideStats worst = results[0].stats;
+                    StepStats worst = results[0].stats;
                     for (const RunResult& r : results) {
                         sps.push_back(r.stepsPerSecond);
                         cpu.push_back(r.cpuMsPerStep);

@@ -109,7 +109,7 @@ int stress(const std::string& path, const std::vector<std::string>& overrides) {
 
 /// Steps/s of B-sim with the head's collider made by `collider(pose)`.
 template <typename MakeCollider>
-double headOnly(size_t count, MakeCollider&& collider, GuideStats& stats) {
+double headOnly(size_t count, MakeCollider&& collider, StepStats& stats) {
     const float radius = 0.1f;
     SpinningSphere head(radius, 90.f);
     const std::vector<Vec3f> dirs = fibonacciCap(count);
@@ -131,7 +131,7 @@ double headOnly(size_t count, MakeCollider&& collider, GuideStats& stats) {
     for (int k = 1; k <= 270; ++k) {
         if (k == 21) start = Clock::now();
         p = posed(solver.nextTime(), roots);
-        const GuideStats& s = solver.step(roots, p);
+        const StepStats& s = solver.step(roots, p);
         if (k == 21) stats = s;
         else if (k > 21) stats.accumulate(s);
     }
@@ -148,10 +148,10 @@ int colliders(const std::vector<size_t>& counts) {
     std::printf("B-sim head-only (sphere r=0.1 m, 90 deg/s, rope, 250 timed steps): the head's collider\n\n"
                 "| guides | collider | steps/s | max stretch | max penetration mm |\n|---:|---|---:|---:|---:|\n");
     for (size_t n : counts) {
-        auto row = [&](const char* name, double sps, const GuideStats& s) {
+        auto row = [&](const char* name, double sps, const StepStats& s) {
             std::printf("| %zu | %s | %.0f | %.2e | %.3f |\n", n, name, sps, s.maxLengthError, s.maxPenetration * 1e3);
         };
-        GuideStats s;
+        StepStats s;
         double sps = headOnly(n, [](const HeadPose& p) {
             return std::make_shared<SphereCollider>(Vec3f(p.transform.translation()), 0.1f);
         }, s);

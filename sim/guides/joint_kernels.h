@@ -1,18 +1,19 @@
-// Solver kernels for guide strands: pure functions on plain vectors, each
-// with its governing equation, testable without a physics world (after
-// PositionBasedDynamics). The rope formulation (sim/guides/rope_group.cpp) runs them
-// after every Bullet step; the rigid formulation uses the collision and
-// measurement kernels.
+// Bending kernels of the guides' rope (and, for measuring bends, every
+// guide formulation): joint frames carried along a strand, the joint drive
+// toward the (gravity pre-loaded) rest shape, the projection limit and the
+// soft bend limits as spans. Pure functions on plain vectors, each with its
+// governing equation, testable without a physics world (after
+// PositionBasedDynamics). The rope formulation (sim/guides/rope_group.cpp)
+// runs them at Bullet's solver extension point and after its step.
 //
 // Notation: x_i vertex positions (x_0 the root), l_i rest length of segment
 // i = (x_i, x_{i+1}), h the Bullet step, m mass, κ angular stiffness.
 #pragma once
 
-#include "sim/strands/head.h"
+#include "sim/solver/head_contact.h"
 
 #include <Eigen/Geometry>
 
-#include <cmath>
 #include <cstddef>
 
 namespace hp::strand {
@@ -20,21 +21,12 @@ namespace hp::strand {
 using Mat3f = Eigen::Matrix3f;
 using Quatf = Eigen::Quaternionf;
 
-/// The root's orthonormal, right-handed frame as a rotation: columns
-/// (tangent, normal, tangent × normal), the tangent re-orthogonalised against
-/// the normal. Rest shapes are stored in these root-local coordinates.
-Mat3f rootRotation(const SurfaceFrame& frame);
-
 /// Compliance of an implicit spring in one XPBD iteration (Macklin 2016):
 /// a constraint C with stiffness κ on a coordinate of inertia I is corrected by
 ///   Δ = -C · h²κ / (I + h²κ),
 /// which is implicit Euler for the spring: stable for any κ, and the static
 /// sag under a load τ is τ/κ whatever h. Returns the fraction h²κ/(I + h²κ).
 float springFraction(float stiffness, float inertia, float h);
-
-/// Velocity damping over a time h: v ← v·exp(-c·h). Applying it n times with
-/// h/n gives the same decay, so damping does not depend on the step size.
-float dampingFactor(float rate, float h);
 
 /// The rotation-minimising transport of a frame: the smallest rotation taking
 /// unit vector `from` to unit vector `to` (parallel transport along a bend).
@@ -47,69 +39,6 @@ float angleBetween(const Vec3f& a, const Vec3f& b);
 /// between them is exactly `angle` (radians):
 ///   d' = cos(angle)·axis + sin(angle)·normalize(d - (d·axis)·axis).
 Vec3f rotateToAngle(const Vec3f& d, const Vec3f& axis, float angle);
-
-/// Follow-the-leader (Müller et al. 2012): places the child at exactly the rest
-/// length from its already-placed parent, along the current direction:
-///   x_{i+1} ← x_i + l_i · (x_{i+1} - x_i)/|x_{i+1} - x_i|.
-Vec3f followTheLeader(const Vec3f& parent, const Vec3f& child, float length);
-
-/// Follow-the-leader along a whole strand, root fixed. `correction[i]` (may
-/// be null) receives x_i(after) - x_i(before), used for the velocity update.
-void followTheLeader(Vec3f* x, const float* restLength, size_t vertexCount, Vec3f* correction = nullptr);
-
-/// Follow-the-leader on compressed segments only: where |x_{i+1} - x_i| < l_i
-/// the child is pushed out to l_i along the segment, root to tip; stretched
-/// segments are left alone. Run before a mass-weighted link solve so that it
-/// only sees tension: Gauss-Seidel on a compressed limp chain folds it into a
-/// zig-zag (measured: 8° kinks at the root of a standing strand), whereas a
-/// hair resists buckling through its bending stiffness.
-void relieveCompression(Vec3f* x, const float* restLength, size_t vertexCount);
-
-/// The head during one Bullet step, as the kernels see it. The collider is
-/// posed at the end of the outer step; `toCollider` maps a world point at the
-/// end of this Bullet step onto that pose (identity without substeps) and
-/// `normalToWorld` maps normals back; `toPrevious` maps a point riding on the
-/// head at the end of the step to where it was at the step's start, which
-/// gives the surface velocity for friction. Rigid head motion is exact; a
-/// deforming head's non-rigid motion is taken from the end pose.
-struct HeadQuery {
-    const Collider* collider = nullptr;
-    Eigen::Isometry3f toCollider = Eigen::Isometry3f::Identity();
-    Mat3f normalToWorld = Mat3f::Identity();
-    Eigen::Isometry3f toPrevious = Eigen::Isometry3f::Identity();
-
-    /// Signed distance (negative inside) and outward world normal at `x`.
-    float distance(const Vec3f& x, Vec3f* normal) const;
-    /// Velocity of the head surface at `x` over a step of length h.
-    Vec3f surfaceVelocity(const Vec3f& x, float h) const { return (x - toPrevious * x) / h; }
-};
-
-/// What a contact did to one vertex (for the velocity update).
-struct Contact {
-    bool active = false;
-    Vec3f normal = Vec3f::Zero();  ///< outward head normal
-    float push = 0.f;              ///< distance moved out along the normal, m
-};
-
-/// Projection out of the head's signed distance φ, keeping `radius` clear:
-///   if φ(x) < r:  x ← x + (r - φ(x))·∇φ(x).
-Contact projectOut(const HeadQuery& head, float radius, Vec3f& x);
-
-/// Places a child vertex at exactly `length` from its parent and outside the
-/// head: follow-the-leader, then (if inside) projection out of φ and back onto
-/// the sphere of radius `length` about the parent, repeated a few times; the
-/// two sets (a sphere around the parent, the outside of the head) intersect
-/// whenever the parent is outside, so this converges to a point on both. If
-/// it cannot (parent deep inside), the head wins over the length.
-Contact placeSegment(const Vec3f& parent, Vec3f& child, float length, const HeadQuery* head, float radius);
-
-/// Coulomb friction for a vertex the head pushed out by `push` during the
-/// step (velocity level, relative to the surface velocity vs):
-///   v_rel = v - vs; the push added push/h along n, which is removed (no
-///   bounce); the normal part is clamped to ≥ 0 (no approach); Δv_n is what
-///   the contact removed; the tangential part shrinks by at most μ·Δv_n
-///   (static friction when that stops it).
-Vec3f contactFriction(const Vec3f& v, const Vec3f& vs, const Contact& contact, float mu, float h);
 
 /// Per-joint parameters of relaxJoints, for joint j (segment j relative to
 /// its parent segment, or to the root frame for j = 0).
@@ -187,15 +116,5 @@ void bendLimitSpan(const float* restLength, const Vec3f* restDir, int segments, 
 /// wa, wb. Run inside Bullet's link iterations, it is the soft bend limit:
 /// both sides of the joint move, so the stop's reaction reaches the chain.
 void limitSpan(Vec3f& a, Vec3f& b, float wa, float wb, float minSpan, float maxSpan, float fraction);
-
-/// Pushes two segments apart along `normal` (from B to A) by `depth` at the
-/// parameters s (on A: a0→a1) and t (on B), weighted by inverse masses w:
-///   Δa_k = +w_ak·α_k·λ·n, Δb_k = -w_bk·β_k·λ·n,  λ = depth / Σ w·(weight)²,
-/// with α = (1-s, s), β = (1-t, t) (position-based edge-edge contact).
-void separateSegments(Vec3f& a0, Vec3f& a1, Vec3f& b0, Vec3f& b1, float s, float t, const Vec3f& normal,
-                      float depth, const float w[4]);
-
-/// |l/l_rest - 1| of segment (a, b).
-inline float stretch(const Vec3f& a, const Vec3f& b, float rest) { return std::abs((b - a).norm() / rest - 1.f); }
 
 }  // namespace hp::strand

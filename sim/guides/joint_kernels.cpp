@@ -1,4 +1,4 @@
-#include "sim/guides/strand_constraints.h"
+#include "sim/guides/joint_kernels.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,23 +8,10 @@
 
 namespace hp::strand {
 
-Mat3f rootRotation(const SurfaceFrame& frame) {
-    const Vec3f n = frame.normal.normalized();
-    Vec3f t = frame.tangent - n * n.dot(frame.tangent);
-    t = t.squaredNorm() > 1e-12f ? Vec3f(t.normalized()) : Vec3f(n.unitOrthogonal());
-    Mat3f r;
-    r.col(0) = t;
-    r.col(1) = n;
-    r.col(2) = t.cross(n);
-    return r;
-}
-
 float springFraction(float stiffness, float inertia, float h) {
     const float k = stiffness * h * h;
     return k > 0.f ? k / (inertia + k) : 0.f;
 }
-
-float dampingFactor(float rate, float h) { return std::exp(-rate * h); }
 
 namespace {
 
@@ -51,105 +38,6 @@ Vec3f rotateToAngle(const Vec3f& d, const Vec3f& axis, float angle) {
     // angle > 0 is asked of a direction at angle 0 or π).
     perp = len > 1e-12f ? Vec3f(perp / len) : Vec3f(axis.unitOrthogonal());
     return std::cos(angle) * axis + std::sin(angle) * perp;
-}
-
-Vec3f followTheLeader(const Vec3f& parent, const Vec3f& child, float length) {
-    const Vec3f e = child - parent;
-    const float len = e.norm();
-    // A collapsed segment keeps its length along an arbitrary (deterministic) axis.
-    return len > 1e-12f ? Vec3f(parent + e * (length / len)) : Vec3f(parent + Vec3f::UnitY() * length);
-}
-
-void followTheLeader(Vec3f* x, const float* restLength, size_t vertexCount, Vec3f* correction) {
-    if (correction && vertexCount > 0) correction[0] = Vec3f::Zero();
-    for (size_t i = 0; i + 1 < vertexCount; ++i) {
-        const Vec3f placed = followTheLeader(x[i], x[i + 1], restLength[i]);
-        if (correction) correction[i + 1] = placed - x[i + 1];
-        x[i + 1] = placed;
-    }
-}
-
-void relieveCompression(Vec3f* x, const float* restLength, size_t vertexCount) {
-    for (size_t i = 0; i + 1 < vertexCount; ++i)
-        if ((x[i + 1] - x[i]).squaredNorm() < restLength[i] * restLength[i])
-            x[i + 1] = followTheLeader(x[i], x[i + 1], restLength[i]);
-}
-
-float HeadQuery::distance(const Vec3f& x, Vec3f* normal) const {
-    Vec3f n;
-    const float d = collider->signedDistance(toCollider * x, &n);
-    if (normal) *normal = normalToWorld * n;
-    return d;
-}
-
-Contact projectOut(const HeadQuery& head, float radius, Vec3f& x) {
-    Contact c;
-    if (!head.collider) return c;
-    if (head.distance(x, nullptr) >= radius) return c;  // the common case: no normal needed
-    Vec3f n;
-    const float d = head.distance(x, &n);
-    c.active = true;
-    c.normal = n;
-    c.push = radius - d;
-    x += c.push * n;
-    return c;
-}
-
-namespace {
-
-/// The point at `length` from `parent` nearest to `onPlane` that is not
-/// below the plane through `onPlane` with unit normal n: with e = onPlane -
-/// parent, a = n·e (the plane's height relative to the parent), clamped to
-/// [-length, length], and t the unit tangential part of e,
-///   x = parent + a·n + sqrt(length² - a²)·t.
-/// It slides the child along the contact plane in one step, where
-/// alternating projections (plane, then sphere) creep toward the corner
-/// and leave the segment short after a few rounds (a strand meeting a floor
-/// nearly head-on: 3% in 4 rounds).
-Vec3f slideOnPlane(const Vec3f& parent, const Vec3f& onPlane, float length, const Vec3f& n) {
-    const Vec3f e = onPlane - parent;
-    const float a = std::clamp(n.dot(e), -length, length);
-    Vec3f t = e - n * n.dot(e);
-    const float tl = t.norm();
-    t = tl > 1e-9f ? Vec3f(t / tl) : Vec3f(n.unitOrthogonal());
-    return parent + a * n + std::sqrt(std::max(0.f, length * length - a * a)) * t;
-}
-
-}  // namespace
-
-Contact placeSegment(const Vec3f& parent, Vec3f& child, float length, const HeadQuery* head, float radius) {
-    child = followTheLeader(parent, child, length);
-    Contact total;
-    if (!head || !head->collider) return total;
-    const Vec3f start = child;
-    for (int iter = 0; iter < 4; ++iter) {
-        const Contact c = projectOut(*head, radius, child);
-        if (!c.active) break;
-        total.active = true;
-        total.normal = c.normal;
-        child = slideOnPlane(parent, child, length, c.normal);
-    }
-    if (total.active) {
-        // A last projection guarantees the clearance; it can only cost length
-        // when the parent itself sits inside the clearance band.
-        const Contact c = projectOut(*head, radius, child);
-        if (c.active) total.normal = c.normal;
-        total.push = std::max(0.f, (child - start).dot(total.normal));
-    }
-    return total;
-}
-
-Vec3f contactFriction(const Vec3f& v, const Vec3f& vs, const Contact& contact, float mu, float h) {
-    if (!contact.active) return v;
-    const Vec3f& n = contact.normal;
-    const Vec3f rel = v - vs;
-    const float vnRaw = rel.dot(n) - contact.push / h;  // what it would have been without the push
-    const float vn = std::max(vnRaw, 0.f);
-    const float removed = vn - vnRaw;                    // ≥ 0: approach speed the contact stopped
-    Vec3f vt = rel - rel.dot(n) * n;
-    const float vtLen = vt.norm();
-    if (vtLen > 0.f) vt *= std::max(0.f, 1.f - mu * removed / vtLen);
-    return vs + vn * n + vt;
 }
 
 namespace {
@@ -433,20 +321,6 @@ void limitSpan(Vec3f& a, Vec3f& b, float wa, float wb, float minSpan, float maxS
     const Vec3f corr = (fraction * excess / (d * w)) * e;
     a += wa * corr;
     b -= wb * corr;
-}
-
-void separateSegments(Vec3f& a0, Vec3f& a1, Vec3f& b0, Vec3f& b1, float s, float t, const Vec3f& normal,
-                      float depth, const float w[4]) {
-    const float alpha[2] = {1.f - s, s};
-    const float beta[2] = {1.f - t, t};
-    const float denom = w[0] * alpha[0] * alpha[0] + w[1] * alpha[1] * alpha[1] + w[2] * beta[0] * beta[0] +
-                        w[3] * beta[1] * beta[1];
-    if (denom <= 0.f) return;
-    const float lambda = depth / denom;
-    a0 += w[0] * alpha[0] * lambda * normal;
-    a1 += w[1] * alpha[1] * lambda * normal;
-    b0 -= w[2] * beta[0] * lambda * normal;
-    b1 -= w[3] * beta[1] * lambda * normal;
 }
 
 }  // namespace hp::strand
