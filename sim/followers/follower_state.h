@@ -144,6 +144,8 @@ struct StepContext {
 
 struct Counters {
     size_t projected = 0, queries = 0;
+    size_t bent = 0;        ///< vertices the slide left inside, bent out (follower_pinch.h)
+    size_t pinned = 0;      ///< vertices with no place outside at their length, held (follower_pinch.h)
     size_t inside = 0;      ///< projected vertices left inside (signed distance < 0)
     float maxDepth = 0.f;   ///< deepest of those, m
 };

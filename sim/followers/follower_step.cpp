@@ -29,6 +29,7 @@
 //   bits; within one machine every follower runs the same code in whatever
 //   lane, packet or thread, which is the determinism the project needs
 //   (bits identical across CPU generations are not promised).
+#include "sim/followers/follower_pinch.h"
 #include "sim/followers/follower_simd.h"
 #include "sim/followers/follower_state.h"
 
@@ -103,13 +104,16 @@ template <bool Own>
 
 /// Follow the leader for lane k of a packet (positions pos[3v + c], lanes =
 /// followers): a vertex the bound cannot clear is queried; one inside is
-/// projected out keeping its segment's length, and every later vertex moves
-/// by the same shift, so segment directions are kept elsewhere.
+/// projected out keeping its segment's length (slid along the surface, or
+/// where that fails bent or pinned: follower_pinch.h), and every later vertex
+/// moves by the same shift, so segment directions are kept elsewhere. `last`:
+/// the lane's vertices in the previous frame (null when there is none).
 /// `cleared[v]` is the vector pass's bound test of the unshifted vertex,
 /// valid until the first projection (and `uncleared`, bit v, the same for
 /// vertices 1..31); after it shifted vertices are tested again.
 void collideLane(const StepContext& ctx, const FollowerClass& c, const float* g1, const i8* cleared,
-                 uint32_t uncleared, int k, const float* ownRest, float segmentLength, f8* pos, Counters& counters) {
+                 uint32_t uncleared, int k, const float* ownRest, float segmentLength, const Vec3f* last, f8* pos,
+                 Counters& counters) {
     const size_t P = c.pad;
     float sx = 0.f, sy = 0.f, sz = 0.f;
     bool shifted = false;
@@ -127,7 +131,16 @@ void collideLane(const StepContext& ctx, const FollowerClass& c, const float* g1
             const float* r = ownRest + size_t(v) * 3 * kLanes + k;
             length = std::sqrt(r[0] * r[0] + r[kLanes] * r[kLanes] + r[2 * kLanes] * r[2 * kLanes]);
         }
-        const float after = projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p);
+        const Vec3f wanted = p;
+        float after = projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p);
+        if (after < 0.f) {
+            // The slide could not bring it out: bend, else pin (follower_pinch.h).
+            const PinchPlace place = placePinched(*ctx.collider, previous, length, c.radii[v], wanted,
+                                                  last ? last + v : nullptr);
+            p = place.position;
+            after = place.distance;
+            ++(place.pinned ? counters.pinned : counters.bent);
+        }
         if (after < 0.f) {
             ++counters.inside;
             counters.maxDepth = std::max(counters.maxDepth, -after);
@@ -332,7 +345,9 @@ template <FollowerMode M, bool Own>
         for (uint32_t k = 0; k < pk.count; ++k)
             if (!clear[k]) {
                 const float* g1 = c.cold.data() + size_t(pk.guide1[k]) * FollowerClass::kCold * P;
-                collideLane(ctx, c, g1, cleared, uncleared[k], int(k), ownRest, pk.scale[k], pos, counters);
+                // The lane's previous output, where a pinned vertex is held (still in `positions` until written below).
+                const Vec3f* last = ctx.difference ? ctx.positions + pk.vertexOffset[k] : nullptr;
+                collideLane(ctx, c, g1, cleared, uncleared[k], int(k), ownRest, pk.scale[k], last, pos, counters);
             }
     }
 

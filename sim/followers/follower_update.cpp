@@ -194,7 +194,7 @@ FollowerStats Followers::update(const FollowerStep& step, StrandFrame& out) {
     follower::StepContext ctx{&im, step.followerRoots.data(), collider, out.positions.data() + guideVertices,
                               out.velocities.data() + guideVertices, stats.differenceVelocities,
                               step.dt > 0.0 ? float(1.0 / step.dt) : 0.f};
-    std::atomic<size_t> projected{0}, queries{0}, inside{0};
+    std::atomic<size_t> projected{0}, queries{0}, inside{0}, bent{0}, pinned{0};
     std::atomic<uint32_t> depthBits{0};  // a non-negative float's bits order like the float
     auto packetsLoop = [&](const tbb::blocked_range<size_t>& r) {
         follower::Counters counters;
@@ -202,6 +202,8 @@ FollowerStats Followers::update(const FollowerStep& step, StrandFrame& out) {
         projected += counters.projected;
         queries += counters.queries;
         inside += counters.inside;
+        bent += counters.bent;
+        pinned += counters.pinned;
         uint32_t bits;
         std::memcpy(&bits, &counters.maxDepth, sizeof bits);
         uint32_t seen = depthBits.load();
@@ -224,6 +226,8 @@ FollowerStats Followers::update(const FollowerStep& step, StrandFrame& out) {
     stats.projected = projected;
     stats.collisionQueries = queries;
     stats.penetrationCount = inside;
+    stats.bent = bent;
+    stats.pinned = pinned;
     const uint32_t bits = depthBits.load();
     std::memcpy(&stats.maxPenetration, &bits, sizeof bits);
     im.lastPositions = out.positions.data();
