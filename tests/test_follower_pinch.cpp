@@ -3,6 +3,7 @@
 // parent, else pinned; never stretched. The kernel against analytic
 // answers (a slab gap, a closed pocket), then whole followers squeezed
 // between a sphere head and a lid that cuts into it.
+#include "follower_support.h"
 #include "sim/followers/follower_kernels.h"
 #include "sim/followers/follower_pinch.h"
 #include "sim/followers/followers.h"
@@ -142,15 +143,11 @@ TEST(FollowerPinch, FollowersSqueezedUnderALidStayOutsideAtTheirLengths) {
     // A lid 5 mm below the crown cuts into the head; guides lie over the
     // crown, so followers there press into the wedge between the head and
     // the lid, where sliding along one surface pushes into the other.
-    SphereGroomSettings s;
-    s.guides = 94;
-    s.followers = 2000;
-    const FollowerGroom groom = makeSphereGroom(s);
-    const SyntheticGuides motion(groom, {});
-    StrandFrame guides;
-    std::vector<SurfaceFrame> guideRoots, followerRoots;
-    motion.sample(0.7, guides, guideRoots);
-    rotateRoots(groom.followerRoots, motion.headRotation(0.7), followerRoots);
+    const hp::test::SphereScene scene(94, 2000, 0.7);
+    const FollowerGroom& groom = scene.groom;
+    const StrandFrame& guides = scene.guides;
+    const std::vector<SurfaceFrame>& guideRoots = scene.guideRoots;
+    const std::vector<SurfaceFrame>& followerRoots = scene.followerRoots;
     const HeadUnderLid head(0.095f);
     const float rest = 0.25f / 23;
 
