@@ -144,20 +144,17 @@ TEST(FollowerPinch, FollowersSqueezedUnderALidStayOutsideAtTheirLengths) {
     // crown, so followers there press into the wedge between the head and
     // the lid, where sliding along one surface pushes into the other.
     const hp::test::SphereScene scene(94, 2000, 0.7);
-    const FollowerGroom& groom = scene.groom;
-    const StrandFrame& guides = scene.guides;
-    const std::vector<SurfaceFrame>& guideRoots = scene.guideRoots;
-    const std::vector<SurfaceFrame>& followerRoots = scene.followerRoots;
     const HeadUnderLid head(0.095f);
     const float rest = 0.25f / 23;
 
     auto run = [&](int threads, StrandFrame& out, FollowerStats* second) {
         tbb::task_arena arena(threads);
         arena.execute([&] {
-            Followers followers(groom, {});
-            const FollowerStats first = followers.update({guides, guideRoots, followerRoots, &head}, out);
+            Followers followers(scene.groom, {});
+            const FollowerStep step{scene.guides, scene.guideRoots, scene.followerRoots, &head};
+            const FollowerStats first = followers.update(step, out);
             // Again into the same buffer: pinned vertices are now held toward their last places.
-            *second = followers.update({guides, guideRoots, followerRoots, &head, 0.04}, out);
+            *second = followers.update({scene.guides, scene.guideRoots, scene.followerRoots, &head, 0.04}, out);
             EXPECT_GT(first.bent, 0u) << "the slide alone leaves vertices inside the wedge";
         });
     };
