@@ -1,9 +1,11 @@
 // Followers caught in a pinch (sim/followers/follower_pinch.h, issue 20): a
 // vertex that sliding along the surface cannot bring out is bent about its
 // parent, else pinned; never stretched. The kernel against analytic
-// answers (a slab gap, a closed pocket), then whole followers squeezed
-// between a sphere head and a lid that cuts into it.
+// answers (a slab gap, a wedge, a closed pocket), then whole followers
+// squeezed between a sphere head and a lid that cuts into it, and the
+// frame statistics that report them.
 #include "follower_support.h"
+#include "pipeline/stages/shot_simulation.h"
 #include "sim/followers/follower_kernels.h"
 #include "sim/followers/follower_pinch.h"
 #include "sim/followers/followers.h"
@@ -189,4 +191,16 @@ TEST(FollowerPinch, FollowersSqueezedUnderALidStayOutsideAtTheirLengths) {
     EXPECT_GT(stats.pinned, 0u) << "roots under the lid have no place outside within a segment";
     std::printf("bent %zu, pinned %zu, left inside %zu (%.2f mm), max stretch %.1e\n", stats.bent, stats.pinned,
                 inside, deepest * 1e3, stretch);
+}
+
+TEST(FollowerPinch, FrameStatisticsReportBentAndPinnedFollowerVertices) {
+    SimFrameStats s;
+    s.guides.pinnedCount = 2;
+    s.followers.bent = 5;
+    s.followers.pinned = 3;
+    const std::string j = s.json();
+    const size_t followers = j.find("\"followers\": {");
+    ASSERT_NE(followers, std::string::npos) << j;
+    EXPECT_NE(j.find("\"bent\": 5, \"pinned\": 3}", followers), std::string::npos) << j;
+    EXPECT_LT(j.find("\"pinned\": 2"), followers) << "the guides' pinned count stays at the top level";
 }
