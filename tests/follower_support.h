@@ -2,6 +2,9 @@
 #pragma once
 
 #include "sim/strands/head.h"
+#include "sim/strands/synthetic_groom.h"
+
+#include <vector>
 
 namespace hp::test {
 
@@ -14,5 +17,25 @@ inline SurfaceFrame frameAt(const Vec3f& position, const Vec3f& normal, const Ve
     f.tangent = (tangent - f.normal * f.normal.dot(tangent)).normalized();
     return f;
 }
+
+/// The follower tests' sphere scene at time t: a sphere groom of `guides`
+/// guides and `followers` followers, its guides as SyntheticGuides draws
+/// them (lying over the head, differing a lot between neighbours at the
+/// crown) and the follower roots turned with the head.
+struct SphereScene {
+    FollowerGroom groom;
+    StrandFrame guides;
+    std::vector<SurfaceFrame> guideRoots, followerRoots;
+
+    SphereScene(size_t guideCount, size_t followerCount, double t) {
+        SphereGroomSettings s;
+        s.guides = guideCount;
+        s.followers = followerCount;
+        groom = makeSphereGroom(s);
+        const SyntheticGuides motion(groom, {});
+        motion.sample(t, guides, guideRoots);
+        rotateRoots(groom.followerRoots, motion.headRotation(t), followerRoots);
+    }
+};
 
 }  // namespace hp::test

@@ -499,17 +499,13 @@ TEST(Followers, InPlaceAppendEqualsSeparateOutput) {
 }
 
 TEST(Followers, CollisionLeavesNoVertexInsideTheHead) {
-    SphereGroomSettings s;
-    s.guides = 94;
-    s.followers = 2000;
-    const FollowerGroom groom = makeSphereGroom(s);
     // Guides lie over the head and differ a lot between neighbours at the
     // crown, so interpolated followers cut into the head (the seed's Fig. 5.4).
-    const SyntheticGuides motion(groom, {});
-    StrandFrame guides;
-    std::vector<SurfaceFrame> guideRoots, followerRoots;
-    motion.sample(0.7, guides, guideRoots);
-    rotateRoots(groom.followerRoots, motion.headRotation(0.7), followerRoots);
+    const hp::test::SphereScene scene(94, 2000, 0.7);
+    const FollowerGroom& groom = scene.groom;
+    const StrandFrame& guides = scene.guides;
+    const std::vector<SurfaceFrame>& guideRoots = scene.guideRoots;
+    const std::vector<SurfaceFrame>& followerRoots = scene.followerRoots;
     const SphereCollider head(Vec3f::Zero(), 0.1f);
     auto inside = [&](const StrandFrame& out, double* stretch) {
         size_t count = 0;

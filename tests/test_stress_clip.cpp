@@ -1,16 +1,16 @@
 // The stress clip (scenes/stress.yaml: the default head's "stress" clip, hair
 // rooted everywhere, nape and neck included, shoulders as a Bullet capsule):
 // after every frame no guide or follower segment is stretched more than 1%
-// and no free vertex is more than 1 mm inside any collider, on 1 and 2
-// threads, with the same strands on both.
+// and no free vertex is more than 1 mm inside any collider (the pose's
+// composite collider: head and Bullet world), on 1 and 2 threads, with the
+// same strands on both.
 //
 // With the rod formulation every segment stays within 1% on every frame
 // (the rope stretched nape strands 3.3% where the tipping head pinches them
-// against the neck, frames 12-14). The depth limit is not met yet: during and
-// after the 180° turn (frames 29-46) a few follower vertices end up to
-// 1.74 mm inside (the guides stay outside), so that check is its own
-// DISABLED test; run it with
-//   build/tests/test_stress_clip --gtest_also_run_disabled_tests
+// against the neck, frames 12-14). Follower vertices that sliding along the
+// surface cannot bring out of the neck fold (frames 29-46, up to 1.74 mm
+// deep before) are bent about their parent or pinned at their length
+// (sim/followers/follower_pinch.h), so none ends inside.
 #include "pipeline/scene/scene.h"
 #include "pipeline/stages/shot_simulation.h"
 #include "test_support.h"
@@ -47,7 +47,7 @@ std::vector<StrandFrame> runStress(int threads, float depthLimit) {
                 depth = std::max(depth, -sim.pose().collider->signedDistance(f.positions[i + 1]));
             }
         EXPECT_LE(stretch, 0.01f) << "frame " << frame << ", " << threads << " threads";
-        if (depthLimit > 0.f) EXPECT_LE(depth, depthLimit) << "frame " << frame << ", " << threads << " threads";
+        EXPECT_LE(depth, depthLimit) << "frame " << frame << ", " << threads << " threads";
         out.push_back(f);
     }
     return out;
@@ -55,12 +55,8 @@ std::vector<StrandFrame> runStress(int threads, float depthLimit) {
 
 }  // namespace
 
-TEST(StressClip, NoStretchAfterAnyFrameOnOneAndTwoThreads) {
-    const std::vector<StrandFrame> one = runStress(1, 0.f), two = runStress(2, 0.f);
+TEST(StressClip, NoStretchNorVertexDeeperThanAMillimetreAfterAnyFrameOnOneAndTwoThreads) {
+    const std::vector<StrandFrame> one = runStress(1, 1e-3f), two = runStress(2, 1e-3f);
     ASSERT_EQ(one.size(), two.size());
     for (size_t k = 0; k < one.size(); ++k) EXPECT_EQ(one[k].positions, two[k].positions) << "frame index " << k;
-}
-
-TEST(StressClip, DISABLED_NoVertexDeeperThanAMillimetreAfterAnyFrame) {
-    runStress(1, 1e-3f);
 }

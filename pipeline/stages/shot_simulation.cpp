@@ -160,7 +160,8 @@ std::string SimFrameStats::json() const {
     o << ", \"followers\": {\"max_length_error\": " << followers.maxLengthError
       << ", \"mean_length_error\": " << followers.meanLengthError
       << ", \"penetration_count\": " << followers.penetrationCount
-      << ", \"max_penetration\": " << followers.maxPenetration << ", \"projected\": " << followerProjected << "}";
+      << ", \"max_penetration\": " << followers.maxPenetration << ", \"projected\": " << followerProjected
+      << ", \"bent\": " << followers.bent << ", \"pinned\": " << followers.pinned << "}";
     o << "}";
     return o.str();
 }
@@ -333,7 +334,7 @@ void ShotSimulation::produceFrame(double time) {
     stats_.guides.steps = pendingSteps_;
     stats_.followerProjected = fs.projected;
     const Followers::LengthError lengthError = followers_->lengthError(strands_);
-    stats_.followers = {lengthError.max, lengthError.mean, fs.penetrationCount, fs.maxPenetration};
+    stats_.followers = {lengthError.max, lengthError.mean, fs.penetrationCount, fs.maxPenetration, fs.bent, fs.pinned};
     stats_.followerMs = msSince(followerStart);
     stats_.headMs = headMs;
     stats_.strands = strands_.strandCount();

@@ -40,6 +40,7 @@ struct SimFrameStats {
         double maxLengthError = 0, meanLengthError = 0;  ///< |segment length / rest - 1|
         size_t penetrationCount = 0;  ///< vertices left inside the head (signed distance < 0)
         double maxPenetration = 0;    ///< m
+        size_t bent = 0, pinned = 0;  ///< pinch: vertices bent out, vertices pinned (FollowerStats)
     } followers;
     double headMs = 0;             ///< sampling the head animation (all steps)
     double followerMs = 0;         ///< rebuilding the followers

@@ -302,10 +302,11 @@ HP_FOLLOWER_KERNEL Quat segmentRotation(const Quat& currentFrame, const Quat& re
 /// out as the segment reaches, toward the pushed point c:
 ///   p = previous + length (c - previous) / |c - previous|,
 /// and so after the rounds if p is still inside: the segment keeps its
-/// length and the vertex may stay inside (the depth is returned and counted
-/// in FollowerStats) rather than the strand stretching to reach out (issue
-/// 20: a follower pushed out of the head must not stretch). Returns the
-/// signed distance of p afterwards; `radius` or more when it did not move.
+/// length and the vertex may stay inside rather than the strand stretching
+/// to reach out (issue 20: a follower pushed out of the head must not
+/// stretch); the caller then bends the segment or pins the vertex
+/// (sim/followers/follower_pinch.h). Returns the signed distance of p
+/// afterwards; `radius` or more when it did not move.
 inline float projectSegmentOut(const Collider& head, const Eigen::Vector3f& previous, float length, float radius,
                                float distance, Eigen::Vector3f normal, Eigen::Vector3f& p) {
     if (distance >= radius) return distance;

@@ -43,6 +43,20 @@ HP_SIMD bool anyLane(i8 m) {
     return (q[0] | q[1] | q[2] | q[3]) != 0;
 }
 
+/// A 4 × 4 transpose in each 128-bit half of four vectors (the first two
+/// rounds of an 8 × 8 transpose): lane i of half h of c_k is lane k of half
+/// h of r_i. 8 shuffles.
+HP_SIMD void transposeHalves(f8 r0, f8 r1, f8 r2, f8 r3, f8& c0, f8& c1, f8& c2, f8& c3) {
+    const i8 lo{0, 8, 1, 9, 4, 12, 5, 13}, hi{2, 10, 3, 11, 6, 14, 7, 15};
+    const i8 lo2{0, 1, 8, 9, 4, 5, 12, 13}, hi2{2, 3, 10, 11, 6, 7, 14, 15};
+    const f8 t0 = __builtin_shuffle(r0, r1, lo), t1 = __builtin_shuffle(r0, r1, hi);
+    const f8 t2 = __builtin_shuffle(r2, r3, lo), t3 = __builtin_shuffle(r2, r3, hi);
+    c0 = __builtin_shuffle(t0, t2, lo2);
+    c1 = __builtin_shuffle(t0, t2, hi2);
+    c2 = __builtin_shuffle(t1, t3, lo2);
+    c3 = __builtin_shuffle(t1, t3, hi2);
+}
+
 /// Half of an 8 × 8 transpose: the 4 floats at p[k] (k = 0..7, the lanes)
 /// as 4 vectors, c_i lane k = p[k][i]. Two 4-float loads per 128-bit half,
 /// then a 4 × 4 transpose in each half: 12 shuffles for 4 outputs, and only
@@ -53,14 +67,7 @@ HP_SIMD void transpose8x4(const float* const* p, f8& c0, f8& c1, f8& c2, f8& c3)
     const f8 r1 = __builtin_shufflevector(*reinterpret_cast<const f4u*>(p[1]), *reinterpret_cast<const f4u*>(p[5]), 0, 1, 2, 3, 4, 5, 6, 7);
     const f8 r2 = __builtin_shufflevector(*reinterpret_cast<const f4u*>(p[2]), *reinterpret_cast<const f4u*>(p[6]), 0, 1, 2, 3, 4, 5, 6, 7);
     const f8 r3 = __builtin_shufflevector(*reinterpret_cast<const f4u*>(p[3]), *reinterpret_cast<const f4u*>(p[7]), 0, 1, 2, 3, 4, 5, 6, 7);
-    const i8 lo{0, 8, 1, 9, 4, 12, 5, 13}, hi{2, 10, 3, 11, 6, 14, 7, 15};
-    const i8 lo2{0, 1, 8, 9, 4, 5, 12, 13}, hi2{2, 3, 10, 11, 6, 7, 14, 15};
-    const f8 t0 = __builtin_shuffle(r0, r1, lo), t1 = __builtin_shuffle(r0, r1, hi);
-    const f8 t2 = __builtin_shuffle(r2, r3, lo), t3 = __builtin_shuffle(r2, r3, hi);
-    c0 = __builtin_shuffle(t0, t2, lo2);
-    c1 = __builtin_shuffle(t0, t2, hi2);
-    c2 = __builtin_shuffle(t1, t3, lo2);
-    c3 = __builtin_shuffle(t1, t3, hi2);
+    transposeHalves(r0, r1, r2, r3, c0, c1, c2, c3);
 }
 
 /// Lane-wise square root (a loop GCC turns into one vector instruction;
@@ -76,17 +83,10 @@ HP_SIMD f8 sqrt8(f8 x) {
 /// 24 shuffles, each one instruction in the AVX2 build. Separate variables,
 /// not an array: GCC keeps those in registers.
 HP_SIMD void transpose8(f8& r0, f8& r1, f8& r2, f8& r3, f8& r4, f8& r5, f8& r6, f8& r7) {
-    const i8 lo{0, 8, 1, 9, 4, 12, 5, 13}, hi{2, 10, 3, 11, 6, 14, 7, 15};
-    const i8 lo2{0, 1, 8, 9, 4, 5, 12, 13}, hi2{2, 3, 10, 11, 6, 7, 14, 15};
     const i8 lowHalves{0, 1, 2, 3, 8, 9, 10, 11}, highHalves{4, 5, 6, 7, 12, 13, 14, 15};
-    const f8 t0 = __builtin_shuffle(r0, r1, lo), t1 = __builtin_shuffle(r0, r1, hi);
-    const f8 t2 = __builtin_shuffle(r2, r3, lo), t3 = __builtin_shuffle(r2, r3, hi);
-    const f8 t4 = __builtin_shuffle(r4, r5, lo), t5 = __builtin_shuffle(r4, r5, hi);
-    const f8 t6 = __builtin_shuffle(r6, r7, lo), t7 = __builtin_shuffle(r6, r7, hi);
-    const f8 u0 = __builtin_shuffle(t0, t2, lo2), u1 = __builtin_shuffle(t0, t2, hi2);
-    const f8 u2 = __builtin_shuffle(t1, t3, lo2), u3 = __builtin_shuffle(t1, t3, hi2);
-    const f8 u4 = __builtin_shuffle(t4, t6, lo2), u5 = __builtin_shuffle(t4, t6, hi2);
-    const f8 u6 = __builtin_shuffle(t5, t7, lo2), u7 = __builtin_shuffle(t5, t7, hi2);
+    f8 u0, u1, u2, u3, u4, u5, u6, u7;
+    transposeHalves(r0, r1, r2, r3, u0, u1, u2, u3);
+    transposeHalves(r4, r5, r6, r7, u4, u5, u6, u7);
     r0 = __builtin_shuffle(u0, u4, lowHalves);
     r1 = __builtin_shuffle(u1, u5, lowHalves);
     r2 = __builtin_shuffle(u2, u6, lowHalves);

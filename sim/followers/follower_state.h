@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include <cstddef>
 #include <vector>
 
 namespace hp {
@@ -22,6 +23,77 @@ struct GuidePair {
     float twistC = 1.f, twistS = 0.f;
 };
 
+/// Rows of a class's hot table, per guide (GuideRows): what the pair and
+/// guide records are built from each step.
+enum class HotRow : uint32_t {
+    RotationW, RotationX, RotationY, RotationZ,  ///< q: the guide segment mapped to the slot's segment, rest to now
+    Speed,                                       ///< m/s, the segment's centre
+    RestX, RestY, RestZ,                         ///< unit rest direction, root frame (static)
+    Count
+};
+
+/// Rows of a class's cold table, per guide (GuideRows); slot = vertex.
+enum class ColdRow : uint32_t {
+    X, Y, Z,                             ///< the guide vertex, world
+    Bound,                               ///< its collisionBound (+inf at the root and in the padding)
+    VelocityX, VelocityY, VelocityZ,     ///< its velocity
+    Count
+};
+
+/// Row::Count rows of P floats per guide, a structure of arrays: a loop
+/// over the slots of one row reads contiguous floats and vectorises.
+template <typename Row>
+class GuideRows {
+  public:
+    static constexpr size_t kRows = size_t(Row::Count);
+    void assign(size_t guides, size_t pad) {
+        pad_ = pad;
+        data_.assign(guides * kRows * pad, 0.f);
+    }
+    float* row(size_t guide, Row r) { return data_.data() + (guide * kRows + size_t(r)) * pad_; }
+    const float* row(size_t guide, Row r) const { return data_.data() + (guide * kRows + size_t(r)) * pad_; }
+
+  private:
+    std::vector<float> data_;
+    size_t pad_ = 0;
+};
+
+/// Per guide and slot, what the followers led by that guide read for the
+/// slot's segment, rebuilt every step. One record is 32 bytes; the step
+/// transposes the records of 8 lanes into vectors 4 floats at a time, so
+/// the two groups (lead, then vertex and bound) must stay in this order.
+struct GuideRecord {
+    /// A = q r q* of follower_kernels.h's (2) and 0 (followers with the
+    /// guides' rest shape), or the guide's rotation q, w x y z (own rest shapes).
+    float lead[4];
+    float vertex[3];  ///< the guide vertex, world (the follower vertex's collision bound centre)
+    float bound;      ///< its collisionBound
+    const float* vertexAndBound() const { return vertex; }  ///< the second group: x y z bound
+};
+
+/// Per guide pair and slot, rebuilt every step (32 bytes, read like
+/// GuideRecord in two groups of 4: θ and terms 0-2, then terms 3-5 and d_v).
+struct PairRecord {
+    float theta;  ///< the slerp arc θ between q1 and K q2 K⁻¹
+    /// B - A then D of (2) (followers with the guides' rest shape), or the
+    /// quaternion e of (1), w x y z, then 0, 0 (own rest shapes).
+    float terms[6];
+    float speedOffset;  ///< Algorithm 1's d_v: guide 1's clamped speed
+    const float* arcAndTerms() const { return &theta; }            ///< θ, terms 0-2
+    const float* lastTermsAndSpeed() const { return &terms[3]; }   ///< terms 3-5, d_v
+};
+
+static_assert(sizeof(GuideRecord) == 8 * sizeof(float) && offsetof(GuideRecord, bound) == 7 * sizeof(float),
+              "the step reads a guide record as two groups of 4 floats");
+static_assert(sizeof(PairRecord) == 8 * sizeof(float) && offsetof(PairRecord, speedOffset) == 7 * sizeof(float),
+              "the step reads a pair record as two groups of 4 floats");
+
+/// A packet's own rest segment at one slot (direction × length, in the
+/// aligned frame), each coordinate over the packet's 8 lanes: one vector load each.
+struct OwnRestSlot {
+    float x[8], y[8], z[8];
+};
+
 /// Followers sharing one segment count S. Every table is in slots: P
 /// slots (P a multiple of 8, P >= S + 1) where slot j is vertex j and
 /// segment j - 1, the segment ending at vertex j; slot 0 (the root) and the
@@ -29,29 +101,17 @@ struct GuidePair {
 struct FollowerClass {
     uint32_t segments = 0;
     uint32_t pad = 0;
-    /// Per guide, kHot rows of P slots: qw qx qy qz (rotation of the guide
-    /// segment mapped to the slot's segment), speed (m/s, the segment's
-    /// centre), rx ry rz (unit rest direction, static).
-    std::vector<float> hot;
-    /// Per guide, kCold rows of P slots, slot = vertex: x y z (world), bound
-    /// (collisionBound; +inf at the root and in the padding), vx vy vz, unused.
-    std::vector<float> cold;
-    /// Per guide and slot, a record of 8 floats rebuilt every step: A of
-    /// follower_kernels.h's (2) and 0 (followers with the guides' rest shape)
-    /// or the guide's rotation q (own rest shapes), then the vertex x y z and
-    /// its collision bound.
-    std::vector<float> guideRecords;
-    /// Guide pairs of this class's followers and, per pair and slot, a record
-    /// of 8 floats rebuilt every step: θ, then B - A and D of (2) (followers
-    /// with the guides' rest shape) or the quaternion e of (1) and 0, 0 (own
-    /// rest shapes), then Algorithm 1's d_v (guide 1's clamped speed).
+    GuideRows<HotRow> hot;
+    GuideRows<ColdRow> cold;
+    std::vector<GuideRecord> guideRecords;  ///< per guide, P slots
+    /// Guide pairs of this class's followers and their records, per pair P slots.
     std::vector<GuidePair> pairs;
-    std::vector<float> pairRecords;
+    std::vector<PairRecord> pairRecords;
     std::vector<float> radii;          ///< S + 1 tapered radii
     std::vector<float> weightedCurve;  ///< fixedOffset · d_f(j - 1) per slot, 0 at slot 0 and in the padding
-    static constexpr int kHot = 8;
-    static constexpr int kCold = 8;
-    static constexpr int kRecord = 8;
+
+    const GuideRecord* guideRecord(size_t guide) const { return guideRecords.data() + guide * pad; }
+    const PairRecord* pairRecord(size_t pair) const { return pairRecords.data() + pair * pad; }
 
     /// Guide segment read by follower segment y: the one covering the same
     /// fraction of the strand, floor((y + 1/2) Sg / S); y itself when Sg = S.
@@ -76,8 +136,10 @@ struct alignas(32) FollowerPacket {
     uint32_t follower[kLanes], guide1[kLanes], pair[kLanes];
     uint32_t vertexOffset[kLanes];  ///< first output vertex, relative to the follower block
     uint32_t count = 0, cls = 0;
-    uint32_t own = 0;  ///< offset of the packet's own rest segments: P slots × 3 × 8 lanes
+    uint32_t own = 0;  ///< the packet's first OwnRestSlot (P of them) in Followers::Impl::ownRest
 };
+
+static_assert(sizeof(OwnRestSlot) == 3 * FollowerPacket::kLanes * sizeof(float), "one float per lane and coordinate");
 
 /// Barycentric mode: the second and third guide of each lane of a packet,
 /// the weights, and the rest twists K2, K3 (about y) into guide 1's frame.
@@ -108,9 +170,9 @@ struct Followers::Impl {
     std::vector<float> weight;             ///< interpolation weight d1 / (d1 + d2)
     std::vector<float> alignC, alignS;     ///< follower frame turned about its normal by φ_f
     std::vector<float> segmentLength;      ///< followers without own rest shapes
-    /// Own rest segments (direction × length, in the aligned frame), per
-    /// packet P slots × (x, y, z) × 8 lanes; zero at slot 0 and in the padding.
-    std::vector<float> ownRestData;
+    /// Own rest segments, per packet P slots; zero at slot 0 and in the
+    /// padding. Empty: the followers take their guides' rest shapes.
+    std::vector<OwnRestSlot> ownRest;
     std::vector<uint32_t> vertexOffset;    ///< follower vertex offsets, relative to the follower block
     std::vector<uint32_t> ids;
 
@@ -144,6 +206,8 @@ struct StepContext {
 
 struct Counters {
     size_t projected = 0, queries = 0;
+    size_t bent = 0;        ///< vertices the slide left inside, bent out (follower_pinch.h)
+    size_t pinned = 0;      ///< vertices with no place outside at their length, held (follower_pinch.h)
     size_t inside = 0;      ///< projected vertices left inside (signed distance < 0)
     float maxDepth = 0.f;   ///< deepest of those, m
 };

@@ -29,6 +29,7 @@
 //   bits; within one machine every follower runs the same code in whatever
 //   lane, packet or thread, which is the determinism the project needs
 //   (bits identical across CPU generations are not promised).
+#include "sim/followers/follower_pinch.h"
 #include "sim/followers/follower_simd.h"
 #include "sim/followers/follower_state.h"
 
@@ -53,11 +54,14 @@ template <bool Own>
         // One pointer per row: the slot loop reads and writes contiguous
         // rows and vectorizes (ivdep: rows never overlap; restrict alone is
         // lost once this is inlined).
-        const float* h1 = c.hot.data() + size_t(gp.guide1) * FollowerClass::kHot * P;
-        const float* h2 = c.hot.data() + size_t(gp.guide2) * FollowerClass::kHot * P;
-        const float *aW = h1, *aX = h1 + P, *aY = h1 + 2 * P, *aZ = h1 + 3 * P, *speed = h1 + 4 * P;
-        const float *fX = h1 + 5 * P, *fY = h1 + 6 * P, *fZ = h1 + 7 * P;
-        const float *bW = h2, *bX = h2 + P, *bY = h2 + 2 * P, *bZ = h2 + 3 * P;
+        const GuideRows<HotRow>& hot = c.hot;
+        const uint32_t g1 = gp.guide1, g2 = gp.guide2;
+        const float *aW = hot.row(g1, HotRow::RotationW), *aX = hot.row(g1, HotRow::RotationX),
+                    *aY = hot.row(g1, HotRow::RotationY), *aZ = hot.row(g1, HotRow::RotationZ);
+        const float* speed = hot.row(g1, HotRow::Speed);
+        const float *fX = hot.row(g1, HotRow::RestX), *fY = hot.row(g1, HotRow::RestY), *fZ = hot.row(g1, HotRow::RestZ);
+        const float *bW = hot.row(g2, HotRow::RotationW), *bX = hot.row(g2, HotRow::RotationX),
+                    *bY = hot.row(g2, HotRow::RotationY), *bZ = hot.row(g2, HotRow::RotationZ);
         float *o0 = rows[0], *o1 = rows[1], *o2 = rows[2], *o3 = rows[3], *o4 = rows[4], *o5 = rows[5], *o6 = rows[6],
               *o7 = rows[7];
         const float kc = gp.twistC, ks = gp.twistS;
@@ -89,28 +93,41 @@ template <bool Own>
                 o6[j] = D.z();
             }
         }
-        // Rows to one record of 8 floats per slot.
-        float* out = c.pairRecords.data() + p * P * FollowerClass::kRecord;
+        // Rows to one PairRecord per slot: row i is the record's float i
+        // (θ, terms 0-5, d_v), written 8 slots at a time by a transpose.
+        PairRecord* out = c.pairRecords.data() + p * P;
         for (size_t j = 0; j < P; j += 8) {
             f8 r0 = load(rows[0] + j), r1 = load(rows[1] + j), r2 = load(rows[2] + j), r3 = load(rows[3] + j);
             f8 r4 = load(rows[4] + j), r5 = load(rows[5] + j), r6 = load(rows[6] + j), r7 = load(rows[7] + j);
             transpose8(r0, r1, r2, r3, r4, r5, r6, r7);
             const f8 r[8] = {r0, r1, r2, r3, r4, r5, r6, r7};
-            for (int k = 0; k < 8; ++k) store(out + (j + k) * FollowerClass::kRecord, r[k]);
+            for (int k = 0; k < 8; ++k) store(&out[j + k].theta, r[k]);
         }
     }
 }
 
+/// A guide's vertex velocity rows (x, y, z) in a class's cold table.
+struct VelocityRows {
+    const float* row[3];
+    VelocityRows(const FollowerClass& c, uint32_t guide)
+        : row{c.cold.row(guide, ColdRow::VelocityX), c.cold.row(guide, ColdRow::VelocityY),
+              c.cold.row(guide, ColdRow::VelocityZ)} {}
+};
+
 /// Follow the leader for lane k of a packet (positions pos[3v + c], lanes =
 /// followers): a vertex the bound cannot clear is queried; one inside is
-/// projected out keeping its segment's length, and every later vertex moves
-/// by the same shift, so segment directions are kept elsewhere.
+/// projected out keeping its segment's length (slid along the surface, or
+/// where that fails bent or pinned: follower_pinch.h), and every later vertex
+/// moves by the same shift, so segment directions are kept elsewhere. `last`:
+/// the lane's vertices in the previous frame (null when there is none).
 /// `cleared[v]` is the vector pass's bound test of the unshifted vertex,
 /// valid until the first projection (and `uncleared`, bit v, the same for
 /// vertices 1..31); after it shifted vertices are tested again.
-void collideLane(const StepContext& ctx, const FollowerClass& c, const float* g1, const i8* cleared,
-                 uint32_t uncleared, int k, const float* ownRest, float segmentLength, f8* pos, Counters& counters) {
-    const size_t P = c.pad;
+void collideLane(const StepContext& ctx, const FollowerClass& c, uint32_t guide1, const i8* cleared,
+                 uint32_t uncleared, int k, const OwnRestSlot* ownRest, float segmentLength, const Vec3f* last, f8* pos,
+                 Counters& counters) {
+    const float *gX = c.cold.row(guide1, ColdRow::X), *gY = c.cold.row(guide1, ColdRow::Y),
+                *gZ = c.cold.row(guide1, ColdRow::Z), *bound = c.cold.row(guide1, ColdRow::Bound);
     float sx = 0.f, sy = 0.f, sz = 0.f;
     bool shifted = false;
     // Vertex v at q: queried without the normal (most queried vertices are
@@ -124,10 +141,19 @@ void collideLane(const StepContext& ctx, const FollowerClass& c, const float* g1
         const Vec3f previous(pos[3 * v - 3][k], pos[3 * v - 2][k], pos[3 * v - 1][k]);
         float length = segmentLength;
         if (ownRest) {
-            const float* r = ownRest + size_t(v) * 3 * kLanes + k;
-            length = std::sqrt(r[0] * r[0] + r[kLanes] * r[kLanes] + r[2 * kLanes] * r[2 * kLanes]);
+            const OwnRestSlot& r = ownRest[v];
+            length = std::sqrt(r.x[k] * r.x[k] + r.y[k] * r.y[k] + r.z[k] * r.z[k]);
         }
-        const float after = projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p);
+        const Vec3f wanted = p;
+        float after = projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p);
+        if (after < 0.f) {
+            // The slide could not bring it out: bend, else pin (follower_pinch.h).
+            const PinchPlace place = placePinched(*ctx.collider, previous, length, c.radii[v], wanted,
+                                                  last ? last + v : nullptr);
+            p = place.position;
+            after = place.distance;
+            ++(place.pinned ? counters.pinned : counters.bent);
+        }
         if (after < 0.f) {
             ++counters.inside;
             counters.maxDepth = std::max(counters.maxDepth, -after);
@@ -156,8 +182,8 @@ void collideLane(const StepContext& ctx, const FollowerClass& c, const float* g1
         if (!shifted && cleared[v][k]) continue;
         float &px = pos[3 * v][k], &py = pos[3 * v + 1][k], &pz = pos[3 * v + 2][k];
         const float qx = px + sx, qy = py + sy, qz = pz + sz;
-        const float gx = qx - g1[v], gy = qy - g1[P + v], gz = qz - g1[2 * P + v];
-        if (!shifted || !(gx * gx + gy * gy + gz * gz < g1[3 * P + v])) query(v, qx, qy, qz);
+        const float gx = qx - gX[v], gy = qy - gY[v], gz = qz - gZ[v];
+        if (!shifted || !(gx * gx + gy * gy + gz * gz < bound[v])) query(v, qx, qy, qz);
         if (shifted) {
             px += sx;
             py += sy;
@@ -172,24 +198,24 @@ template <FollowerMode M, bool Own>
     const FollowerClass& c = im.classes[pk.cls];
     const size_t P = c.pad;
     const uint32_t S = c.segments;
-    const float* ownRest = Own ? im.ownRestData.data() + pk.own : nullptr;
-    const float* guideRec[kLanes];
-    const float* pairRec[kLanes];
+    const OwnRestSlot* ownRest = Own ? im.ownRest.data() + pk.own : nullptr;
+    const GuideRecord* guideRec[kLanes];
+    const PairRecord* pairRec[kLanes];
     for (int k = 0; k < kLanes; ++k) {
-        guideRec[k] = c.guideRecords.data() + size_t(pk.guide1[k]) * P * FollowerClass::kRecord;
-        pairRec[k] = c.pairRecords.data() + size_t(pk.pair[k]) * P * FollowerClass::kRecord;
+        guideRec[k] = c.guideRecord(pk.guide1[k]);
+        pairRec[k] = c.pairRecord(pk.pair[k]);
     }
     // Barycentric: guides 2 and 3 of each lane, their weights and twists.
     constexpr bool kTri = M == FollowerMode::Barycentric;
     static_assert(!kTri || Own, "barycentric followers read their own rest shapes");
     const TrianglePacket* tp = kTri ? &im.triangles[size_t(&pk - im.packets.data())] : nullptr;
-    const float* guide2Rec[kLanes];
-    const float* guide3Rec[kLanes];
+    const GuideRecord* guide2Rec[kLanes];
+    const GuideRecord* guide3Rec[kLanes];
     f8 b1{}, b2{}, b3{}, k2c{}, k2s{}, k3c{}, k3s{};
     if constexpr (kTri) {
         for (int k = 0; k < kLanes; ++k) {
-            guide2Rec[k] = c.guideRecords.data() + size_t(tp->guide2[k]) * P * FollowerClass::kRecord;
-            guide3Rec[k] = c.guideRecords.data() + size_t(tp->guide3[k]) * P * FollowerClass::kRecord;
+            guide2Rec[k] = c.guideRecord(tp->guide2[k]);
+            guide3Rec[k] = c.guideRecord(tp->guide3[k]);
         }
         b1 = load(tp->b1), b2 = load(tp->b2), b3 = load(tp->b3);
         k2c = load(tp->k2c), k2s = load(tp->k2s), k3c = load(tp->k3c), k3s = load(tp->k3s);
@@ -251,9 +277,9 @@ template <FollowerMode M, bool Own>
         if constexpr (M != FollowerMode::Cluster && !kTri) {
             // The lanes' pair records (θ, ..., d_v), the slerp weight t
             // (Algorithm 1: d_r = fixedOffset d_f + rand_xy d_v), sin and cos of φ = tθ.
-            for (int k = 0; k < kLanes; ++k) lane[k] = pairRec[k] + 8 * j;
+            for (int k = 0; k < kLanes; ++k) lane[k] = pairRec[k][j].arcAndTerms();
             transpose8x4(lane, theta, e1, e2, e3);
-            for (int k = 0; k < kLanes; ++k) lane[k] += 4;
+            for (int k = 0; k < kLanes; ++k) lane[k] = pairRec[k][j].lastTermsAndSpeed();
             transpose8x4(lane, e4, e5, e6, dv);
             if constexpr (M == FollowerMode::Interpolate) {
                 t = weight;
@@ -265,7 +291,7 @@ template <FollowerMode M, bool Own>
         }
         weights[j] = t;
         f8 l0, l1, l2, l3;  // the guide record's lead: A or q
-        for (int k = 0; k < kLanes; ++k) lane[k] = guideRec[k] + 8 * j;
+        for (int k = 0; k < kLanes; ++k) lane[k] = guideRec[k][j].lead;
         transpose8x4(lane, l0, l1, l2, l3);
         f8 vx = l0, vy = l1, vz = l2;
         if constexpr (!Own) {  // (2): A + s² (B - A) + cs D
@@ -279,9 +305,9 @@ template <FollowerMode M, bool Own>
             // q = normalize(b1 q1 + b2 ±K2 q2 K2⁻¹ + b3 ±K3 q3 K3⁻¹): K turns the
             // vector part about y (x' = c x + s z, z' = -s x + c z); each sign
             // puts the quaternion on q1's side (q and -q are one rotation).
-            auto corner = [&](const float* const* rec, f8 kc, f8 ks, f8 b, f8& ow, f8& ox, f8& oy, f8& oz) {
+            auto corner = [&](const GuideRecord* const* rec, f8 kc, f8 ks, f8 b, f8& ow, f8& ox, f8& oy, f8& oz) {
                 f8 m0, m1, m2, m3;
-                for (int k = 0; k < kLanes; ++k) lane[k] = rec[k] + 8 * j;
+                for (int k = 0; k < kLanes; ++k) lane[k] = rec[k][j].lead;
                 transpose8x4(lane, m0, m1, m2, m3);
                 const f8 x2 = kc * m1 + ks * m3, z2 = kc * m3 - ks * m1;
                 const f8 dot = l0 * m0 + l1 * x2 + l2 * m2 + l3 * z2;
@@ -295,12 +321,12 @@ template <FollowerMode M, bool Own>
             corner(guide2Rec, k2c, k2s, b2, qw, qx, qy, qz);
             corner(guide3Rec, k3c, k3s, b3, qw, qx, qy, qz);
             const f8 inv = splat(1.f) / sqrt8(qw * qw + qx * qx + qy * qy + qz * qz);
-            const float* f = ownRest + size_t(j) * 3 * kLanes;
-            rotate(qw * inv, qx * inv, qy * inv, qz * inv, load(f), load(f + kLanes), load(f + 2 * kLanes), vx, vy, vz);
+            const OwnRestSlot& f = ownRest[j];
+            rotate(qw * inv, qx * inv, qy * inv, qz * inv, load(f.x), load(f.y), load(f.z), vx, vy, vz);
         } else {  // (1): q = cos φ a + sin φ e, then q f q* of the lane's own rest segment
             const f8 qw = co * l0 + s * e1, qx = co * l1 + s * e2, qy = co * l2 + s * e3, qz = co * l3 + s * e4;
-            const float* f = ownRest + size_t(j) * 3 * kLanes;
-            rotate(qw, qx, qy, qz, load(f), load(f + kLanes), load(f + 2 * kLanes), vx, vy, vz);
+            const OwnRestSlot& f = ownRest[j];
+            rotate(qw, qx, qy, qz, load(f.x), load(f.y), load(f.z), vx, vy, vz);
         }
         pos[3 * j] = vx;
         pos[3 * j + 1] = vy;
@@ -316,7 +342,7 @@ template <FollowerMode M, bool Own>
         pos[3 * j + 2] = z;
         if (ctx.collider) {
             f8 gx, gy, gz, bound;  // the guide record's vertex and bound
-            for (int k = 0; k < kLanes; ++k) lane[k] = guideRec[k] + 8 * j + 4;
+            for (int k = 0; k < kLanes; ++k) lane[k] = guideRec[k][j].vertexAndBound();
             transpose8x4(lane, gx, gy, gz, bound);
             const f8 dx = x - gx, dy = y - gy, dz = z - gz;
             cleared[j] = dx * dx + dy * dy + dz * dz < bound;
@@ -331,8 +357,9 @@ template <FollowerMode M, bool Own>
         std::memcpy(clear, &outside, sizeof clear);
         for (uint32_t k = 0; k < pk.count; ++k)
             if (!clear[k]) {
-                const float* g1 = c.cold.data() + size_t(pk.guide1[k]) * FollowerClass::kCold * P;
-                collideLane(ctx, c, g1, cleared, uncleared[k], int(k), ownRest, pk.scale[k], pos, counters);
+                // The lane's previous output, where a pinned vertex is held (still in `positions` until written below).
+                const Vec3f* last = ctx.difference ? ctx.positions + pk.vertexOffset[k] : nullptr;
+                collideLane(ctx, c, pk.guide1[k], cleared, uncleared[k], int(k), ownRest, pk.scale[k], last, pos, counters);
             }
     }
 
@@ -386,24 +413,21 @@ template <FollowerMode M, bool Own>
     if (!ctx.difference && kTri) {
         // No previous positions: the barycentric blend of the three guides' vertex velocities.
         for (uint32_t k = 0; k < pk.count; ++k) {
-            const float* g[3] = {c.cold.data() + size_t(pk.guide1[k]) * FollowerClass::kCold * P,
-                                 c.cold.data() + size_t(tp->guide2[k]) * FollowerClass::kCold * P,
-                                 c.cold.data() + size_t(tp->guide3[k]) * FollowerClass::kCold * P};
+            const VelocityRows g[3] = {{c, pk.guide1[k]}, {c, tp->guide2[k]}, {c, tp->guide3[k]}};
             const float b[3] = {tp->b1[k], tp->b2[k], tp->b3[k]};
             float* vel = outVel[k];
             for (uint32_t v = 0; v <= S; ++v)
                 for (int i = 0; i < 3; ++i)
-                    vel[3 * v + i] = b[0] * g[0][(4 + i) * P + v] + b[1] * g[1][(4 + i) * P + v] + b[2] * g[2][(4 + i) * P + v];
+                    vel[3 * v + i] = b[0] * g[0].row[i][v] + b[1] * g[1].row[i][v] + b[2] * g[2].row[i][v];
         }
     } else if (!ctx.difference) {
         // No previous positions: the slerp-weighted blend of the guides' vertex velocities.
         for (uint32_t k = 0; k < pk.count; ++k) {
-            const float* g1 = c.cold.data() + size_t(pk.guide1[k]) * FollowerClass::kCold * P;
-            const float* g2 = c.cold.data() + size_t(c.pairs[pk.pair[k]].guide2) * FollowerClass::kCold * P;
+            const VelocityRows g1{c, pk.guide1[k]}, g2{c, c.pairs[pk.pair[k]].guide2};
             float* vel = outVel[k];
             for (uint32_t v = 0; v <= S; ++v) {
                 const float b = weights[v > 0 ? v : 1][k];
-                for (int i = 0; i < 3; ++i) vel[3 * v + i] = (1.f - b) * g1[(4 + i) * P + v] + b * g2[(4 + i) * P + v];
+                for (int i = 0; i < 3; ++i) vel[3 * v + i] = (1.f - b) * g1.row[i][v] + b * g2.row[i][v];
             }
         }
     }
@@ -417,7 +441,7 @@ template <FollowerMode M, bool Own>
 
 [[gnu::target_clones("arch=x86-64-v3", "default")]] void processRange(const StepContext& ctx, size_t begin,
                                                                       size_t end, Counters& counters) {
-    const bool own = !ctx.im->ownRestData.empty();
+    const bool own = !ctx.im->ownRest.empty();
     switch (ctx.im->settings.mode) {
         case FollowerMode::Cluster:
             return own ? processRangeT<FollowerMode::Cluster, true>(ctx, begin, end, counters)
@@ -435,7 +459,7 @@ template <FollowerMode M, bool Own>
 
 [[gnu::target_clones("arch=x86-64-v3", "default")]] void pairRange(const Impl& im, FollowerClass& c, size_t begin,
                                                                    size_t end) {
-    if (im.ownRestData.empty()) buildPairRecords<false>(im, c, begin, end);
+    if (im.ownRest.empty()) buildPairRecords<false>(im, c, begin, end);
     else buildPairRecords<true>(im, c, begin, end);
 }
 

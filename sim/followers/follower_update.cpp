@@ -76,41 +76,52 @@ void fillGuide(Impl& im, const FollowerStep& step, const Collider* collider, siz
         const size_t P = c.pad;
         const uint32_t S = c.segments;
         const bool same = S == gs;  // the usual case: no resampling
-        float* row = c.hot.data() + g * FollowerClass::kHot * P;
+        float* rotation[4] = {c.hot.row(g, HotRow::RotationW), c.hot.row(g, HotRow::RotationX),
+                              c.hot.row(g, HotRow::RotationY), c.hot.row(g, HotRow::RotationZ)};
+        float* rowSpeed = c.hot.row(g, HotRow::Speed);
         for (uint32_t j = 1; j <= S; ++j) {
             const uint32_t s = same ? j - 1 : FollowerClass::guideSegment(j - 1, S, gs);
-            for (int k = 0; k < 4; ++k) row[k * P + j] = q[s][k];
-            row[4 * P + j] = speed[s];
+            for (int k = 0; k < 4; ++k) rotation[k][j] = q[s][k];
+            rowSpeed[j] = speed[s];
         }
-        float* cold = c.cold.data() + g * FollowerClass::kCold * P;
+        const float *restX = c.hot.row(g, HotRow::RestX), *restY = c.hot.row(g, HotRow::RestY),
+                    *restZ = c.hot.row(g, HotRow::RestZ);
+        float *vx = c.cold.row(g, ColdRow::X), *vy = c.cold.row(g, ColdRow::Y), *vz = c.cold.row(g, ColdRow::Z);
+        float* bound = c.cold.row(g, ColdRow::Bound);
+        float *ux = c.cold.row(g, ColdRow::VelocityX), *uy = c.cold.row(g, ColdRow::VelocityY),
+              *uz = c.cold.row(g, ColdRow::VelocityZ);
+        GuideRecord* records = c.guideRecords.data() + g * P;
         for (uint32_t j = 0; j < P; ++j) {
             const uint32_t gv = j == 0 || same ? std::min(j, gs) : FollowerClass::guideSegment(std::min(j, S) - 1, S, gs) + 1;
             const bool vertex = j >= 1 && j <= S;  // the root and the padding are never tested
-            cold[j] = x[gv].x();
-            cold[P + j] = x[gv].y();
-            cold[2 * P + j] = x[gv].z();
-            cold[3 * P + j] = vertex ? follower::collisionBound(clearance[gv], c.radii[0]) : inf;
-            cold[4 * P + j] = v ? v[gv].x() : 0.f;
-            cold[5 * P + j] = v ? v[gv].y() : 0.f;
-            cold[6 * P + j] = v ? v[gv].z() : 0.f;
+            vx[j] = x[gv].x();
+            vy[j] = x[gv].y();
+            vz[j] = x[gv].z();
+            bound[j] = vertex ? follower::collisionBound(clearance[gv], c.radii[0]) : inf;
+            ux[j] = v ? v[gv].x() : 0.f;
+            uy[j] = v ? v[gv].y() : 0.f;
+            uz[j] = v ? v[gv].z() : 0.f;
             // The record followers led by this guide read per slot: A = q r q*
             // (the rest direction turned; followers with own rest shapes take
             // q itself), then the vertex and its bound.
-            float* rec = c.guideRecords.data() + (g * P + j) * FollowerClass::kRecord;
-            const follower::Quat qj{row[j], row[P + j], row[2 * P + j], row[3 * P + j]};
-            if (im.ownRestData.empty()) {
-                const Vec3f a = follower::sandwich(qj, Vec3f(row[5 * P + j], row[6 * P + j], row[7 * P + j]));
-                rec[0] = a.x();
-                rec[1] = a.y();
-                rec[2] = a.z();
-                rec[3] = 0.f;
+            GuideRecord& rec = records[j];
+            const follower::Quat qj{rotation[0][j], rotation[1][j], rotation[2][j], rotation[3][j]};
+            if (im.ownRest.empty()) {
+                const Vec3f a = follower::sandwich(qj, Vec3f(restX[j], restY[j], restZ[j]));
+                rec.lead[0] = a.x();
+                rec.lead[1] = a.y();
+                rec.lead[2] = a.z();
+                rec.lead[3] = 0.f;
             } else {
-                rec[0] = qj.w;
-                rec[1] = qj.x;
-                rec[2] = qj.y;
-                rec[3] = qj.z;
+                rec.lead[0] = qj.w;
+                rec.lead[1] = qj.x;
+                rec.lead[2] = qj.y;
+                rec.lead[3] = qj.z;
             }
-            for (int k = 0; k < 4; ++k) rec[4 + k] = cold[k * P + j];
+            rec.vertex[0] = vx[j];
+            rec.vertex[1] = vy[j];
+            rec.vertex[2] = vz[j];
+            rec.bound = bound[j];
         }
     }
 }
@@ -194,7 +205,7 @@ FollowerStats Followers::update(const FollowerStep& step, StrandFrame& out) {
     follower::StepContext ctx{&im, step.followerRoots.data(), collider, out.positions.data() + guideVertices,
                               out.velocities.data() + guideVertices, stats.differenceVelocities,
                               step.dt > 0.0 ? float(1.0 / step.dt) : 0.f};
-    std::atomic<size_t> projected{0}, queries{0}, inside{0};
+    std::atomic<size_t> projected{0}, queries{0}, inside{0}, bent{0}, pinned{0};
     std::atomic<uint32_t> depthBits{0};  // a non-negative float's bits order like the float
     auto packetsLoop = [&](const tbb::blocked_range<size_t>& r) {
         follower::Counters counters;
@@ -202,6 +213,8 @@ FollowerStats Followers::update(const FollowerStep& step, StrandFrame& out) {
         projected += counters.projected;
         queries += counters.queries;
         inside += counters.inside;
+        bent += counters.bent;
+        pinned += counters.pinned;
         uint32_t bits;
         std::memcpy(&bits, &counters.maxDepth, sizeof bits);
         uint32_t seen = depthBits.load();
@@ -224,6 +237,8 @@ FollowerStats Followers::update(const FollowerStep& step, StrandFrame& out) {
     stats.projected = projected;
     stats.collisionQueries = queries;
     stats.penetrationCount = inside;
+    stats.bent = bent;
+    stats.pinned = pinned;
     const uint32_t bits = depthBits.load();
     std::memcpy(&stats.maxPenetration, &bits, sizeof bits);
     im.lastPositions = out.positions.data();
@@ -261,7 +276,6 @@ Followers::LengthError Followers::lengthError(const StrandFrame& out) const {
         !sameRange(out.offsets, G, im.vertexOffset, 0, F + 1, out.offsets[G]))
         throw Error("followers: the frame to measure does not have this groom's follower layout");
     const Vec3f* base = out.positions.data() + out.offsets[G];
-    constexpr int L = FollowerPacket::kLanes;
     // Per packet, then summed in packet order: the same result on any thread count.
     std::vector<double> sums(im.packets.size()), maxima(im.packets.size());
     std::vector<size_t> counts(im.packets.size());
@@ -274,9 +288,9 @@ Followers::LengthError Followers::lengthError(const StrandFrame& out) const {
                 const Vec3f* p = base + pk.vertexOffset[k];
                 for (uint32_t j = 1; j <= c.segments; ++j) {
                     double rest = pk.scale[k];
-                    if (!im.ownRestData.empty()) {
-                        const float* o = im.ownRestData.data() + pk.own + size_t(j) * 3 * L + k;
-                        rest = std::sqrt(double(o[0]) * o[0] + double(o[L]) * o[L] + double(o[2 * L]) * o[2 * L]);
+                    if (!im.ownRest.empty()) {
+                        const OwnRestSlot& o = im.ownRest[pk.own + j];
+                        rest = std::sqrt(double(o.x[k]) * o.x[k] + double(o.y[k]) * o.y[k] + double(o.z[k]) * o.z[k]);
                     }
                     const double e = std::abs((p[j] - p[j - 1]).cast<double>().norm() / rest - 1.0);
                     sum += e;

@@ -89,9 +89,9 @@ T perFollower(const std::vector<T>& values, size_t i) { return values.size() == 
 /// Cuts each class's followers, in index order, into packets of 8; fills
 /// the lanes' fields and own rest segments. Unused lanes of a class's last
 /// packet repeat its last follower.
-void buildPackets(Followers::Impl& im, const std::vector<size_t>& ownStart, const std::vector<float>& ownRows) {
+void buildPackets(Followers::Impl& im, const std::vector<size_t>& ownStart, const std::vector<Vec3f>& ownSegments) {
     constexpr int L = FollowerPacket::kLanes;
-    const bool own = !ownRows.empty();
+    const bool own = !ownSegments.empty();
     size_t ownTotal = 0;
     for (uint32_t cls = 0; cls < im.classes.size(); ++cls) {
         std::vector<uint32_t> members;
@@ -117,12 +117,16 @@ void buildPackets(Followers::Impl& im, const std::vector<size_t>& ownStart, cons
                 pk.hash[k] = follower::followerHash(im.settings.seed, f);
             }
             if (own) {
-                im.ownRestData.resize(ownTotal + size_t(P) * 3 * L);
+                im.ownRest.resize(ownTotal + P);
                 for (int k = 0; k < L; ++k)
-                    for (uint32_t j = 0; j < P; ++j)
-                        for (int c = 0; c < 3; ++c)
-                            im.ownRestData[ownTotal + (size_t(j) * 3 + c) * L + k] = ownRows[ownStart[pk.follower[k]] + c * P + j];
-                ownTotal += size_t(P) * 3 * L;
+                    for (uint32_t j = 0; j < P; ++j) {
+                        const Vec3f& r = ownSegments[ownStart[pk.follower[k]] + j];
+                        OwnRestSlot& slot = im.ownRest[ownTotal + j];
+                        slot.x[k] = r.x();
+                        slot.y[k] = r.y();
+                        slot.z[k] = r.z();
+                    }
+                ownTotal += P;
                 if (ownTotal > 0xffffffffu) throw Error("followers: too many follower rest vertices");
             }
             im.packets.push_back(pk);
@@ -294,20 +298,21 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
     }
     for (FollowerClass& c : im.classes) {
         const uint32_t P = c.pad;
-        c.hot.assign(G * FollowerClass::kHot * P, 0.f);
-        c.cold.assign(G * FollowerClass::kCold * P, 0.f);
+        c.hot.assign(G, P);
+        c.cold.assign(G, P);
         for (size_t g = 0; g < G; ++g) {
             // Identity rotations and zero rest directions at the root slot and
             // in the padding: those slots add nothing to the positions.
-            float* row = c.hot.data() + g * FollowerClass::kHot * P;
+            float* w = c.hot.row(g, HotRow::RotationW);
+            float *rx = c.hot.row(g, HotRow::RestX), *ry = c.hot.row(g, HotRow::RestY), *rz = c.hot.row(g, HotRow::RestZ);
             const uint32_t gs = im.guideSegmentOffsets[g + 1] - im.guideSegmentOffsets[g];
             for (uint32_t j = 0; j < P; ++j) {
-                row[0 * P + j] = 1.f;
+                w[j] = 1.f;
                 if (j < 1 || j > c.segments) continue;
                 const Vec3f r = im.guideRestDirs[im.guideSegmentOffsets[g] + FollowerClass::guideSegment(j - 1, c.segments, gs)];
-                row[5 * P + j] = r.x();
-                row[6 * P + j] = r.y();
-                row[7 * P + j] = r.z();
+                rx[j] = r.x();
+                ry[j] = r.y();
+                rz[j] = r.z();
             }
         }
         c.weightedCurve.assign(P, 0.f);
@@ -333,13 +338,13 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
     im.vertexOffset.resize(F + 1);
     im.vertexOffset[0] = 0;
     for (size_t f = 0; f < F; ++f) im.vertexOffset[f + 1] = im.vertexOffset[f] + followerSegments(f) + 1;
-    // Own rest segments per follower (3 rows of P slots), moved into the
-    // packets' lane layout once those are formed.
+    // Own rest segments per follower (P slots from ownStart[f]), moved into
+    // the packets' lane layout (OwnRestSlot) once those are formed.
     std::vector<size_t> ownStart(own ? F + 1 : 0);
-    std::vector<float> ownRows;
+    std::vector<Vec3f> ownSegments;
     if (own) {
-        for (size_t f = 0; f < F; ++f) ownStart[f + 1] = ownStart[f] + 3 * size_t(im.classes[im.classOf[f]].pad);
-        ownRows.assign(ownStart[F], 0.f);
+        for (size_t f = 0; f < F; ++f) ownStart[f + 1] = ownStart[f] + size_t(im.classes[im.classOf[f]].pad);
+        ownSegments.assign(ownStart[F], Vec3f::Zero());
     }
 
     // Mean squared difference of unit rest directions, `b` carried into `a`'s
@@ -423,17 +428,16 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
             im.alignC[f] = float(std::cos(phiF));
             im.alignS[f] = float(std::sin(phiF));
 
-            const FollowerClass& c = im.classes[im.classOf[f]];
             if (own) {
                 // Rest segments (direction × length) in the effective frame:
                 // f' = R_y(φ)ᵀ f, slot y + 1 for segment y.
-                float* out = ownRows.data() + ownStart[f];
+                Vec3f* out = ownSegments.data() + ownStart[f];
                 const uint32_t a = shapes.offsets[f];
                 for (uint32_t y = 0; y < segs; ++y) {
                     const Vec3d d = (shapes.points[a + y + 1] - shapes.points[a + y]).cast<double>();
                     const double len = d.norm();
                     const Vec3d r = len * rotateY(-phiF, d / len);
-                    for (int i = 0; i < 3; ++i) out[i * c.pad + y + 1] = float(r[i]);
+                    out[y + 1] = r.cast<float>();
                 }
             } else {
                 im.segmentLength[f] = perFollower(groom.followerLengths, f) / float(segs);
@@ -459,14 +463,14 @@ Followers::Followers(const FollowerGroom& groom, const FollowerSettings& setting
             im.pairOf[f] = it->second;
         }
         for (FollowerClass& c : im.classes) {
-            c.pairRecords.assign(c.pairs.size() * c.pad * FollowerClass::kRecord, 0.f);
-            c.guideRecords.assign(G * c.pad * FollowerClass::kRecord, 0.f);
+            c.pairRecords.assign(c.pairs.size() * c.pad, PairRecord{});
+            c.guideRecords.assign(G * c.pad, GuideRecord{});
         }
     }
 
     im.ids.resize(F);
     for (size_t f = 0; f < F; ++f) im.ids[f] = groom.followerIds.empty() ? uint32_t(G + f) : groom.followerIds[f];
-    buildPackets(im, ownStart, ownRows);
+    buildPackets(im, ownStart, ownSegments);
     if (tri) {
         // K of guides 2 and 3 into guide 1's frame, as for the pairs.
         im.triangles.resize(im.packets.size());

@@ -159,8 +159,15 @@ struct FollowerStep {
 
 struct FollowerStats {
     size_t projected = 0;         ///< follower vertices pushed out of the head
-    /// Projected vertices the segment could not bring out (signed distance
-    /// < 0 after projection): the segment keeps its length instead. Every
+    /// Projected vertices that sliding along the surface left inside, placed
+    /// outside by turning their segment about its parent (sim/followers/follower_pinch.h).
+    size_t bent = 0;
+    /// Projected vertices with no place outside at their segment length
+    /// (a pinch): held at their length toward their place in the previous
+    /// frame (sim/followers/follower_pinch.h). Lengths stay exact.
+    size_t pinned = 0;
+    /// Projected vertices left inside (signed distance < 0 after the slide,
+    /// the bend and the pin): the segment keeps its length instead. Every
     /// other follower vertex is outside (queried, or cleared by the bound).
     size_t penetrationCount = 0;
     float maxPenetration = 0.f;   ///< deepest of those, m

@@ -13,7 +13,9 @@
 // Usage: bench_followers [--quick] [--sizes 751,10000,...] [--steps N]
 //        [--modes varied,cluster,interpolate,barycentric] [--threads 1,2] [--no-collide]
 //        [--angle] [--length-variation X] [--clump X] [--clumps N]
-//        [--wave M] [--wave-length M] [--curl X] [--frizz M]
+//        [--wave M] [--wave-length M] [--curl X] [--frizz M] [--digest]
+// --digest adds a column: FNV-1a (64 bit) of the last step's positions and
+// velocities, to check that a change of the follower code keeps the bits.
 // --angle adds a column: the median angle between mid-strand tangents of
 // root-neighbouring followers (sim/followers/follower_metrics.h) after the last step;
 // the modifier options apply sim/strands/groom_modifiers.h to the groom first.
@@ -26,6 +28,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -80,7 +83,14 @@ struct Result {
     double cpu = 0;  ///< median CPU ms per step, all threads together
     double projected = 0, queries = 0;
     double angle = 0;  ///< median neighbour angle after the last step, degrees
+    uint64_t digest = 0;  ///< FNV-1a of the last step's positions and velocities
 };
+
+uint64_t fnv1a(const void* data, size_t bytes, uint64_t h = 1469598103934665603ull) {
+    const unsigned char* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
+    return h;
+}
 
 const char* modeName(FollowerMode m) {
     return m == FollowerMode::Varied ? "varied" : m == FollowerMode::Cluster ? "cluster"
@@ -125,6 +135,8 @@ Result measure(const GuideSource& src, FollowerMode mode, int threads, int steps
         }
         frame.validate();
         r.angle = medianNeighbourAngle(frame, frame.guideCount);
+        r.digest = fnv1a(frame.velocities.data(), frame.velocities.size() * sizeof(Vec3f),
+                         fnv1a(frame.positions.data(), frame.positions.size() * sizeof(Vec3f)));
     });
     std::sort(runs.begin(), runs.end());
     r.median = runs[1];
@@ -153,7 +165,7 @@ int main(int argc, char** argv) {
     std::vector<FollowerMode> modes = {FollowerMode::Varied, FollowerMode::Cluster, FollowerMode::Interpolate};
     std::vector<int> threads = {1, 2};
     int steps = 0;  // 0: by size
-    bool collide = true, angle = false;
+    bool collide = true, angle = false, digest = false;
     GroomModifiers modifiers;
     for (int a = 1; a < argc; ++a) {
         const std::string arg = argv[a];
@@ -179,6 +191,7 @@ int main(int argc, char** argv) {
         } else if (arg == "--threads") threads = parseList<int>(value(), [](const std::string& s) { return std::stoi(s); });
         else if (arg == "--no-collide") collide = false;
         else if (arg == "--angle") angle = true;
+        else if (arg == "--digest") digest = true;
         else if (arg == "--length-variation") modifiers.lengthVariation = std::stof(value());
         else if (arg == "--clump") modifiers.clump = std::stof(value());
         else if (arg == "--clumps") modifiers.clumps = uint32_t(std::stoul(value()));
@@ -197,9 +210,9 @@ int main(int argc, char** argv) {
         std::printf("# groom modifiers: length variation %g, clump %g (%u centres), wave %g m / %g m, curl %g, frizz %g m\n",
                     modifiers.lengthVariation, modifiers.clump, modifiers.clumps, modifiers.wave, modifiers.waveLength,
                     modifiers.curl, modifiers.frizz);
-    std::printf("| guides | followers | mode | threads | ms/step | spread | cpu ms/step | build ms | queries/step | projected/step |%s\n",
-                angle ? " neighbour angle deg |" : "");
-    std::printf("|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|%s\n", angle ? "---:|" : "");
+    std::printf("| guides | followers | mode | threads | ms/step | spread | cpu ms/step | build ms | queries/step | projected/step |%s%s\n",
+                angle ? " neighbour angle deg |" : "", digest ? " digest |" : "");
+    std::printf("|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|%s%s\n", angle ? "---:|" : "", digest ? "---|" : "");
     for (const Scene& sc : scenes) {
         const GuideSource src = makeSyntheticSource(sc.guides, sc.followers, modifiers);
         const int n = steps > 0 ? steps : sc.followers >= 400000 ? 5 : sc.followers >= 100000 ? 10 : 30;
@@ -210,6 +223,7 @@ int main(int argc, char** argv) {
                             sc.followers, modeName(mode), t, r.median, r.spread, r.cpu, r.buildMs, r.queries,
                             r.projected);
                 if (angle) std::printf(" %.2f |", r.angle);
+                if (digest) std::printf(" %016llx |", static_cast<unsigned long long>(r.digest));
                 std::printf("\n");
                 std::fflush(stdout);
             }

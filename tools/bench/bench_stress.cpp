@@ -9,7 +9,11 @@
 // frame, pinned vertices (the most in one frame; rod only: the rope pins
 // nothing) and NaN.
 //
-//   bench_stress [--scene scenes/stress.yaml] [--threads 2] [--set key=value ...]
+//   bench_stress [--scene scenes/stress.yaml] [--threads 2] [--set key=value ...] [--per-frame]
+//
+// --per-frame adds a line per frame: the deepest guide and follower vertex,
+// pinned guide vertices, and the followers' projected, bent, pinned and
+// left-inside vertices (FollowerStats).
 //
 // --colliders: B-sim head-only (docs/benchmarks.md: sphere r = 0.1 m spinning
 // 90°/s, 0.25 m guides of 24 vertices, 20 warm-up + 250 timed steps) with
@@ -61,7 +65,7 @@ std::vector<float> segmentLengths(const StrandFrame& f) {
     return out;
 }
 
-int stress(const std::string& path, const std::vector<std::string>& overrides) {
+int stress(const std::string& path, const std::vector<std::string>& overrides, bool perFrame) {
     const Scene scene = Scene::load(path, overrides);
     const std::vector<int>& frames = scene.frames("frames");
     const double fps = scene.number("fps");
@@ -73,7 +77,7 @@ int stress(const std::string& path, const std::vector<std::string>& overrides) {
     const size_t guides = sim.guideCount();
     double simSeconds = 0, guideWorst = 0, followerWorst = 0, depthWorst = 0;
     int guideFrame = 0, followerFrame = 0, depthFrame = 0, resets = 0;
-    size_t steps = 0, nan = 0, pinnedWorst = 0;
+    size_t steps = 0, nan = 0, pinnedWorst = 0, followerPinnedWorst = 0, followerBentWorst = 0;
     for (int frame : frames) {
         if (frame == frames.front()) continue;
         t = Clock::now();
@@ -82,6 +86,8 @@ int stress(const std::string& path, const std::vector<std::string>& overrides) {
         steps += sim.stats().guides.steps;
         resets += sim.stats().guides.reset ? 1 : 0;
         pinnedWorst = std::max(pinnedWorst, sim.stats().guides.pinnedCount);
+        followerPinnedWorst = std::max(followerPinnedWorst, sim.stats().followers.pinned);
+        followerBentWorst = std::max(followerBentWorst, sim.stats().followers.bent);
         const double g = worstStretch(f, rest, 0, guides), fo = worstStretch(f, rest, guides, f.strandCount());
         if (g > guideWorst) guideWorst = g, guideFrame = frame;
         if (fo > followerWorst) followerWorst = fo, followerFrame = frame;
@@ -98,12 +104,22 @@ int stress(const std::string& path, const std::vector<std::string>& overrides) {
         nan += bad;
         const float d = *std::max_element(depth.begin(), depth.end());
         if (d > depthWorst) depthWorst = d, depthFrame = frame;
+        if (perFrame) {
+            const SimFrameStats& st = sim.stats();
+            std::printf("frame %d: depth mm guides %.3f followers %.3f; guides pinned %zu; followers projected %zu, "
+                        "bent %zu, pinned %zu, left inside %zu (%.3f mm)\n",
+                        frame, 1e3 * *std::max_element(depth.begin(), depth.begin() + long(guides)),
+                        1e3 * *std::max_element(depth.begin() + long(guides), depth.end()), st.guides.pinnedCount,
+                        st.followerProjected, st.followers.bent, st.followers.pinned, st.followers.penetrationCount,
+                        1e3 * st.followers.maxPenetration);
+        }
     }
     std::printf("| steps/s | worst stretch guides (frame) | worst stretch followers (frame) | worst depth mm (frame) "
-                "| pinned (most in a frame) | NaN | cuts |\n|---:|---:|---:|---:|---:|---:|---:|\n");
-    std::printf("| %.1f | %.2e (%d) | %.2e (%d) | %.3f (%d) | %zu | %zu | %d |\n", double(steps) / simSeconds,
-                guideWorst, guideFrame, followerWorst, followerFrame, depthWorst * 1e3, depthFrame, pinnedWorst, nan,
-                resets);
+                "| pinned guides / followers (most in a frame) | followers bent (most in a frame) | NaN | cuts |\n"
+                "|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::printf("| %.1f | %.2e (%d) | %.2e (%d) | %.3f (%d) | %zu / %zu | %zu | %zu | %d |\n", double(steps) / simSeconds,
+                guideWorst, guideFrame, followerWorst, followerFrame, depthWorst * 1e3, depthFrame, pinnedWorst,
+                followerPinnedWorst, followerBentWorst, nan, resets);
     return 0;
 }
 
@@ -171,7 +187,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> overrides;
     std::vector<size_t> counts{94, 845};
     int threads = 2;
-    bool colliderMode = false;
+    bool colliderMode = false, perFrame = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string {
@@ -185,6 +201,7 @@ int main(int argc, char** argv) {
         else if (a == "--set") overrides.push_back(next());
         else if (a == "--threads") threads = std::stoi(next());
         else if (a == "--colliders") colliderMode = true;
+        else if (a == "--per-frame") perFrame = true;
         else if (a == "--guides") {
             counts.clear();
             const std::string list = next();
@@ -201,7 +218,7 @@ int main(int argc, char** argv) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     std::printf("threads: %d\n", threads);
     try {
-        return colliderMode ? colliders(counts) : stress(scenePath, overrides);
+        return colliderMode ? colliders(counts) : stress(scenePath, overrides, perFrame);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_stress: %s\n", e.what());
         return 1;
