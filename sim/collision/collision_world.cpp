@@ -98,10 +98,6 @@ struct PropShape {
     ~PropShape() { shape->getMeshPart(0)->unlockChildShapes(); }
 };
 
-}  // namespace
-
-namespace {
-
 /// A skinned mesh's tree: its own copy of the vertices, Bullet's view of
 /// them and a quantized BVH built once on the rest pose. Each pose copies
 /// its vertices in and refits the tree (btBvhTriangleMeshShape::refitTree:
@@ -177,6 +173,9 @@ struct Nearest final : btTriangleCallback {
     float square = -1.f;   ///< |n·(q - c)| / |q - c| of that triangle
     bool inside = false;
     btVector3 normal{0, 1, 0};
+    /// Only its stateless closest-point routine is used: one per query, not
+    /// per triangle (it is a large object to construct).
+    btVoronoiSimplexSolver solver;
 
     Nearest(const btVector3& point, float range) : q(point), distance(range) {}
 
@@ -186,7 +185,6 @@ struct Nearest final : btTriangleCallback {
         n.normalize();
         // Bullet's exact Voronoi-region closest point on a triangle (GJK
         // on a flat triangle stops ~10% short of it in float).
-        btVoronoiSimplexSolver solver;
         btSubSimplexClosestResult closest;
         solver.closestPtPointTriangle(q, t[0], t[1], t[2], closest);
         const btVector3 e = q - closest.m_closestPointOnSimplex;
@@ -207,30 +205,43 @@ struct Nearest final : btTriangleCallback {
     }
 };
 
+/// The nearest triangle within `range`, asking `visit(nearest, box
+/// half-width)` for the triangles in ever larger boxes about q: a box of
+/// half-width r holds every triangle within r, so the search stops at the
+/// first box whose nearest triangle is within its half-width. Hair lies
+/// within millimetres of a surface, where the first, small box holds a
+/// few triangles instead of the hundreds of the full range.
+template <typename Visit>
+float nearestTriangle(const btVector3& q, float range, btVector3& normal, Visit&& visit) {
+    for (float r = range / 16.f;; r = std::min(range, 4.f * r)) {
+        Nearest nearest(q, r);
+        visit(nearest, btVector3(r, r, r));
+        if (nearest.distance < r || r >= range) return nearest.result(normal);
+    }
+}
+
 /// A skinned mesh: its refitted BVH lists the triangles near q.
 float meshDistance(const btBvhTriangleMeshShape& mesh, const btVector3& q, float range, btVector3& normal) {
-    Nearest nearest(q, range);
-    const btVector3 r(range, range, range);
-    mesh.processAllTriangles(&nearest, q - r, q + r);
-    return nearest.result(normal);
+    return nearestTriangle(q, range, normal, [&](Nearest& nearest, const btVector3& r) {
+        mesh.processAllTriangles(&nearest, q - r, q + r);
+    });
 }
 
 /// A rigid prop: its GImpact box set lists the triangles near q.
 float meshDistance(const btGImpactMeshShape& mesh, const btVector3& q, float range, btVector3& normal) {
-    Nearest nearest(q, range);
-    const btVector3 r(range, range, range);
     const btGImpactMeshShapePart& part = *mesh.getMeshPart(0);
-    btAABB box;
-    box.m_min = q - r;
-    box.m_max = q + r;
-    btAlignedObjectArray<int> near;
-    part.getBoxSet()->boxQuery(box, near);
-    btPrimitiveTriangle t;
-    for (int k = 0; k < near.size(); ++k) {
-        part.getPrimitiveTriangle(near[k], t);
-        nearest.processTriangle(t.m_vertices, 0, near[k]);
-    }
-    return nearest.result(normal);
+    return nearestTriangle(q, range, normal, [&](Nearest& nearest, const btVector3& r) {
+        btAABB box;
+        box.m_min = q - r;
+        box.m_max = q + r;
+        btAlignedObjectArray<int> near;
+        part.getBoxSet()->boxQuery(box, near);
+        btPrimitiveTriangle t;
+        for (int k = 0; k < near.size(); ++k) {
+            part.getPrimitiveTriangle(near[k], t);
+            nearest.processTriangle(t.m_vertices, 0, near[k]);
+        }
+    });
 }
 
 /// A posed world: one collision object per shape, one broadphase.

@@ -24,7 +24,10 @@
 //   bench_sim [--guides 94,845] [--formulation rod,rope,rigid] [--strand-collision off,on]
 //             [--threads 1,2] [--runs 3] [--warmup 20] [--steps 250]
 //             [--substeps 1] [--iterations 20] [--rod-substeps 2] [--per-world 16] [--rate 90]
-//             [--preload on|off] [--collider sphere,grid,bullet,grid+box]
+//             [--preload on|off] [--collider sphere,grid,bullet,grid+box] [--range 0.05]
+//
+// --range: how far the Bullet mesh measures (the query range of
+// CollisionWorld::posed; beyond it a lower bound), metres.
 #include "sim/collision/collision_world.h"
 #include "sim/collision/level_set.h"
 #include "sim/collision/mesh_collider.h"
@@ -81,6 +84,9 @@ struct RunResult {
     GuideStats stats;
 };
 
+/// How far a Bullet mesh collider measures (beyond: a lower bound), m.
+float kRange = 0.05f;
+
 /// The head's collider at a pose, per --collider mode (see the file comment).
 class HeadColliders {
   public:
@@ -109,7 +115,7 @@ class HeadColliders {
 
     /// Replaces pose.collider (the analytic sphere) by this mode's.
     void apply(HeadPose& pose) const {
-        if (mode_ == "bullet") pose.collider = world_->posed({pose.transform});
+        if (mode_ == "bullet") pose.collider = world_->posed({pose.transform}, kRange);
         if (grid_) pose.collider = std::make_shared<LevelSetCollider>(grid_, pose.transform, exact_);
         if (mode_ == "grid+box")
             pose.collider = std::make_shared<CompositeCollider>(pose.collider, world_->posed({boxPlace_}));
@@ -188,6 +194,7 @@ int main(int argc, char** argv) {
         else if (a == "--rate") rate = std::stof(next());
         else if (a == "--preload") preload = next() != "off";
         else if (a == "--collider") colliderList = split(next());
+        else if (a == "--range") kRange = std::stof(next());
         else {
             std::fprintf(stderr, "bench_sim: unknown option %s\n", a.c_str());
             return 1;
