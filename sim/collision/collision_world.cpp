@@ -205,43 +205,101 @@ struct Nearest final : btTriangleCallback {
     }
 };
 
+/// Counts the triangles a ray from `from` along `dir` crosses (Möller and
+/// Trumbore's ray-triangle test): odd means `from` is inside a closed mesh.
+struct Crossings final : btTriangleCallback {
+    btVector3 from, dir;
+    int count = 0;
+    Crossings(const btVector3& f, const btVector3& d) : from(f), dir(d) {}
+    void processTriangle(btVector3* t, int, int) override {
+        const btVector3 e1 = t[1] - t[0], e2 = t[2] - t[0], p = dir.cross(e2);
+        const btScalar det = e1.dot(p);
+        if (std::abs(det) < 1e-12f) return;  // parallel to the ray
+        const btVector3 s = from - t[0];
+        const btScalar u = s.dot(p) / det;
+        if (u < 0 || u > 1) return;
+        const btVector3 qv = s.cross(e1);
+        const btScalar v = dir.dot(qv) / det;
+        if (v < 0 || u + v > 1) return;
+        count += e2.dot(qv) / det > 0;
+    }
+};
+
+/// A ray direction no mesh edge of ours lines up with (an axis would graze
+/// the seams of a mesh built on a grid).
+const btVector3 kRayDirection = btVector3(0.5377f, 0.6411f, -0.5476f).normalized();
+
 /// The nearest triangle within `range`, asking `visit(nearest, box
 /// half-width)` for the triangles in ever larger boxes about q: a box of
 /// half-width r holds every triangle within r, so the search stops at the
 /// first box whose nearest triangle is within its half-width. Hair lies
 /// within millimetres of a surface, where the first, small box holds a
-/// few triangles instead of the hundreds of the full range.
-template <typename Visit>
-float nearestTriangle(const btVector3& q, float range, btVector3& normal, Visit&& visit) {
-    for (float r = range / 16.f;; r = std::min(range, 4.f * r)) {
+/// few triangles instead of the hundreds of the full range. With none
+/// within range, q is clear unless `inside()` (ray parity) says it lies
+/// deep inside the mesh; then the boxes grow on until they find the way
+/// out, so a vertex pushed deep into a body still gets its exact depth.
+template <typename Visit, typename Inside>
+float nearestTriangle(const btVector3& q, float range, btVector3& normal, Visit&& visit, Inside&& inside) {
+    bool deep = false;
+    for (float r = range / 16.f;; r = deep ? 4.f * r : std::min(range, 4.f * r)) {
         Nearest nearest(q, r);
         visit(nearest, btVector3(r, r, r));
-        if (nearest.distance < r || r >= range) return nearest.result(normal);
+        if (nearest.distance < r || r > 1e3f) return nearest.result(normal);
+        if (r >= range && !deep) {
+            if (!inside()) return nearest.result(normal);
+            deep = true;
+        }
     }
+}
+
+/// The length of a ray from q that surely leaves a shape's local box.
+float rayLength(const btCollisionShape& shape, const btVector3& q) {
+    btVector3 lo, hi;
+    shape.getAabb(btTransform::getIdentity(), lo, hi);
+    return float((hi - lo).length() + 2 * (q - 0.5f * (lo + hi)).length()) + 1.f;
 }
 
 /// A skinned mesh: its refitted BVH lists the triangles near q.
 float meshDistance(const btBvhTriangleMeshShape& mesh, const btVector3& q, float range, btVector3& normal) {
-    return nearestTriangle(q, range, normal, [&](Nearest& nearest, const btVector3& r) {
-        mesh.processAllTriangles(&nearest, q - r, q + r);
-    });
+    return nearestTriangle(
+        q, range, normal,
+        [&](Nearest& nearest, const btVector3& r) { mesh.processAllTriangles(&nearest, q - r, q + r); },
+        [&] {
+            Crossings crossings(q, kRayDirection);
+            // A read-only walk of the tree, as processAllTriangles is.
+            const_cast<btBvhTriangleMeshShape&>(mesh).performRaycast(&crossings, q,
+                                                                     q + rayLength(mesh, q) * kRayDirection);
+            return crossings.count % 2 == 1;
+        });
 }
 
 /// A rigid prop: its GImpact box set lists the triangles near q.
 float meshDistance(const btGImpactMeshShape& mesh, const btVector3& q, float range, btVector3& normal) {
     const btGImpactMeshShapePart& part = *mesh.getMeshPart(0);
-    return nearestTriangle(q, range, normal, [&](Nearest& nearest, const btVector3& r) {
-        btAABB box;
-        box.m_min = q - r;
-        box.m_max = q + r;
-        btAlignedObjectArray<int> near;
-        part.getBoxSet()->boxQuery(box, near);
+    auto visitAll = [&](btTriangleCallback& callback, const btAlignedObjectArray<int>& near) {
         btPrimitiveTriangle t;
         for (int k = 0; k < near.size(); ++k) {
             part.getPrimitiveTriangle(near[k], t);
-            nearest.processTriangle(t.m_vertices, 0, near[k]);
+            callback.processTriangle(t.m_vertices, 0, near[k]);
         }
-    });
+    };
+    return nearestTriangle(
+        q, range, normal,
+        [&](Nearest& nearest, const btVector3& r) {
+            btAABB box;
+            box.m_min = q - r;
+            box.m_max = q + r;
+            btAlignedObjectArray<int> near;
+            part.getBoxSet()->boxQuery(box, near);
+            visitAll(nearest, near);
+        },
+        [&] {
+            Crossings crossings(q, kRayDirection);
+            btAlignedObjectArray<int> along;
+            part.getBoxSet()->rayQuery(kRayDirection, q, along);
+            visitAll(crossings, along);
+            return crossings.count % 2 == 1;
+        });
 }
 
 /// A posed world: one collision object per shape, one broadphase.

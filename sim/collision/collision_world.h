@@ -16,8 +16,9 @@
 // vertex and Bullet's Voronoi-region closest point
 // (btVoronoiSimplexSolver::closestPtPointTriangle) picks the nearest, whose face (by its winding) says
 // inside or outside. A vertex farther than the query range from every
-// triangle is taken as clear: a mesh collider sees only hair near its skin,
-// which is where projection keeps hair. The result is a Collider
+// triangle is clear (the range is returned, a lower bound) unless a ray
+// from it crosses the mesh an odd number of times: then it lies deep inside,
+// and the search goes on to its exact depth. The result is a Collider
 // (sim/strands/head.h), and CompositeCollider joins it to the head's own collider
 // (the distance-grid fast path), so every solver (rope, rigid, rod,
 // followers) collides with all of them unchanged; a head without extra
