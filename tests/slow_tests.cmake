@@ -26,6 +26,7 @@ set(_hp_slow_tests
   test_scene_cut:SceneCut.StressClipCutFrameHasNoVertexInsideAnyCollider  # exact collider per step
   test_collision_world:CollisionWorld.HairOnAShoulderBoxStaysOnIt  # 300 solver steps
   test_collision_world:CollisionWorld.PropColliderFromASecondFile  # head import + grid
+  test_collision_world:CollisionWorld.NonConvexPropKeepsItsHollowWhereAHullFillsIt  # 2 x 50 solver steps
   test_stress_clip:StressClip.NoStretchNorVertexDeeperThanAMillimetreAfterAnyFrameOnOneAndTwoThreads  # two 62-frame shots
   test_camera:CameraAuto.ProjectHeadAndHairStayInFrame         # 2 x 84 frames projected
   test_camera:CameraAuto.FoxStaysInFrame

@@ -33,6 +33,29 @@ ColliderShape box(const Vec3f& half) {
     return s;
 }
 
+/// A cup: a closed solid of revolution about +Y (outer radius R, inner
+/// radius Ri, height H, floor thickness B), wound outward, N sectors.
+ColliderShape cup(ColliderShape::Kind kind, float R, float Ri, float H, float B, int N) {
+    // The profile (r, y), traversed so that its normal faces out of the solid:
+    // bottom centre, out, up the outer wall, in across the rim, down the
+    // inner wall, in across the floor of the hollow.
+    const float profile[][2] = {{0, 0}, {R, 0}, {R, H}, {Ri, H}, {Ri, B}, {0, B}};
+    ColliderShape s;
+    s.kind = kind;
+    for (const auto& p : profile)
+        for (int j = 0; j < N; ++j) {
+            const float a = 2.f * float(M_PI) * float(j) / float(N);
+            s.points.emplace_back(p[0] * std::cos(a), p[1], p[0] * std::sin(a));
+        }
+    for (uint32_t k = 0; k + 1 < 6; ++k)
+        for (uint32_t j = 0; j < uint32_t(N); ++j) {
+            const uint32_t a = k * N + j, b = (k + 1) * N + j, c = (k + 1) * N + (j + 1) % N, d = k * N + (j + 1) % N;
+            s.triangles.push_back({a, b, c});
+            s.triangles.push_back({a, c, d});
+        }
+    return s;
+}
+
 }  // namespace
 
 TEST(CollisionWorld, SignedDistancesOfBulletPrimitivesMatchTheGeometry) {
@@ -154,11 +177,13 @@ TEST(CollisionWorld, PropColliderFromASecondFile) {
     Vec3f n;
     const HeadPose start = head.motion->sample(0.0);
     EXPECT_NEAR(start.collider->signedDistance({0.5f, 0.f, 0.f}, &n), -0.05f, 1e-4f) << "the cube's centre";
-    EXPECT_NEAR(start.collider->signedDistance({0.58f, 0.f, 0.f}, &n), 0.03f, 1e-4f);
+    EXPECT_NEAR(start.collider->signedDistance({0.556f, 0.f, 0.f}, &n), 0.006f, 1e-4f);
     EXPECT_GT(n.x(), 0.999f);
     const HeadPose later = head.motion->sample(1.0);  // frame 25: moved up 0.2 m
     EXPECT_NEAR(later.collider->signedDistance({0.5f, 0.2f, 0.f}), -0.05f, 1e-4f);
-    EXPECT_NEAR(later.collider->signedDistance({0.5f, 0.28f, 0.f}), 0.03f, 1e-4f);
+    EXPECT_NEAR(later.collider->signedDistance({0.5f, 0.256f, 0.f}), 0.006f, 1e-4f);
+    // Farther than the colliders' 1 cm range: a lower bound (the head's own grid does the same 6 mm out).
+    EXPECT_NEAR(later.collider->signedDistance({0.5f, 0.28f, 0.f}), 0.01f, 1e-6f);
     EXPECT_LT(later.collider->signedDistance({0.f, 0.f, 0.f}), 0.f) << "the head's own collider is still there";
 }
 
@@ -186,31 +211,120 @@ TEST(CollisionWorld, SkinnedBodyColliderFollowsItsSkin) {
     play.clip = 0;
     play.collider = ColliderMethod::None;
     const AnimatedHead body(rig, play);
-    const double t = 0.375;  // the first nod at its deepest: 20° down
-    TriangleMesh skin = body.sample(t).mesh;
-    skin.computeNormals();
     TriangleMesh rest = body.rest();
     rest.computeNormals();
-    const auto collider = head.motion->sample(t).collider;
-    // Reference: the exact closest-triangle distance of the deformed mesh
-    // (Embree BVH, angle-weighted pseudonormals; sim/collision/mesh_collider.h).
-    const MeshCollider exact(skin);
-    float worst = 0.f;
-    size_t moved = 0, checked = 0;
-    for (size_t v = 0; v < skin.positions.size(); v += 23) {
-        const Vec3f& p = skin.positions[v];
-        const Vec3f& n = skin.normals[v];
-        for (float offset : {0.003f, 0.001f, -0.001f, -0.002f}) {
-            const Vec3f q = p + offset * n;
-            worst = std::max(worst, std::abs(collider->signedDistance(q) - exact.signedDistance(q)));
+    // Each pose's skin refits a tree of its own (built once on the rest
+    // pose): two poses alive at once (the nod down, then up), then a third
+    // once they are gone, which refits a tree the others used.
+    auto check = [&](double t, const std::shared_ptr<const Collider>& collider) {
+        TriangleMesh skin = body.sample(t).mesh;
+        skin.computeNormals();
+        // Reference: the exact closest-triangle distance of the deformed mesh
+        // (Embree BVH, angle-weighted pseudonormals; sim/collision/mesh_collider.h).
+        const MeshCollider exact(skin);
+        float worst = 0.f;
+        size_t moved = 0, checked = 0, sides = 0;
+        for (size_t v = 0; v < skin.positions.size(); v += 23) {
+            const Vec3f& p = skin.positions[v];
+            const Vec3f& n = skin.normals[v];
+            for (float offset : {0.003f, 0.001f, -0.001f, -0.002f}) {
+                const Vec3f q = p + offset * n;
+                const float d = collider->signedDistance(q);
+                worst = std::max(worst, std::abs(d - exact.signedDistance(q)));
+                sides += (d > 0.f) == (offset > 0.f);  // just outside the moved skin is outside, just inside inside
+            }
+            // The same offset from the rest pose is off the skin where the nod moved it.
+            const Vec3f r = rest.positions[v] + 0.003f * rest.normals[v];
+            if (std::abs(collider->signedDistance(r) - exact.signedDistance(r)) < 1e-4f &&
+                std::abs(exact.signedDistance(r) - 0.003f) > 0.002f)
+                ++moved;
+            ++checked;
         }
-        // The same offset from the rest pose is off the skin where the nod moved it.
-        const Vec3f r = rest.positions[v] + 0.003f * rest.normals[v];
-        if (std::abs(collider->signedDistance(r) - exact.signedDistance(r)) < 1e-4f &&
-            std::abs(exact.signedDistance(r) - 0.003f) > 0.002f)
-            ++moved;
-        ++checked;
+        EXPECT_LE(worst, 1e-4f) << "t = " << t << ": within 3 mm of the deformed skin, inside and out, Bullet's "
+                                   "distance is the exact one";
+        EXPECT_EQ(sides, 4 * checked) << "t = " << t;
+        // Deep inside, beyond the 1 cm the colliders measure near a surface:
+        // ray parity says inside, and the search goes on to the exact depth.
+        const Vec3f centre = body.sample(t).transform * Vec3f(0.f, 0.02f, -0.01f);
+        EXPECT_LT(exact.signedDistance(centre), -0.05f) << "the skull's centre";
+        EXPECT_NEAR(collider->signedDistance(centre), exact.signedDistance(centre), 1e-4f) << "t = " << t;
+        EXPECT_GT(moved, checked / 4) << "t = " << t << ": the collider is the deformed mesh, not the rest mesh";
+    };
+    {
+        const auto down = head.motion->sample(0.375).collider;  // the first nod at its deepest: 20° down
+        const auto up = head.motion->sample(0.625).collider;    // and 20° up, while the first pose is alive
+        check(0.375, down);
+        check(0.625, up);
     }
-    EXPECT_LE(worst, 1e-4f) << "within 3 mm of the deformed skin, inside and out, Bullet's distance is the exact one";
-    EXPECT_GT(moved, checked / 4) << "the collider is the deformed mesh, not the rest mesh";
+    check(2.0, head.motion->sample(2.0).collider);  // mid-shake, on a refitted tree
+}
+
+// A cup (a non-convex prop) as a GImpact mesh keeps its hollow open; its
+// convex hull fills it. Distances against the cup's geometry computed here,
+// then limp hair hanging from a head above the cup: into the hollow with
+// the mesh, held on the rim's level by the hull.
+TEST(CollisionWorld, NonConvexPropKeepsItsHollowWhereAHullFillsIt) {
+    const float R = 0.08f, Ri = 0.07f, H = 0.15f, B = 0.01f;
+    const int N = 48;
+    const CollisionWorld mesh({cup(ColliderShape::Kind::Mesh, R, Ri, H, B, N)});
+    const CollisionWorld hull({cup(ColliderShape::Kind::ConvexMesh, R, Ri, H, B, N)});
+    const Eigen::Isometry3f place = at({0, 0, 0});
+    const auto m = mesh.posed({place}, 0.1f), h = hull.posed({place}, 0.1f);
+    // On the axis, in the hollow: the inner wall's apothem away, outside the solid.
+    const float apothem = Ri * std::cos(float(M_PI) / N);
+    Vec3f n;
+    EXPECT_NEAR(m->signedDistance({0, 0.1f, 0}, &n), apothem, 1e-4f);
+    EXPECT_NEAR(h->signedDistance({0, 0.1f, 0}), -(H - 0.1f), 1e-4f) << "the hull: inside, 5 cm under its top";
+    // In the wall (halfway between the radii) and in the floor: inside both.
+    EXPECT_NEAR(m->signedDistance({0.5f * (R + Ri), 0.1f, 0}, &n), -0.5f * (R - Ri), 2e-4f);
+    EXPECT_GT(n.x(), 0.99f) << "pushed out through the outer wall (the nearer, by the winding)";
+    EXPECT_NEAR(m->signedDistance({0.02f, 0.004f, 0}, &n), -0.004f, 1e-4f);
+    EXPECT_LT(n.y(), -0.999f) << "out through the bottom";
+    // Just above the hollow's floor: 2 mm outside the solid, pushed up.
+    EXPECT_NEAR(m->signedDistance({0.01f, B + 0.002f, 0.01f}, &n), 0.002f, 1e-4f);
+    EXPECT_GT(n.y(), 0.999f);
+
+    // Limp guides from the underside of a small head above the cup.
+    const Vec3f headCentre(0, 0.3f, 0);
+    const float headRadius = 0.05f;
+    const std::vector<Vec3f> dirs = fibonacciCap(12, -Vec3f::UnitY(), 0.8f);
+    auto hang = [&](const std::shared_ptr<const Collider>& prop, size_t& inHollow, float& worstDepth) {
+        GuideSettings s;
+        s.formulation = GuideFormulation::Rope;  // nearly limp: the test measures the collider
+        s.preload = false;
+        s.bendStiffness = 1e-7f;
+        s.limitStiffness = 1e-7f;
+        s.length = 0.2f;
+        s.strandsPerWorld = 8;
+        GuideSolver solver(s);
+        HeadPose pose;
+        pose.transform = at(headCentre);
+        pose.collider = std::make_shared<CompositeCollider>(std::make_shared<SphereCollider>(headCentre, headRadius), prop);
+        std::vector<SurfaceFrame> roots(dirs.size());
+        for (size_t i = 0; i < dirs.size(); ++i) {
+            roots[i].position = headCentre + headRadius * dirs[i];
+            roots[i].normal = dirs[i];
+            roots[i].tangent = dirs[i].unitOrthogonal();
+        }
+        solver.initialize(roots, pose);
+        worstDepth = 0.f;
+        StrandFrame f;
+        for (int k = 0; k < 50; ++k) {
+            pose.time = solver.nextTime();
+            solver.step(roots, pose);
+            solver.write(f);
+            for (const Vec3f& p : f.positions) worstDepth = std::max(worstDepth, -prop->signedDistance(p));
+        }
+        inHollow = 0;
+        for (const Vec3f& p : f.positions)
+            inHollow += p.y() < H - 0.01f && Vec2f(p.x(), p.z()).norm() < Ri;
+    };
+    size_t inMesh = 0, inHull = 0;
+    float depthMesh = 0.f, depthHull = 0.f;
+    hang(m, inMesh, depthMesh);
+    hang(h, inHull, depthHull);
+    EXPECT_GT(inMesh, 50u) << "hair hangs into the cup's hollow (a 20 cm strand reaches 9 cm below the rim)";
+    EXPECT_EQ(inHull, 0u) << "the hull fills the hollow: hair stops on its top";
+    EXPECT_LE(depthMesh, 1e-3f) << "no vertex more than 1 mm inside the cup's walls";
+    EXPECT_LE(depthHull, 1e-3f);
 }

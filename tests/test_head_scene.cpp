@@ -73,6 +73,61 @@ TEST(DefaultHead, CommittedAssetIsWhatTheToolWrites) {
     }
 }
 
+TEST(DefaultHead, CommittedBodyIsWhatTheToolWrites) {
+    // scenes/assets/body.glb: `make_head OUT --body`, the shoulders the default scene's hair rests on.
+    TempDir dir;
+    const std::string command =
+        std::string("'") + HAIRPIPE_MAKE_HEAD + "' '" + (dir / "body.glb").string() + "' --body > /dev/null";
+    ASSERT_EQ(std::system(command.c_str()), 0);
+    EXPECT_TRUE(readFile(dir / "body.glb") == readFile(sourcePath("scenes/assets/body.glb")))
+        << "scenes/assets/body.glb is stale: regenerate it with 'tools/make_head scenes/assets/body.glb --body'";
+    HeadImportSettings s;
+    s.file = sourcePath("scenes/assets/body.glb");
+    const HeadRig loaded = importHead(s);
+    ASSERT_EQ(loaded.meshes.size(), 1u);
+    EXPECT_EQ(loaded.meshes[0].name, "shoulders");
+    ASSERT_EQ(loaded.clips.size(), 2u);
+    EXPECT_EQ(loaded.clips[0].name, "nod_shake_turn") << "the head's clips, so the body plays the head's clip";
+}
+
+// Adult proportions (stature ~1.75 m): the shoulder tips (acromion) lie
+// about 0.3 m under the top of the head, the neck-shoulder point ~0.25 m; the
+// shoulders are ~0.4 m wide. The body stays still while the head moves,
+// except beside the neck, which follows the neck bone.
+TEST(DefaultHead, ShouldersHaveAdultProportionsAndFollowTheNeck) {
+    const HeadRig head = makeDefaultHead(), body = makeDefaultBody();
+    const float top = head.restMesh().bounds().max().y();
+    const TriangleMesh rest = body.restMesh();
+    float tip = -1.f, neck = -1.f, width = 0.f;
+    for (const Vec3f& p : rest.positions) {
+        if (std::abs(std::abs(p.x()) - 0.17f) < 0.01f && std::abs(p.z() + 0.03f) < 0.02f) tip = std::max(tip, p.y());
+        if (std::abs(std::abs(p.x()) - 0.07f) < 0.01f && std::abs(p.z() + 0.03f) < 0.02f) neck = std::max(neck, p.y());
+        width = std::max(width, 2.f * std::abs(p.x()));
+    }
+    EXPECT_NEAR(top - tip, 0.30f, 0.03f) << "skull top to shoulder tip";
+    EXPECT_NEAR(top - neck, 0.25f, 0.03f) << "skull top to the shoulder beside the neck";
+    EXPECT_NEAR(width, 0.42f, 0.04f) << "shoulder width";
+    // The hair that hangs from the back of the head lands on the upper back:
+    // 22 cm below the lowest roots of the default scene's cap (~3 cm under
+    // the skull centre, at the back, 9-11 cm behind the neck's axis) is
+    // below the back's surface there.
+    float back = -1.f;
+    for (const Vec3f& p : rest.positions)
+        if (std::abs(p.x()) < 0.02f && p.z() < -0.09f && p.z() > -0.11f) back = std::max(back, p.y());
+    EXPECT_LT(-0.03f - 0.22f, back) << "the upper back is within reach of 22 cm nape hair";
+    TriangleMesh still = rest, tipped = rest;
+    body.pose(1, 0.0, still);
+    body.pose(1, 0.5, tipped);  // the stress clip: tipped back 70°
+    float far = 0.f, near = 0.f;
+    for (size_t v = 0; v < rest.positions.size(); ++v) {
+        const float moved = (tipped.positions[v] - still.positions[v]).norm();
+        const float radial = Vec2f(rest.positions[v].x(), rest.positions[v].z() + 0.018f).norm();
+        (radial > 0.1f ? far : near) = std::max(radial > 0.1f ? far : near, moved);
+    }
+    EXPECT_LT(far, 1e-6f) << "shoulders away from the neck stay still";
+    EXPECT_GT(near, 0.005f) << "skin beside the neck follows the neck as it tips";
+}
+
 TEST(DefaultHead, ProportionsAndAClipThatEndsStill) {
     const HeadRig rig = makeDefaultHead();
     const Eigen::AlignedBox3f box = rig.restMesh().bounds();

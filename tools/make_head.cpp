@@ -4,6 +4,8 @@
 // matches.
 //
 //   make_head OUT.glb [--rings N] [--sectors N] [--key-rate HZ]
+//   make_head OUT.glb --body             the shoulders under that head, with its
+//                                        neck and clips (scenes/assets/body.glb)
 //   make_head OUT.glb --sphere RADIUS    a static UV sphere, the seed's and
 //                                        the benchmarks' head (scenes/assets/sphere.glb)
 #include "core/errors.h"
@@ -186,6 +188,8 @@ void zeroUnusedGlbBytes(const std::filesystem::path& file) {
     if (!out) throw IoError(file.string(), "cannot rewrite the file");
 }
 
+const char* const kUsage = "usage: make_head OUT.glb [--body] [--rings N] [--sectors N] [--key-rate HZ] | OUT.glb --sphere RADIUS";
+
 int intOption(const std::string& name, const char* value) {
     char* end = nullptr;
     const long n = value ? std::strtol(value, &end, 10) : 0;
@@ -200,21 +204,23 @@ int main(int argc, char** argv) {
         DefaultHeadOptions options;
         std::string out;
         double sphere = 0;
+        bool body = false;
         for (int i = 1; i < argc; ++i) {
             const std::string a = argv[i];
             if (a == "--rings") options.rings = intOption(a, i + 1 < argc ? argv[++i] : nullptr);
             else if (a == "--sectors") options.sectors = intOption(a, i + 1 < argc ? argv[++i] : nullptr);
             else if (a == "--key-rate") options.keyRate = intOption(a, i + 1 < argc ? argv[++i] : nullptr);
             else if (a == "--sphere" && i + 1 < argc) sphere = std::atof(argv[++i]);
+            else if (a == "--body") body = true;
             else if (a == "-h" || a == "--help" || (!a.empty() && a[0] == '-') || !out.empty())
-                throw UsageError("usage: make_head OUT.glb [--rings N] [--sectors N] [--key-rate HZ]");
+                throw UsageError(kUsage);
             else out = a;
         }
-        if (out.empty()) throw UsageError("usage: make_head OUT.glb [--rings N] [--sectors N] [--key-rate HZ]");
+        if (out.empty()) throw UsageError(kUsage);
 
         if (sphere < 0 || (sphere == 0 && std::find(argv, argv + argc, std::string("--sphere")) != argv + argc))
             throw UsageError("make_head: --sphere needs a positive radius in metres");
-        const HeadRig rig = sphere > 0 ? sphereRig(float(sphere)) : makeDefaultHead(options);
+        const HeadRig rig = sphere > 0 ? sphereRig(float(sphere)) : body ? makeDefaultBody(options) : makeDefaultHead(options);
         aiScene scene;
         scene.mRootNode = buildNodes(rig, 0);
         scene.mNumMeshes = unsigned(rig.meshes.size());

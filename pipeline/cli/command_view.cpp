@@ -1,6 +1,7 @@
 // `hairpipe view scene.yaml`: the preview pass in an interactive window
 // (render/viewer.h), fed by the scene's frame source.
 #include "core/log.h"
+#include "pipeline/head/animated_head.h"
 #include "pipeline/stages/camera_track.h"
 #include "pipeline/cli/commands.h"
 #include "pipeline/scene/preview_settings.h"
@@ -35,6 +36,10 @@ class SourceFrames {
         f.strands = data_.strands;
         if (data_.head) {
             f.head = &data_.head->mesh;
+            if (!data_.head->scenery.triangles.empty()) {  // the visible colliders beside the head
+                drawn_ = drawnMesh(*data_.head);
+                f.head = &drawn_;
+            }
             f.headTransform = data_.head->transform;
         }
         return f;
@@ -45,6 +50,7 @@ class SourceFrames {
     ShotSettings shot_;
     std::unique_ptr<FrameSource> source_;
     FrameData data_;
+    TriangleMesh drawn_;  ///< the head and its scenery, while the frame is shown
     int current_ = INT_MIN;
 };
 

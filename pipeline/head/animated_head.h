@@ -30,6 +30,7 @@ class AnimatedHead;
 struct ExtraCollider {
     ColliderShape shape;
     bool followsHead = false;
+    bool visible = true;  ///< a mesh collider drawn beside the head (HeadPose::scenery)
     std::function<Eigen::Isometry3f(double)> place;
     /// Skinned mesh: its own file's animation, sampled at the shot time
     /// for the vertices of each pose (shape.kind SkinnedMesh).
@@ -90,6 +91,10 @@ class AnimatedHead final : public HeadMotion {
     mutable std::shared_ptr<const MeshCollider> restExact_;
     std::shared_ptr<const CollisionWorld> world_;  ///< settings_.colliders in Bullet; null when none
 };
+
+/// @brief What a renderer draws of a pose: the head's mesh followed by its
+/// scenery (the visible mesh colliders), as one mesh.
+TriangleMesh drawnMesh(const HeadPose& pose);
 
 /// @brief Least-squares rigid transform (Kabsch / Umeyama without scale)
 /// taking `from[i]` to `to[i]` for the listed indices (all when empty).

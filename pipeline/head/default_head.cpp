@@ -33,6 +33,7 @@ const Vec3f kSkull(0.f, 0.015f, -0.01f), kSkullRadii(0.075f, 0.092f, 0.098f);
 const Vec3f kEarRadii(0.012f, 0.027f, 0.017f);
 const Vec3f kNeckJoint(0.f, -0.235f, -0.018f);  // world bind positions: the neck pivots at its base
 const Vec3f kHeadJoint(0.f, -0.035f, -0.015f);
+const Vec3f kChest(0.f, -0.27f, -0.03f);  // centre of the shoulders' trapezius-and-chest ellipsoid, and its bone
 
 /// Hairline height above which the scalp starts, by angle from the front.
 float hairline(float angle) {
@@ -101,6 +102,22 @@ RigClip headClip(const HeadRig& rig, const char* name, double duration, double k
     return clip;
 }
 
+/// The two clips of DefaultHeadOptions on a rig whose nodes 3 and 4 are
+/// the Neck and Head bones.
+void addClips(HeadRig& rig, const DefaultHeadOptions& o) {
+    std::vector<double> times;
+    for (int k = 0; k <= int(std::lround(kDefaultHeadClipSeconds * o.keyRate)); ++k) times.push_back(k / o.keyRate);
+    rig.clips.push_back(headClip(rig, "nod_shake_turn", kDefaultHeadClipSeconds, o.keyRate, times, headAngles));
+    // The stress clip's cut: the pose before it is held until 1 ms before.
+    times.clear();
+    for (int k = 0; k <= int(std::lround(kStressClipSeconds * o.keyRate)); ++k) {
+        const double t = k / o.keyRate;
+        if (t >= kStressCut && times.back() < kStressCut) times.push_back(kStressCut - 1e-3);
+        times.push_back(t);
+    }
+    rig.clips.push_back(headClip(rig, "stress", kStressClipSeconds, o.keyRate, times, stressAngles));
+}
+
 }  // namespace
 
 float defaultHeadField(const Vec3f& p) {
@@ -121,29 +138,42 @@ float defaultHeadHairMask(const Vec3f& p) {
     return std::clamp((p.y() - hairline(angle)) / 0.01f + 0.5f, 0.f, 1.f);
 }
 
-HeadRig makeDefaultHead(const DefaultHeadOptions& o) {
-    // Star-shaped about a point inside skull, jaw and neck: each direction of
-    // a UV sphere is marched inward from outside to the outermost surface.
-    const TriangleMesh dirs = makeSphereMesh(Vec3f::Zero(), 1.f, o.rings, o.sectors);
-    const Vec3f centre(0.f, -0.05f, -0.012f);
-    std::vector<Vec3f> positions(dirs.positions.size()), normals(dirs.positions.size());
+namespace {
+
+/// The outermost surface of `field` (negative inside) as a UV sphere's
+/// directions from `centre` see it: each direction is marched inward from
+/// 0.45 m to the first point inside, then bisected. Normals: the field's
+/// gradient.
+void marchSurface(float (*field)(const Vec3f&), const Vec3f& centre, const TriangleMesh& dirs,
+                  std::vector<Vec3f>& positions, std::vector<Vec3f>& normals) {
+    positions.resize(dirs.positions.size());
+    normals.resize(dirs.positions.size());
     for (size_t i = 0; i < dirs.positions.size(); ++i) {
         const Vec3f d = dirs.positions[i];
         float outside = 0.45f, inside = outside;
-        while (inside > 0.f && defaultHeadField(centre + inside * d) > 0.f) inside -= 0.001f;
+        while (inside > 0.f && field(centre + inside * d) > 0.f) inside -= 0.001f;
         outside = inside + 0.001f;
         for (int k = 0; k < 40; ++k) {
             const float mid = 0.5f * (inside + outside);
-            (defaultHeadField(centre + mid * d) > 0.f ? outside : inside) = mid;
+            (field(centre + mid * d) > 0.f ? outside : inside) = mid;
         }
         const Vec3f p = centre + inside * d;
         positions[i] = p;
         const float h = 1e-4f;
-        const Vec3f g(defaultHeadField(p + h * Vec3f::UnitX()) - defaultHeadField(p - h * Vec3f::UnitX()),
-                      defaultHeadField(p + h * Vec3f::UnitY()) - defaultHeadField(p - h * Vec3f::UnitY()),
-                      defaultHeadField(p + h * Vec3f::UnitZ()) - defaultHeadField(p - h * Vec3f::UnitZ()));
+        const Vec3f g(field(p + h * Vec3f::UnitX()) - field(p - h * Vec3f::UnitX()),
+                      field(p + h * Vec3f::UnitY()) - field(p - h * Vec3f::UnitY()),
+                      field(p + h * Vec3f::UnitZ()) - field(p - h * Vec3f::UnitZ()));
         normals[i] = g.norm() > 0.f ? Vec3f(g.normalized()) : d;
     }
+}
+
+}  // namespace
+
+HeadRig makeDefaultHead(const DefaultHeadOptions& o) {
+    // Star-shaped about a point inside skull, jaw and neck.
+    const TriangleMesh dirs = makeSphereMesh(Vec3f::Zero(), 1.f, o.rings, o.sectors);
+    std::vector<Vec3f> positions, normals;
+    marchSurface(defaultHeadField, Vec3f(0.f, -0.05f, -0.012f), dirs, positions, normals);
 
     HeadRig rig;
     rig.file = "default head";
@@ -197,17 +227,55 @@ HeadRig makeDefaultHead(const DefaultHeadOptions& o) {
         rig.meshes.push_back(std::move(m));
     }
 
-    std::vector<double> times;
-    for (int k = 0; k <= int(std::lround(kDefaultHeadClipSeconds * o.keyRate)); ++k) times.push_back(k / o.keyRate);
-    rig.clips.push_back(headClip(rig, "nod_shake_turn", kDefaultHeadClipSeconds, o.keyRate, times, headAngles));
-    // The stress clip's cut: the pose before it is held until 1 ms before.
-    times.clear();
-    for (int k = 0; k <= int(std::lround(kStressClipSeconds * o.keyRate)); ++k) {
-        const double t = k / o.keyRate;
-        if (t >= kStressCut && times.back() < kStressCut) times.push_back(kStressCut - 1e-3);
-        times.push_back(t);
+    addClips(rig, o);
+    return rig;
+}
+
+float defaultBodyField(const Vec3f& p) {
+    // Trapezius and chest: a wide, flat ellipsoid whose top slopes from the
+    // neck (y -0.14 beside it) to the shoulder (-0.2 at x ±0.17); deltoid
+    // caps round the shoulders; cut flat at mid-chest. Heights from an
+    // adult of 1.75 m: the neck-shoulder point ~0.25 m under the top of the
+    // head (0.107 here), the acromion ~0.3 m.
+    float f = ellipsoid(p, kChest, Vec3f(0.2f, 0.135f, 0.11f));
+    for (float side : {-1.f, 1.f})
+        f = smin(f, ellipsoid(p, Vec3f(side * 0.165f, -0.24f, -0.03f), Vec3f(0.055f, 0.05f, 0.055f)), 0.03f);
+    return std::max(f, -0.4f - p.y());
+}
+
+HeadRig makeDefaultBody(const DefaultHeadOptions& o) {
+    const TriangleMesh dirs = makeSphereMesh(Vec3f::Zero(), 1.f, o.rings, o.sectors);
+    RigMesh m;
+    marchSurface(defaultBodyField, kChest, dirs, m.positions, m.normals);
+    m.name = "shoulders";
+    m.node = 1;
+    m.material = 1;  // skin
+    m.uvs = dirs.uvs;
+    m.triangles = dirs.triangles;
+    m.colors.assign(m.positions.size(), Eigen::Vector4f(0.f, 0.f, 0.f, 1.f));  // no hair grows here
+    // The chest bone carries the body; skin next to the neck follows the
+    // neck bone halfway, as a trapezius does when the head tips.
+    m.boneNodes = {2, 3};
+    m.boneOffsets = {Affine3f(Eigen::Translation3f(-kChest)), Affine3f(Eigen::Translation3f(-kNeckJoint))};
+    m.influenceStart.push_back(0);
+    for (const Vec3f& p : m.positions) {
+        const float radial = Eigen::Vector2f(p.x(), p.z() - kNeckJoint.z()).norm();
+        const float neck = 0.5f * (1.f - smoothstep(0.05f, 0.09f, radial)) * smoothstep(-0.19f, -0.14f, p.y());
+        m.influenceBone.push_back(0), m.influenceWeight.push_back(1.f - neck);
+        if (neck > 0.f) m.influenceBone.push_back(1), m.influenceWeight.push_back(neck);
+        m.influenceStart.push_back(uint32_t(m.influenceBone.size()));
     }
-    rig.clips.push_back(headClip(rig, "stress", kStressClipSeconds, o.keyRate, times, stressAngles));
+    HeadRig rig;
+    rig.file = "default body";
+    // Nodes 3 and 4 are the head's Neck and Head bones (same places, same clips).
+    rig.nodes = {{"BodyRig", -1, Affine3f::Identity()},
+                 {"Shoulders", 0, Affine3f::Identity()},
+                 {"Chest", 0, Affine3f(Eigen::Translation3f(kChest))},
+                 {"Neck", 0, Affine3f(Eigen::Translation3f(kNeckJoint))},
+                 {"Head", 3, Affine3f(Eigen::Translation3f(kHeadJoint - kNeckJoint))}};
+    rig.materials = {"scalp", "skin"};
+    rig.meshes.push_back(std::move(m));
+    addClips(rig, o);
     return rig;
 }
 

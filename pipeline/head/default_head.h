@@ -29,9 +29,21 @@ constexpr double kStressCut = 2.0;
 /// bit-identical data. About 2·rings·sectors triangles (5k by default).
 HeadRig makeDefaultHead(const DefaultHeadOptions& options = {});
 
+/// @brief The shoulders under the default head (scenes/assets/body.glb,
+/// `make_head --body`): an upper torso, one mesh "shoulders" skinned to a
+/// Chest bone (and, next to the neck, halfway to the head's Neck bone), with
+/// the head's Neck and Head bones and both clips, so played with the head's
+/// clip it moves as the head's body. The top of the shoulders is 0.25 m
+/// below the skull top beside the neck and 0.3 m at the shoulder tips, an
+/// adult's proportions; the upper back lies under the nape hair.
+HeadRig makeDefaultBody(const DefaultHeadOptions& options = {});
+
 /// The head's inside/outside function (negative inside), metres: a smooth
 /// union of skull, jaw, nose, ears and neck. Exposed for tests.
 float defaultHeadField(const Vec3f& p);
+
+/// The shoulders' inside/outside function (negative inside), metres.
+float defaultBodyField(const Vec3f& p);
 
 /// True above the hairline: the scalp the default scene grows hair on.
 float defaultHeadHairMask(const Vec3f& p);

@@ -72,7 +72,8 @@ std::vector<ExtraCollider> extraColliders(const Scene& scene, const HeadAnimatio
         const std::string type = scene.text(k + "type");
         c.shape.kind = type == "sphere"    ? ColliderShape::Kind::Sphere
                        : type == "capsule" ? ColliderShape::Kind::Capsule
-                       : type == "mesh"    ? ColliderShape::Kind::ConvexMesh
+                       : type == "mesh"    ? ColliderShape::Kind::Mesh
+                       : type == "hull"    ? ColliderShape::Kind::ConvexMesh
                        : type == "skinned" ? ColliderShape::Kind::SkinnedMesh
                                            : ColliderShape::Kind::Box;
         c.shape.radius = float(scene.number(k + "radius"));
@@ -80,7 +81,7 @@ std::vector<ExtraCollider> extraColliders(const Scene& scene, const HeadAnimatio
         c.shape.halfExtents = 0.5f * scene.vec3f(k + "size");
         if (c.shape.kind == ColliderShape::Kind::Box && !(c.shape.halfExtents.minCoeff() > 0.f))
             scene.fail(k + "size", "a box needs positive extents");
-        if (c.shape.kind == ColliderShape::Kind::ConvexMesh || c.shape.kind == ColliderShape::Kind::SkinnedMesh) {
+        if (type == "mesh" || type == "hull" || type == "skinned") {
             // Another file, or (no file) meshes of the head's own file, placed as the head is.
             HeadImportSettings mesh = headImportSettings(scene);
             if (!scene.file(k + "file").empty()) {
@@ -96,7 +97,9 @@ std::vector<ExtraCollider> extraColliders(const Scene& scene, const HeadAnimatio
             } catch (const RigSelectionError& e) {
                 scene.fail(k + "meshes", e.what());
             }
-            c.shape.points = rig->restMesh().positions;
+            const TriangleMesh rest = rig->restMesh();
+            c.shape.points = rest.positions;
+            c.shape.triangles = rest.triangles;
             if (c.shape.kind == ColliderShape::Kind::SkinnedMesh) {
                 // The file's clip on the head's timing (clip_offset, clip_speed, loop).
                 HeadAnimationSettings body = head;
@@ -110,7 +113,7 @@ std::vector<ExtraCollider> extraColliders(const Scene& scene, const HeadAnimatio
                     scene.fail(k + "clip", e.what());
                 }
                 auto skin = std::make_shared<const AnimatedHead>(rig, body);
-                c.shape.triangles = skin->rest().triangles;
+                c.shape.points = skin->rest().positions;  // the tree is built on the rest pose, then refitted
                 c.skin = std::move(skin);
             }
             if (c.shape.points.size() < 4)
@@ -118,6 +121,7 @@ std::vector<ExtraCollider> extraColliders(const Scene& scene, const HeadAnimatio
                                            " vertices; a collider needs at least 4"));
         }
         c.followsHead = scene.text(k + "parent") == "head";
+        c.visible = scene.flag(k + "visible");
         Eigen::Isometry3f base = Eigen::Isometry3f::Identity();
         base.linear() = eulerXYZ(scene.vec3f(k + "rotate"));
         base.translation() = scene.vec3f(k + "translate");

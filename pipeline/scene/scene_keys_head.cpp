@@ -41,26 +41,30 @@ void addHeadKeys(SchemaBuilder& b) {
               "collision world that every hair vertex queries (sim/collision/collision_world.h); the head keeps its own "
               "collider (head.collider) as the fast path.")
         .list("head.colliders", "[]", 64, "The colliders, a list of maps.")
-        .choice("head.colliders[].type", "box", {"sphere", "capsule", "box", "mesh", "skinned"},
-                "sphere, capsule, box: Bullet's primitives; mesh: the convex hull of a mesh file's vertices "
-                "(a rigid prop; split a concave prop into convex parts, one entry each); skinned: a mesh file "
-                "played by its own clip (a body), a triangle mesh rebuilt on each pose's vertices.")
+        .choice("head.colliders[].type", "box", {"sphere", "capsule", "box", "mesh", "hull", "skinned"},
+                "sphere, capsule, box: Bullet's primitives; mesh: a rigid prop's triangles as a GImpact mesh "
+                "(hollows such as a hat's inside stay open; the mesh should be closed and wound outward); hull: "
+                "the convex hull of the file's vertices (cheaper, fills every hollow); skinned: a mesh file "
+                "played by its own clip (a body), a triangle mesh whose BVH is refitted to each pose's vertices.")
         .number("head.colliders[].radius", 0.05, 1e-5, 100, "m", "sphere, capsule: radius.")
         .number("head.colliders[].length", 0.1, 0, 100, "m", "capsule: distance between the cap centres (along local Y).")
         .vec3("head.colliders[].size", 0.1, 0.1, 0.1, "m", "box: full extents along local X, Y, Z.")
         .file("head.colliders[].file", "",
-              "mesh, skinned: the mesh file (any format assimp reads). Empty: the head's own file, imported and "
+              "mesh, hull, skinned: the mesh file (any format assimp reads). Empty: the head's own file, imported and "
               "placed as the head (head.unit_scale, up_axis, translate, rotate).")
         .text("head.colliders[].meshes", "",
-              "mesh, skinned: comma-separated meshes of the file (names or indices as `hairpipe info` lists them); "
+              "mesh, hull, skinned: comma-separated meshes of the file (names or indices as `hairpipe info` lists them); "
               "empty: every mesh.")
         .text("head.colliders[].clip", "",
               "skinned: the file's clip by name or index, on the head's timing (head.clip_offset, clip_speed, loop); "
               "empty: the clip head.clip names; 'none': the rest pose.")
-        .number("head.colliders[].unit_scale", 1, 1e-9, 1e9, "", "mesh, skinned: metres per file unit.")
+        .number("head.colliders[].unit_scale", 1, 1e-9, 1e9, "", "mesh, hull, skinned: metres per file unit.")
         .choice("head.colliders[].parent", "world", {"world", "head"},
                 "world: placed in the world; head: carried by the head's rigid motion (placement in the rest "
                 "pose's world frame).")
+        .flag("head.colliders[].visible", true,
+              "mesh, hull, skinned: drawn beside the head in the preview and reference (the file's triangles, "
+              "posed); false: collides unseen. Primitives are never drawn.")
         .vec3("head.colliders[].translate", 0, 0, 0, "m", "Placement: translation (after rotate).")
         .vec3("head.colliders[].rotate", 0, 0, 0, "deg", "Placement: rotation about X, then Y, then Z.")
         .curve("head.colliders[].move_x", 0, -1e6, 1e6, "m", "Keyed motion per frame, added to translate along X.")

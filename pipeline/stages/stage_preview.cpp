@@ -3,6 +3,7 @@
 // One headless GL context serves the whole run, created on the first frame
 // that needs it (so resumed runs with nothing to do never touch GL).
 #include "core/log.h"
+#include "pipeline/head/animated_head.h"
 #include "pipeline/stages/camera_track.h"
 #include "pipeline/batch/output.h"
 #include "pipeline/batch/path_template.h"
@@ -55,8 +56,13 @@ class PreviewStage final : public FrameStage {
         PreviewFrame frame;
         frame.time = data.time;
         frame.strands = data.strands;
+        TriangleMesh drawn;  // the head with the visible colliders beside it
         if (data.head) {
             frame.head = &data.head->mesh;
+            if (!data.head->scenery.triangles.empty()) {
+                drawn = drawnMesh(*data.head);
+                frame.head = &drawn;
+            }
             frame.headTransform = data.head->transform;
         }
         View view = view_;

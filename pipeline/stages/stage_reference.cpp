@@ -1,6 +1,7 @@
 // The "reference" frame stage: renders each frame's strands and head with the
 // Embree reference renderer (render/reference.h) and writes EXR (+ PNG).
 #include "core/log.h"
+#include "pipeline/head/animated_head.h"
 #include "pipeline/stages/camera_track.h"
 #include "pipeline/batch/output.h"
 #include "pipeline/batch/path_template.h"
@@ -87,6 +88,11 @@ class ReferenceStage final : public FrameStage {
 
     void run(const FrameData& data) override {
         const TriangleMesh* head = data.head && !data.head->mesh.triangles.empty() ? &data.head->mesh : nullptr;
+        TriangleMesh drawn;  // the head with the visible colliders beside it
+        if (head && !data.head->scenery.triangles.empty()) {
+            drawn = drawnMesh(*data.head);
+            head = &drawn;
+        }
         if (!data.strands && !head)
             throw FrameError(cat("frame ", data.frame,
                                  " has neither strands nor a head to render (no hair or head stage produced them)"));

@@ -79,6 +79,9 @@ struct HeadPose {
     Eigen::Isometry3f transform = Eigen::Isometry3f::Identity();
     TriangleMesh mesh;                        ///< deformed, world space
     std::shared_ptr<const Collider> collider; ///< may be null (no head collision)
+    /// Visible meshes beside the head (a body, props), world space with
+    /// normals: drawn with `mesh`, never a root's surface. May be empty.
+    TriangleMesh scenery;
 };
 
 /// A head that can be sampled at any time (seconds). The pipeline's assimp

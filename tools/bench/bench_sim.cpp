@@ -9,15 +9,33 @@
 // over the timed steps, NaN count, threads — for every formulation (rod,
 // rope, rigid), with and without strand-strand collision, on 1 and 2 threads.
 //
+// --collider picks how the head collides, so one run compares them:
+//   sphere  the analytic sphere (the benchmark's own head, the default);
+//   grid    the distance-grid fast path a mesh head uses (head.collider.method
+//           rigid: the rest mesh's narrow-band level set, 2 mm voxels, moved
+//           by the head's rotation);
+//   bullet  Bullet contact queries: the head's mesh as a rigid GImpact mesh in
+//           the collision world of head.colliders (sim/collision/collision_world.h),
+//           every vertex asking Bullet's broadphase and the mesh's BVH;
+//   grid+box  the fast path plus a Bullet world holding a shoulder box under
+//           the head (the default scene's case: the head on its grid, the
+//           body through Bullet).
+//
 //   bench_sim [--guides 94,845] [--formulation rod,rope,rigid] [--strand-collision off,on]
 //             [--threads 1,2] [--runs 3] [--warmup 20] [--steps 250]
 //             [--substeps 1] [--iterations 20] [--rod-substeps 2] [--per-world 16] [--rate 90]
-//             [--preload on|off] [--digest]
+//             [--preload on|off] [--collider sphere,grid,bullet,grid+box] [--range 0.05] [--digest]
+//
+// --range: how far the Bullet mesh measures (the query range of
+// CollisionWorld::posed; beyond it a lower bound), metres.
 //
 // --digest adds a column: an FNV-1a hash of the final state bytes
 // (GuideSolver::saveState; rod and rope), the same for every run and thread
 // count when the solver is deterministic, and unchanged by an optimisation
 // that keeps the results bit for bit.
+#include "sim/collision/collision_world.h"
+#include "sim/collision/level_set.h"
+#include "sim/collision/mesh_collider.h"
 #include "sim/strands/fibonacci.h"
 #include "sim/guides/guides.h"
 
@@ -80,12 +98,60 @@ uint64_t fnv1a(const std::vector<char>& bytes) {
     return h;
 }
 
-RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int warmup, int steps, bool digest) {
+/// How far a Bullet mesh collider measures (beyond: a lower bound), m.
+float kRange = 0.05f;
+
+/// The head's collider at a pose, per --collider mode (see the file comment).
+class HeadColliders {
+  public:
+    HeadColliders(const std::string& mode, const SpinningSphere& head) : mode_(mode) {
+        if (mode == "sphere") return;
+        const TriangleMesh rest = head.sample(0.0).mesh;
+        if (mode == "grid" || mode == "grid+box") {
+            grid_ = std::make_shared<const LevelSet>(rest, LevelSetSettings{});
+            exact_ = std::make_shared<const MeshCollider>(rest);
+        }
+        ColliderShape shape;
+        if (mode == "bullet") {
+            shape.kind = ColliderShape::Kind::Mesh;
+            shape.points = rest.positions;
+            shape.triangles = rest.triangles;
+        } else if (mode == "grid+box") {
+            shape.kind = ColliderShape::Kind::Box;  // shoulders: 40 x 10 x 24 cm, top 2 cm under the head
+            shape.halfExtents = Vec3f(0.2f, 0.05f, 0.12f);
+            boxPlace_.translation() = Vec3f(0.f, -0.17f, 0.f);
+        } else if (mode != "grid") {
+            std::fprintf(stderr, "bench_sim: --collider expects sphere, grid, bullet or grid+box, not %s\n", mode.c_str());
+            std::exit(1);
+        }
+        if (mode != "grid") world_ = std::make_unique<CollisionWorld>(std::vector<ColliderShape>{shape});
+    }
+
+    /// Replaces pose.collider (the analytic sphere) by this mode's.
+    void apply(HeadPose& pose) const {
+        if (mode_ == "bullet") pose.collider = world_->posed({pose.transform}, kRange);
+        if (grid_) pose.collider = std::make_shared<LevelSetCollider>(grid_, pose.transform, exact_);
+        if (mode_ == "grid+box")
+            pose.collider = std::make_shared<CompositeCollider>(pose.collider, world_->posed({boxPlace_}));
+    }
+
+  private:
+    std::string mode_;
+    std::shared_ptr<const LevelSet> grid_;
+    std::shared_ptr<const MeshCollider> exact_;
+    std::unique_ptr<CollisionWorld> world_;
+    Eigen::Isometry3f boxPlace_ = Eigen::Isometry3f::Identity();
+};
+
+RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int warmup, int steps,
+                  const std::string& collider, bool digest) {
     const float radius = 0.1f;
     SpinningSphere head(radius, rate);
+    const HeadColliders colliders(collider, head);
     const std::vector<Vec3f> dirs = fibonacciCap(guides);
     GuideSolver solver(settings);
     HeadPose pose = head.sample(0.0);
+    colliders.apply(pose);
     solver.initialize(rootsAt(dirs, radius, pose), pose);
     RunResult r;
     std::chrono::steady_clock::time_point start;
@@ -96,6 +162,7 @@ RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int 
             cpu0 = processCpuSeconds();
         }
         pose = head.sample(double(k) * settings.timeStep);
+        colliders.apply(pose);
         const StepStats& s = solver.step(rootsAt(dirs, radius, pose), pose);
         if (k > warmup) {
             if (k == warmup + 1) r.stats = s;
@@ -115,7 +182,7 @@ RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int 
 
 int main(int argc, char** argv) {
     std::vector<std::string> guideList{"94", "845"}, formList{"rod", "rope", "rigid"}, collList{"off", "on"},
-        threadList{"1", "2"};
+        threadList{"1", "2"}, colliderList{"sphere"};
     int runs = 3, warmup = 20, steps = 250, substeps = 1, iterations = 20, perWorld = 16, rodSubsteps = 2;
     float rate = 90.f;
     bool preload = true, digest = false;
@@ -142,6 +209,8 @@ int main(int argc, char** argv) {
         else if (a == "--rate") rate = std::stof(next());
         else if (a == "--preload") preload = next() != "off";
         else if (a == "--digest") digest = true;
+        else if (a == "--collider") colliderList = split(next());
+        else if (a == "--range") kRange = std::stof(next());
         else {
             std::fprintf(stderr, "bench_sim: unknown option %s\n", a.c_str());
             return 1;
@@ -151,11 +220,12 @@ int main(int argc, char** argv) {
                 "24 vertices, 0.25 m, collision radius 1 mm; substeps %d, iterations %d, %d guides per world; "
                 "median of %d runs (min-max)\n\n",
                 rate, warmup, steps, substeps, iterations, perWorld, runs);
-    std::printf("| guides | formulation | strand coll. | threads | steps/s median (min-max) | CPU ms/step (min) | "
+    std::printf("| guides | formulation | collider | strand coll. | threads | steps/s median (min-max) | CPU ms/step (min) | "
                 "max stretch | max penetration mm | NaN | strand contacts/step (max) | load avg |%s\n",
                 digest ? " state digest |" : "");
-    std::printf("|---:|---|---|---:|---|---:|---:|---:|---:|---:|---:|%s\n", digest ? "---|" : "");
+    std::printf("|---:|---|---|---|---:|---|---:|---:|---:|---:|---:|---:|%s\n", digest ? "---|" : "");
     for (const std::string& gs : guideList)
+      for (const std::string& collider : colliderList)
         for (const std::string& form : formList)
             for (const std::string& coll : collList)
                 for (const std::string& th : threadList) {
@@ -169,7 +239,7 @@ int main(int argc, char** argv) {
                     s.rodSubsteps = rodSubsteps;
                     s.preload = preload;
                     std::vector<RunResult> results;
-                    for (int r = 0; r < runs; ++r) results.push_back(runOnce(s, std::stoul(gs), rate, warmup, steps, digest));
+                    for (int r = 0; r < runs; ++r) results.push_back(runOnce(s, std::stoul(gs), rate, warmup, steps, collider, digest));
                     std::vector<double> sps, cpu;
                     StepStats worst = results[0].stats;
                     for (const RunResult& r : results) {
@@ -182,8 +252,8 @@ int main(int argc, char** argv) {
                     const double median = sps[sps.size() / 2];
                     double load[1] = {0};
                     getloadavg(load, 1);
-                    std::printf("| %s | %s | %s | %s | %.1f (%.1f-%.1f) | %.2f (%.2f) | %.2e | %.3f | %zu | %zu | %.2f |",
-                                gs.c_str(), form.c_str(), coll.c_str(), th.c_str(), median, sps.front(), sps.back(),
+                    std::printf("| %s | %s | %s | %s | %s | %.1f (%.1f-%.1f) | %.2f (%.2f) | %.2e | %.3f | %zu | %zu | %.2f |",
+                                gs.c_str(), form.c_str(), collider.c_str(), coll.c_str(), th.c_str(), median, sps.front(), sps.back(),
                                 cpu[cpu.size() / 2], cpu.front(), worst.maxLengthError,
                                 worst.maxPenetration * 1000.0, worst.nanCount, worst.strandContacts, load[0]);
                     if (digest) {
