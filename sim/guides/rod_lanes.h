@@ -19,7 +19,9 @@
 // the one the processor runs (GCC function multi-versioning). The results
 // are the same bit for bit: AVX2 adds wider registers, not other arithmetic
 // (no fused multiply-add: that is the separate FMA extension, not enabled).
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+// Not under AddressSanitizer: an ifunc resolver can run before the
+// sanitizer's runtime is up, and the baseline clone gives the same bits.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
 #define HP_ROD_LANES_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define HP_ROD_LANES_CLONES
