@@ -1,4 +1,5 @@
 #include "pipeline/scene/curly_settings.h"
+#include "pipeline/scene/key_fields.h"
 
 #include <algorithm>
 
@@ -8,18 +9,19 @@ bool usesCurlyWetModel(const Scene& scene) { return scene.text("hair.model") == 
 
 CurlyWetSettings curlyWetSettings(const Scene& scene) {
     auto f = [&](const char* key) { return float(scene.number(key)); };
-    auto i = [&](const char* key) { return int(scene.integer(key)); };
     CurlyWetSettings s;
-    s.particles = i("hair.curly.particles");
-    s.length = f("hair.curly.length");
-    s.curlRadius = f("hair.curly.radius");
-    s.curlPitch = f("hair.curly.pitch");
-    s.collisionRadius = f("hair.curly.collision_radius");
-    s.rootRadius = f("hair.curly.root_radius");
-    s.tipRadius = f("hair.curly.tip_radius");
-    s.timeStep = f("hair.curly.time_step");
-    s.substeps = i("hair.curly.substeps");
-    s.iterations = i("hair.curly.iterations");
+    readKeys(scene, s, {
+        {"hair.curly.particles", &CurlyWetSettings::particles},
+        {"hair.curly.length", &CurlyWetSettings::length},
+        {"hair.curly.radius", &CurlyWetSettings::curlRadius},
+        {"hair.curly.pitch", &CurlyWetSettings::curlPitch},
+        {"hair.curly.collision_radius", &CurlyWetSettings::collisionRadius},
+        {"hair.curly.root_radius", &CurlyWetSettings::rootRadius},
+        {"hair.curly.tip_radius", &CurlyWetSettings::tipRadius},
+        {"hair.curly.time_step", &CurlyWetSettings::timeStep},
+        {"hair.curly.substeps", &CurlyWetSettings::substeps},
+        {"hair.curly.iterations", &CurlyWetSettings::iterations},
+    });
     // The wisp's material: the rod formulation's keys (pipeline/scene/sim_settings.cpp).
     s.material.youngs = f("hair.material.youngs_modulus");
     s.material.shear = f("hair.material.shear_modulus");
@@ -38,33 +40,39 @@ CurlyWetSettings curlyWetSettings(const Scene& scene) {
     s.bendDamping = f("hair.curly.bend_damping");
     s.bendSmoothing = f("hair.curly.bend_smoothing");
     s.coreStiffness = given("hair.curly.core_stiffness");
-    s.coreDamping = f("hair.curly.core_damping");
-    s.coreSmoothing = f("hair.curly.core_smoothing");
-    s.maxStrain = f("hair.curly.max_strain");
-    s.maxRelativeVelocity = f("hair.curly.max_relative_velocity");
-    s.friction = f("hair.curly.friction");
-    s.teleportDistance = f("hair.curly.teleport_distance");
-    s.teleportAngle = f("hair.curly.teleport_angle");
-    s.strandsPerWorld = i("hair.curly.strands_per_world");
+    readKeys(scene, s, {
+        {"hair.curly.core_damping", &CurlyWetSettings::coreDamping},
+        {"hair.curly.core_smoothing", &CurlyWetSettings::coreSmoothing},
+        {"hair.curly.max_strain", &CurlyWetSettings::maxStrain},
+        {"hair.curly.max_relative_velocity", &CurlyWetSettings::maxRelativeVelocity},
+        {"hair.curly.friction", &CurlyWetSettings::friction},
+        {"hair.curly.teleport_distance", &CurlyWetSettings::teleportDistance},
+        {"hair.curly.teleport_angle", &CurlyWetSettings::teleportAngle},
+        {"hair.curly.strands_per_world", &CurlyWetSettings::strandsPerWorld},
+    });
 
     s.wetEffects = scene.flag("hair.wet.enabled");
     s.saturation = sceneSaturation(scene, 0.0);
-    s.saturationRoot = f("hair.wet.saturation_root");
-    s.saturationTip = f("hair.wet.saturation_tip");
-    s.helixRadius = f("hair.wet.helix_radius");
-    s.helixPitch = f("hair.wet.helix_pitch");
+    readKeys(scene, s, {
+        {"hair.wet.saturation_root", &CurlyWetSettings::saturationRoot},
+        {"hair.wet.saturation_tip", &CurlyWetSettings::saturationTip},
+        {"hair.wet.helix_radius", &CurlyWetSettings::helixRadius},
+        {"hair.wet.helix_pitch", &CurlyWetSettings::helixPitch},
+    });
     s.helixWeight = given("hair.wet.helix_weight");
-    s.cohesion = scene.flag("hair.wet.cohesion");
-    s.cohesionTightness = f("hair.wet.cohesion_tightness");
-    s.cohesionRadius = f("hair.wet.cohesion_radius");
-    s.cohesionStiffness = f("hair.wet.cohesion_stiffness");
-    s.adhesion = scene.flag("hair.wet.adhesion");
-    s.adhesionWeight = f("hair.wet.adhesion_weight");
-    s.adhesionRadius = f("hair.wet.adhesion_radius");
-    s.globalStiffness = f("hair.wet.global_stiffness");
-    s.wetStiffness = f("hair.wet.wet_stiffness");
-    s.dryStiffness = f("hair.wet.dry_stiffness");
-    s.stiffnessStep = f("hair.wet.stiffness_step");
+    readKeys(scene, s, {
+        {"hair.wet.cohesion", &CurlyWetSettings::cohesion},
+        {"hair.wet.cohesion_tightness", &CurlyWetSettings::cohesionTightness},
+        {"hair.wet.cohesion_radius", &CurlyWetSettings::cohesionRadius},
+        {"hair.wet.cohesion_stiffness", &CurlyWetSettings::cohesionStiffness},
+        {"hair.wet.adhesion", &CurlyWetSettings::adhesion},
+        {"hair.wet.adhesion_weight", &CurlyWetSettings::adhesionWeight},
+        {"hair.wet.adhesion_radius", &CurlyWetSettings::adhesionRadius},
+        {"hair.wet.global_stiffness", &CurlyWetSettings::globalStiffness},
+        {"hair.wet.wet_stiffness", &CurlyWetSettings::wetStiffness},
+        {"hair.wet.dry_stiffness", &CurlyWetSettings::dryStiffness},
+        {"hair.wet.stiffness_step", &CurlyWetSettings::stiffnessStep},
+    });
 
     if (s.adhesion && s.adhesionRadius <= 2.f * s.collisionRadius)
         scene.fail("hair.wet.adhesion_radius",

@@ -1,4 +1,5 @@
 #include "pipeline/scene/follower_settings.h"
+#include "pipeline/scene/key_fields.h"
 
 namespace hp {
 
@@ -11,11 +12,13 @@ FollowerSettings followerSettings(const Scene& s) {
                                      : FollowerMode::Varied;
     f.neighbours = s.text("hair.followers.neighbours") == "shape-similarity" ? NeighbourRule::ShapeSimilarity
                                                                              : NeighbourRule::Nearest;
-    f.fixedOffset = float(s.number("hair.followers.fixed_offset"));
-    f.maxVelocity = float(s.number("hair.followers.max_velocity"));
-    f.collide = s.flag("hair.followers.collide");
-    f.parallel = s.flag("hair.followers.parallel");
-    f.seed = uint32_t(s.integer("seed"));
+    readKeys(s, f, {
+        {"hair.followers.fixed_offset", &FollowerSettings::fixedOffset},
+        {"hair.followers.max_velocity", &FollowerSettings::maxVelocity},
+        {"hair.followers.collide", &FollowerSettings::collide},
+        {"hair.followers.parallel", &FollowerSettings::parallel},
+        {"seed", &FollowerSettings::seed},
+    });
     // Followers taper like the guides (hair.radius.*; the curly model has its own).
     f.rootRadius = float(s.number("hair.radius.root"));
     f.tipRadius = float(s.number("hair.radius.tip"));
@@ -24,15 +27,17 @@ FollowerSettings followerSettings(const Scene& s) {
 
 GroomModifiers groomModifiers(const Scene& s) {
     GroomModifiers m;
-    m.lengthVariation = float(s.number("hair.followers.length_variation"));
-    m.clump = float(s.number("hair.followers.clump"));
-    m.clumpProfile = float(s.number("hair.followers.clump_profile"));
-    m.clumps = uint32_t(s.integer("hair.followers.clumps"));
-    m.wave = float(s.number("hair.followers.wave"));
-    m.waveLength = float(s.number("hair.followers.wave_length"));
-    m.curl = float(s.number("hair.followers.curl"));
-    m.frizz = float(s.number("hair.followers.frizz"));
-    m.seed = uint32_t(s.integer("seed"));
+    readKeys(s, m, {
+        {"hair.followers.length_variation", &GroomModifiers::lengthVariation},
+        {"hair.followers.clump", &GroomModifiers::clump},
+        {"hair.followers.clump_profile", &GroomModifiers::clumpProfile},
+        {"hair.followers.clumps", &GroomModifiers::clumps},
+        {"hair.followers.wave", &GroomModifiers::wave},
+        {"hair.followers.wave_length", &GroomModifiers::waveLength},
+        {"hair.followers.curl", &GroomModifiers::curl},
+        {"hair.followers.frizz", &GroomModifiers::frizz},
+        {"seed", &GroomModifiers::seed},
+    });
     return m;
 }
 

@@ -1,4 +1,5 @@
 #include "pipeline/scene/preview_settings.h"
+#include "pipeline/scene/key_fields.h"
 
 namespace hp {
 
@@ -32,20 +33,24 @@ PreviewSettings makePreviewSettings(const Scene& s) {
     sh.resolution = int(s.integer("preview.shadow.resolution"));
     sh.filter = s.flag("preview.shadow.filter");
     sh.weight = s.text("preview.shadow.weight") == "fragments" ? VoxelWeight::Fragments : VoxelWeight::Crossings;
-    sh.alpha = float(s.number("preview.shadow.alpha"));
-    sh.shadowMap = s.flag("preview.shadow.map");
-    sh.shadowMapSize = int(s.integer("preview.shadow.map_size"));
-    sh.pcfRadius = int(s.integer("preview.shadow.pcf_radius"));
+    readKeys(s, sh, {
+        {"preview.shadow.alpha", &PreviewShadowSettings::alpha},
+        {"preview.shadow.map", &PreviewShadowSettings::shadowMap},
+        {"preview.shadow.map_size", &PreviewShadowSettings::shadowMapSize},
+        {"preview.shadow.pcf_radius", &PreviewShadowSettings::pcfRadius},
+    });
 
     GeneratedHairSettings& g = p.generated;
-    g.enabled = s.flag("preview.generated.enabled");
-    g.innerLevel = int(s.integer("preview.generated.inner_level"));
-    g.outerLevel = int(s.integer("preview.generated.outer_level"));
-    g.gravity = s.vec3f("preview.generated.gravity");
-    g.wind = s.vec3f("preview.generated.wind");
-    g.gust = float(s.number("preview.generated.gust"));
-    g.gustFrequency = float(s.number("preview.generated.gust_frequency"));
-    g.gustWavelength = float(s.number("preview.generated.gust_wavelength"));
+    readKeys(s, g, {
+        {"preview.generated.enabled", &GeneratedHairSettings::enabled},
+        {"preview.generated.inner_level", &GeneratedHairSettings::innerLevel},
+        {"preview.generated.outer_level", &GeneratedHairSettings::outerLevel},
+        {"preview.generated.gravity", &GeneratedHairSettings::gravity},
+        {"preview.generated.wind", &GeneratedHairSettings::wind},
+        {"preview.generated.gust", &GeneratedHairSettings::gust},
+        {"preview.generated.gust_frequency", &GeneratedHairSettings::gustFrequency},
+        {"preview.generated.gust_wavelength", &GeneratedHairSettings::gustWavelength},
+    });
     for (size_t i = 0; i < s.count("preview.generated.types"); ++i) {
         const std::string k = cat("preview.generated.types[", i, "].");
         HairType t;

@@ -1,4 +1,5 @@
 #include "pipeline/scene/sim_settings.h"
+#include "pipeline/scene/key_fields.h"
 
 #include "core/errors.h"
 
@@ -7,37 +8,39 @@ namespace hp {
 GuideSettings guideSettings(const Scene& scene) {
     GuideSettings s;
     s.formulation = parseFormulation(scene.text("simulation.formulation"));
-    s.segments = int(scene.integer("hair.guides.segments"));
-    s.length = float(scene.number("hair.guides.length"));
-    s.collisionRadius = float(scene.number("hair.guides.collision_radius"));
-    s.rootRadius = float(scene.number("hair.radius.root"));
-    s.tipRadius = float(scene.number("hair.radius.tip"));
-    s.timeStep = float(scene.number("simulation.time_step"));
-    s.substeps = int(scene.integer("simulation.substeps"));
-    s.iterations = int(scene.integer("simulation.iterations"));
-    s.friction = float(scene.number("simulation.friction"));
-    s.damping = float(scene.number("simulation.damping"));
-    s.gravity = scene.vec3f("simulation.gravity");
-    s.massPerLength = float(scene.number("simulation.mass_per_length"));
-    s.bendStiffness = float(scene.number("simulation.bend_stiffness"));
-    s.bendDamping = float(scene.number("simulation.bend_damping"));
-    s.youngsModulus = float(scene.number("hair.material.youngs_modulus"));
-    s.shearModulus = float(scene.number("hair.material.shear_modulus"));
-    s.density = float(scene.number("hair.material.density"));
-    s.hairsPerGuide = float(scene.number("hair.material.hairs_per_guide"));
-    s.rodSubsteps = int(scene.integer("simulation.rod_substeps"));
-    s.preload = scene.flag("simulation.preload");
-    s.headCollision = scene.flag("simulation.head_collision");
-    s.strandCollision = scene.flag("simulation.strand_collision");
-    s.strandsPerWorld = int(scene.integer("simulation.strands_per_world"));
-    s.bendLimit = float(scene.number("simulation.limits.bend"));
-    s.twistLimit = float(scene.number("simulation.limits.twist"));
-    s.limitStiffness = float(scene.number("simulation.limits.stiffness"));
-    s.projectionAngle = float(scene.number("simulation.limits.projection_angle"));
-    s.projectionDistance = float(scene.number("simulation.limits.projection_distance"));
-    s.teleportDistance = float(scene.number("simulation.cut_distance"));
-    s.teleportAngle = float(scene.number("simulation.cut_angle"));
-    s.maxSpeed = float(scene.number("simulation.max_speed"));
+    readKeys(scene, s, {
+        {"hair.guides.segments", &GuideSettings::segments},
+        {"hair.guides.length", &GuideSettings::length},
+        {"hair.guides.collision_radius", &GuideSettings::collisionRadius},
+        {"hair.radius.root", &GuideSettings::rootRadius},
+        {"hair.radius.tip", &GuideSettings::tipRadius},
+        {"simulation.time_step", &GuideSettings::timeStep},
+        {"simulation.substeps", &GuideSettings::substeps},
+        {"simulation.iterations", &GuideSettings::iterations},
+        {"simulation.friction", &GuideSettings::friction},
+        {"simulation.damping", &GuideSettings::damping},
+        {"simulation.gravity", &GuideSettings::gravity},
+        {"simulation.mass_per_length", &GuideSettings::massPerLength},
+        {"simulation.bend_stiffness", &GuideSettings::bendStiffness},
+        {"simulation.bend_damping", &GuideSettings::bendDamping},
+        {"hair.material.youngs_modulus", &GuideSettings::youngsModulus},
+        {"hair.material.shear_modulus", &GuideSettings::shearModulus},
+        {"hair.material.density", &GuideSettings::density},
+        {"hair.material.hairs_per_guide", &GuideSettings::hairsPerGuide},
+        {"simulation.rod_substeps", &GuideSettings::rodSubsteps},
+        {"simulation.preload", &GuideSettings::preload},
+        {"simulation.head_collision", &GuideSettings::headCollision},
+        {"simulation.strand_collision", &GuideSettings::strandCollision},
+        {"simulation.strands_per_world", &GuideSettings::strandsPerWorld},
+        {"simulation.limits.bend", &GuideSettings::bendLimit},
+        {"simulation.limits.twist", &GuideSettings::twistLimit},
+        {"simulation.limits.stiffness", &GuideSettings::limitStiffness},
+        {"simulation.limits.projection_angle", &GuideSettings::projectionAngle},
+        {"simulation.limits.projection_distance", &GuideSettings::projectionDistance},
+        {"simulation.cut_distance", &GuideSettings::teleportDistance},
+        {"simulation.cut_angle", &GuideSettings::teleportAngle},
+        {"simulation.max_speed", &GuideSettings::maxSpeed},
+    });
 
     const float segment = s.length / float(s.segments);
     if (2.f * s.collisionRadius >= segment)

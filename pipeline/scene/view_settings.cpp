@@ -1,4 +1,5 @@
 #include "pipeline/scene/view_settings.h"
+#include "pipeline/scene/key_fields.h"
 
 #include "core/errors.h"
 #include "render/hair_bsdf.h"
@@ -8,14 +9,16 @@ namespace hp {
 View makeView(const Scene& s) {
     View v;
     Camera& c = v.camera;
-    c.position = s.vec3f("render.camera.position");
-    c.target = s.vec3f("render.camera.target");
-    c.up = s.vec3f("render.camera.up");
-    c.fovY = float(s.number("render.camera.fov"));
-    c.width = int(s.integer("render.camera.width"));
-    c.height = int(s.integer("render.camera.height"));
-    c.nearClip = float(s.number("render.camera.near"));
-    c.farClip = float(s.number("render.camera.far"));
+    readKeys(s, c, {
+        {"render.camera.position", &Camera::position},
+        {"render.camera.target", &Camera::target},
+        {"render.camera.up", &Camera::up},
+        {"render.camera.fov", &Camera::fovY},
+        {"render.camera.width", &Camera::width},
+        {"render.camera.height", &Camera::height},
+        {"render.camera.near", &Camera::nearClip},
+        {"render.camera.far", &Camera::farClip},
+    });
     if ((c.target - c.position).norm() < 1e-6f) s.fail("render.camera.target", "must differ from the camera position");
     if ((c.target - c.position).normalized().cross(c.up).norm() < 1e-4f)
         s.fail("render.camera.up", "must not be parallel to the viewing direction");
@@ -41,17 +44,19 @@ View makeView(const Scene& s) {
     HairMaterial& h = v.hair;
     h.color = s.number("render.hair.melanin") >= 0 ? hairColorFromAbsorption(hairAbsorption(s), hairRoughness(s))
                                                     : s.vec3f("render.hair.color");
-    h.specularColor = s.vec3f("render.hair.specular_color");
-    h.kd = float(s.number("render.hair.kd"));
-    h.ks = float(s.number("render.hair.ks"));
-    h.shininess = float(s.number("render.hair.shininess"));
-    h.twoLobes = s.flag("render.hair.two_lobes");
-    h.primaryShift = float(s.number("render.hair.primary_shift"));
-    h.secondaryShift = float(s.number("render.hair.secondary_shift"));
-    h.secondaryKs = float(s.number("render.hair.secondary_ks"));
-    h.secondaryShininess = float(s.number("render.hair.secondary_shininess"));
-    h.secondaryColor = s.vec3f("render.hair.secondary_color");
-    h.transmittance = float(s.number("render.hair.transmittance"));
+    readKeys(s, h, {
+        {"render.hair.specular_color", &HairMaterial::specularColor},
+        {"render.hair.kd", &HairMaterial::kd},
+        {"render.hair.ks", &HairMaterial::ks},
+        {"render.hair.shininess", &HairMaterial::shininess},
+        {"render.hair.two_lobes", &HairMaterial::twoLobes},
+        {"render.hair.primary_shift", &HairMaterial::primaryShift},
+        {"render.hair.secondary_shift", &HairMaterial::secondaryShift},
+        {"render.hair.secondary_ks", &HairMaterial::secondaryKs},
+        {"render.hair.secondary_shininess", &HairMaterial::secondaryShininess},
+        {"render.hair.secondary_color", &HairMaterial::secondaryColor},
+        {"render.hair.transmittance", &HairMaterial::transmittance},
+    });
 
     v.head.color = s.vec3f("render.head.color");
     v.head.ambient = float(s.number("render.head.ambient"));

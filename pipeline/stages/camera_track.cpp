@@ -1,4 +1,5 @@
 #include "pipeline/stages/camera_track.h"
+#include "pipeline/scene/key_fields.h"
 
 #include "core/log.h"
 #include "pipeline/head/clip_cuts.h"
@@ -61,13 +62,15 @@ std::string cameraMode(const Scene& scene) {
 
 FramingSettings framingSettings(const Scene& scene) {
     FramingSettings f;
-    f.facing = scene.vec3f("render.camera.facing");
-    f.up = scene.vec3f("render.camera.up");
-    f.azimuthDegrees = float(scene.number("render.camera.azimuth"));
-    f.elevationDegrees = float(scene.number("render.camera.elevation"));
-    f.margin = float(scene.number("render.camera.margin"));
-    f.cutDistance = float(scene.number("simulation.cut_distance"));
-    f.cutAngleDegrees = float(scene.number("simulation.cut_angle"));
+    readKeys(scene, f, {
+        {"render.camera.facing", &FramingSettings::facing},
+        {"render.camera.up", &FramingSettings::up},
+        {"render.camera.azimuth", &FramingSettings::azimuthDegrees},
+        {"render.camera.elevation", &FramingSettings::elevationDegrees},
+        {"render.camera.margin", &FramingSettings::margin},
+        {"simulation.cut_distance", &FramingSettings::cutDistance},
+        {"simulation.cut_angle", &FramingSettings::cutAngleDegrees},
+    });
     if (f.facing.norm() < 1e-6f) scene.fail("render.camera.facing", "must be a non-zero direction");
     if (f.up.norm() < 1e-6f) scene.fail("render.camera.up", "must be a non-zero direction");
     return f;
