@@ -56,6 +56,17 @@ ColliderShape cup(ColliderShape::Kind kind, float R, float Ri, float H, float B,
     return s;
 }
 
+/// Roots on a sphere head along `dirs` (outward normals).
+std::vector<SurfaceFrame> sphereRoots(const Vec3f& centre, float radius, const std::vector<Vec3f>& dirs) {
+    std::vector<SurfaceFrame> roots(dirs.size());
+    for (size_t i = 0; i < dirs.size(); ++i) {
+        roots[i].position = centre + radius * dirs[i];
+        roots[i].normal = dirs[i];
+        roots[i].tangent = dirs[i].unitOrthogonal();
+    }
+    return roots;
+}
+
 }  // namespace
 
 TEST(CollisionWorld, SignedDistancesOfBulletPrimitivesMatchTheGeometry) {
@@ -123,12 +134,7 @@ TEST(CollisionWorld, HairOnAShoulderBoxStaysOnIt) {
         auto head = std::make_shared<SphereCollider>(headCentre, headRadius);
         pose.collider = withShoulders ? std::shared_ptr<const Collider>(std::make_shared<CompositeCollider>(head, posed))
                                       : std::shared_ptr<const Collider>(head);
-        std::vector<SurfaceFrame> roots(dirs.size());
-        for (size_t i = 0; i < dirs.size(); ++i) {
-            roots[i].position = headCentre + headRadius * dirs[i];
-            roots[i].normal = dirs[i];
-            roots[i].tangent = dirs[i].unitOrthogonal();
-        }
+        const std::vector<SurfaceFrame> roots = sphereRoots(headCentre, headRadius, dirs);
         solver.initialize(roots, pose);
         worstDepth = 0.f;
         worstStretch = 0.0;
@@ -300,12 +306,7 @@ TEST(CollisionWorld, NonConvexPropKeepsItsHollowWhereAHullFillsIt) {
         HeadPose pose;
         pose.transform = at(headCentre);
         pose.collider = std::make_shared<CompositeCollider>(std::make_shared<SphereCollider>(headCentre, headRadius), prop);
-        std::vector<SurfaceFrame> roots(dirs.size());
-        for (size_t i = 0; i < dirs.size(); ++i) {
-            roots[i].position = headCentre + headRadius * dirs[i];
-            roots[i].normal = dirs[i];
-            roots[i].tangent = dirs[i].unitOrthogonal();
-        }
+        const std::vector<SurfaceFrame> roots = sphereRoots(headCentre, headRadius, dirs);
         solver.initialize(roots, pose);
         worstDepth = 0.f;
         StrandFrame f;
