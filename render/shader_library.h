@@ -3,7 +3,7 @@
 //
 // Why embedded: users run the hairpipe binary from anywhere (a render farm
 // copies it around), so the sources are compiled into hp_render by a CMake
-// step (cmake/EmbedShaders.cmake). Setting HAIRPIPE_SHADER_DIR=<folder> makes
+// step (cmake/EmbedFiles.cmake). Setting HAIRPIPE_SHADER_DIR=<folder> makes
 // the preview read that folder instead, so a shader edit needs no rebuild.
 #pragma once
 

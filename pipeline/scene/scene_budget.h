@@ -1,4 +1,4 @@
-// Load-time resource budgets (the budget.* keys, scene_keys_budget.cpp).
+// Load-time resource budgets (the budget.* keys, pipeline/scene/keys/budget.yaml).
 //
 // Each key's own range stops a single absurd value (10^9 strands), but a
 // product of in-range keys can still ask for terabytes: a million guides of

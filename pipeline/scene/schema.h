@@ -3,8 +3,8 @@
 // overrides go through it, and docs/scene-reference.md is generated from it
 // (`hairpipe help scene`), so the reference can never drift from the code.
 //
-// Keys are registered per section in pipeline/scene_keys_*.cpp; a later stage
-// adds its keys in its own file and lists its function in schema.cpp.
+// The keys are data, pipeline/scene/keys/*.yaml (format: schema_yaml.h); a
+// later stage adds its keys in its own file and lists it in schema.cpp.
 #pragma once
 
 #include <limits>
@@ -52,6 +52,8 @@ class Schema {
 
     void add(KeySpec spec);
     void section(const std::string& path, const std::string& doc);
+    /// Sets a key's default (YAML text); throws std::logic_error if the key is unknown.
+    void setDefault(const std::string& path, std::string yaml);
 
     /// The key at a normalised path ("render.lights[].type"), or null.
     const KeySpec* find(const std::string& path) const;
@@ -73,34 +75,5 @@ class Schema {
 
 /// Replaces list indices by "[]": "render.lights[2].type" -> "render.lights[].type".
 std::string normalizeKeyPath(const std::string& path);
-
-/// Fluent helpers used by the scene_keys_*.cpp files.
-class SchemaBuilder {
-  public:
-    explicit SchemaBuilder(Schema& schema) : s_(schema) {}
-    SchemaBuilder& section(const std::string& path, const std::string& doc);
-    SchemaBuilder& flag(const std::string& path, bool def, const std::string& doc);
-    SchemaBuilder& integer(const std::string& path, long def, long min, long max, const std::string& unit,
-                           const std::string& doc);
-    SchemaBuilder& number(const std::string& path, double def, double min, double max, const std::string& unit,
-                          const std::string& doc);
-    SchemaBuilder& text(const std::string& path, const std::string& def, const std::string& doc);
-    SchemaBuilder& choice(const std::string& path, const std::string& def, std::vector<std::string> choices,
-                          const std::string& doc);
-    /// An input file; `def` empty means "none".
-    SchemaBuilder& file(const std::string& path, const std::string& def, const std::string& doc,
-                        bool required = false);
-    SchemaBuilder& vec3(const std::string& path, double x, double y, double z, const std::string& unit,
-                        const std::string& doc);
-    SchemaBuilder& frames(const std::string& path, const std::string& def, const std::string& doc);
-    SchemaBuilder& curve(const std::string& path, double def, double min, double max, const std::string& unit,
-                         const std::string& doc);
-    /// A list of maps; `defYaml` is the YAML default (e.g. "[{type: directional}]").
-    SchemaBuilder& list(const std::string& path, const std::string& defYaml, size_t maxItems,
-                        const std::string& doc);
-
-  private:
-    Schema& s_;
-};
 
 }  // namespace hp

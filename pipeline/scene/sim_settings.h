@@ -1,5 +1,5 @@
 // Maps the scene's simulation.* and guide shape keys onto sim/guides/guides.h's
-// GuideSettings (keys: pipeline/scene/scene_keys_sim.cpp).
+// GuideSettings (keys: pipeline/scene/keys/simulation.yaml).
 #pragma once
 
 #include "pipeline/scene/scene.h"
