@@ -1,6 +1,7 @@
 #include "render/embree_scene.h"
 
 #include "core/errors.h"
+#include "core/embree_ray.h"
 #include "core/log.h"
 
 #include <embree3/rtcore.h>
@@ -278,17 +279,7 @@ SceneHit EmbreeScene::intersect(const Vec3f& o, const Vec3f& d, float tnear, flo
     q.start = start;
     if (start.strand != kNoStrand) q.context.filter = skipOwnSurface;
 
-    RTCRayHit rh;
-    rh.ray.org_x = o.x(), rh.ray.org_y = o.y(), rh.ray.org_z = o.z();
-    rh.ray.dir_x = d.x(), rh.ray.dir_y = d.y(), rh.ray.dir_z = d.z();
-    rh.ray.tnear = tnear;
-    rh.ray.tfar = tfar;
-    rh.ray.time = 0.f;
-    rh.ray.mask = 0xffffffffu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    RTCRayHit rh = embree::rayHit(o, d, tnear, tfar);
     rtcIntersect1(impl_->scene, &q.context, &rh);
 
     SceneHit hit;
@@ -322,15 +313,7 @@ float EmbreeScene::transmittance(const Vec3f& o, const Vec3f& d, float tnear, fl
     else if (hairTransmittance >= 1.f) q.maxCrossings = std::numeric_limits<int>::max();
     else q.maxCrossings = std::max(1, int(std::ceil(std::log(1e-4f) / std::log(hairTransmittance))));
 
-    RTCRay ray;
-    ray.org_x = o.x(), ray.org_y = o.y(), ray.org_z = o.z();
-    ray.dir_x = d.x(), ray.dir_y = d.y(), ray.dir_z = d.z();
-    ray.tnear = tnear;
-    ray.tfar = tfar;
-    ray.time = 0.f;
-    ray.mask = 0xffffffffu;
-    ray.id = 0;
-    ray.flags = 0;
+    RTCRay ray = embree::ray(o, d, tnear, tfar);
     rtcOccluded1(impl_->scene, &q.context, &ray);
     if (ray.tfar < 0.f) return 0.f;  // an accepted hit: the head, opaque hair, or too many crossings
     return q.crossings == 0 ? 1.f : std::pow(hairTransmittance, float(q.crossings));

@@ -1,7 +1,8 @@
 // @brief The reference renderer's ray-tracing adapter: an Embree 3 scene of
 // one frame's strands (round Catmull-Rom curves with per-vertex radius) and
-// the head (triangles). embree_scene.cpp is the only file that includes
-// embree3/rtcore.h, so moving to Embree 4 touches nothing else.
+// the head (triangles). embree_scene.cpp is the only render file that
+// includes embree3/rtcore.h (with core/embree_ray.h, the ray set-up it shares
+// with sim/collision/mesh_query.cpp), so moving to Embree 4 touches only those.
 //
 // Notes on why:
 // - Catmull-Rom interpolates the strand vertices, so the reference tube goes

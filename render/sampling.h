@@ -9,6 +9,8 @@
 // the count is a power of two) and stratified pairs in every later dimension.
 #pragma once
 
+#include "core/hash.h"
+
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -17,15 +19,8 @@
 
 namespace hp::sampling {
 
-/// 64-bit finaliser (splitmix64): a bijective avalanche mix.
-inline uint64_t mix64(uint64_t x) {
-    x ^= x >> 30;
-    x *= 0xbf58476d1ce4e5b9ull;
-    x ^= x >> 27;
-    x *= 0x94d049bb133111ebull;
-    x ^= x >> 31;
-    return x;
-}
+/// 64-bit finaliser (splitmix64, core/hash.h): a bijective avalanche mix.
+inline uint64_t mix64(uint64_t x) { return hash::splitMix64(x); }
 
 /// Order-dependent combination of a hash with one more value.
 inline uint64_t hashCombine(uint64_t h, uint64_t v) { return mix64(h ^ (v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2))); }

@@ -4,6 +4,7 @@
 
 #include "sim/curly/curly_wet.h"
 #include "sim/strands/head.h"
+#include "sim/strands/sphere_roots.h"
 
 #include <functional>
 #include <memory>
@@ -29,18 +30,11 @@ class MovingSphere final : public HeadMotion {
     std::function<Vec3f(double)> path_;
 };
 
-/// Root frames of head-fixed directions on a sphere of `radius`, posed.
+/// Root frames of head-fixed directions on a sphere of `radius`, posed
+/// (sim/strands/sphere_roots.h; a root at the pole gets tangent +X, as
+/// bench_curly's).
 inline std::vector<SurfaceFrame> rootFrames(const std::vector<Vec3f>& dirs, const HeadPose& pose, float radius) {
-    std::vector<SurfaceFrame> roots(dirs.size());
-    for (size_t i = 0; i < dirs.size(); ++i) {
-        const Vec3f n = dirs[i];
-        Vec3f t = Vec3f::UnitY().cross(n);
-        if (t.squaredNorm() < 1e-8f) t = Vec3f::UnitX();
-        roots[i].position = pose.transform * (radius * n);
-        roots[i].normal = pose.transform.linear() * n;
-        roots[i].tangent = pose.transform.linear() * t.normalized();
-    }
-    return roots;
+    return sphereRootFrames(dirs, radius, pose, Vec3f::UnitX());
 }
 
 /// Runs `steps` steps of `head`; calls `each` after every step.

@@ -5,6 +5,7 @@
 #include "pipeline/scene/scene.h"
 #include "pipeline/scene/sim_settings.h"
 #include "sim/strands/fibonacci.h"
+#include "sim/strands/sphere_roots.h"
 #include "sim/guides/guides.h"
 #include "sim/guides/rod_kernels.h"
 
@@ -16,20 +17,6 @@
 using namespace hp;
 
 namespace {
-
-/// Root frames of guides on a sphere head of `radius` posed by `pose`.
-std::vector<SurfaceFrame> sphereRoots(const std::vector<Vec3f>& dirs, float radius, const HeadPose& pose) {
-    std::vector<SurfaceFrame> roots(dirs.size());
-    for (size_t i = 0; i < dirs.size(); ++i) {
-        const Vec3f& n = dirs[i];
-        Vec3f t = Vec3f::UnitY().cross(n);
-        t = t.squaredNorm() > 1e-8f ? Vec3f(t.normalized()) : Vec3f(n.unitOrthogonal());
-        roots[i].position = pose.transform * (radius * n);
-        roots[i].normal = pose.transform.linear() * n;
-        roots[i].tangent = pose.transform.linear() * t;
-    }
-    return roots;
-}
 
 /// A head pose with no mesh or collider (free strands).
 HeadPose noHead(double time, const Eigen::Isometry3f& transform = Eigen::Isometry3f::Identity()) {
@@ -44,10 +31,10 @@ template <typename Check>
 void runSphere(GuideSolver& solver, const std::vector<Vec3f>& dirs, float rate, int steps, Check&& check) {
     SpinningSphere head(0.1f, rate);
     HeadPose pose = head.sample(0.0);
-    solver.initialize(sphereRoots(dirs, 0.1f, pose), pose);
+    solver.initialize(sphereRootFrames(dirs, 0.1f, pose), pose);
     for (int k = 1; k <= steps; ++k) {
         pose = head.sample(solver.nextTime());
-        check(solver.step(sphereRoots(dirs, 0.1f, pose), pose), pose, k);
+        check(solver.step(sphereRootFrames(dirs, 0.1f, pose), pose), pose, k);
     }
 }
 
@@ -184,10 +171,10 @@ TEST(Guides, PreloadHoldsTheRestShapeUnderGravity) {
     const std::vector<Vec3f> dirs = fibonacciCap(16);
     SpinningSphere head(0.1f, 0.f);  // still head: nothing should move
     const HeadPose pose = head.sample(0.0);
-    solver.initialize(sphereRoots(dirs, 0.1f, pose), pose);
+    solver.initialize(sphereRootFrames(dirs, 0.1f, pose), pose);
     StrandFrame start, end;
     solver.write(start);
-    for (int k = 1; k <= 100; ++k) solver.step(sphereRoots(dirs, 0.1f, head.sample(k * 0.02)), head.sample(k * 0.02));
+    for (int k = 1; k <= 100; ++k) solver.step(sphereRootFrames(dirs, 0.1f, head.sample(k * 0.02)), head.sample(k * 0.02));
     solver.write(end);
     float drift = 0;
     for (size_t i = 0; i < start.positions.size(); ++i)
@@ -197,9 +184,9 @@ TEST(Guides, PreloadHoldsTheRestShapeUnderGravity) {
     GuideSettings off = s;
     off.preload = false;
     GuideSolver sagging(off);
-    sagging.initialize(sphereRoots(dirs, 0.1f, pose), pose);
+    sagging.initialize(sphereRootFrames(dirs, 0.1f, pose), pose);
     for (int k = 1; k <= 100; ++k)
-        sagging.step(sphereRoots(dirs, 0.1f, head.sample(k * 0.02)), head.sample(k * 0.02));
+        sagging.step(sphereRootFrames(dirs, 0.1f, head.sample(k * 0.02)), head.sample(k * 0.02));
     sagging.write(end);
     drift = 0;
     for (size_t i = 0; i < start.positions.size(); ++i)
@@ -256,13 +243,13 @@ TEST(Guides, StableOverTenThousandStepsWithATeleport) {
         return p;
     };
     HeadPose pose = poseAt(0);
-    solver.initialize(sphereRoots(dirs, 0.1f, pose), pose);
+    solver.initialize(sphereRootFrames(dirs, 0.1f, pose), pose);
     double peak = 0;
     int resets = 0;
     for (int k = 1; k <= 10000; ++k) {
         if (k == 5000) offset.translation() = Vec3f(2.f, 0.5f, -1.f);  // a scene cut
         pose = poseAt(k);
-        const StepStats& st = solver.step(sphereRoots(dirs, 0.1f, pose), pose);
+        const StepStats& st = solver.step(sphereRootFrames(dirs, 0.1f, pose), pose);
         ASSERT_EQ(st.nanCount, 0u) << "step " << k;
         ASSERT_LE(st.maxLengthError, 1e-3) << "step " << k;
         ASSERT_LE(st.maxPenetration, 1e-3) << "step " << k << " pinned " << st.pinnedCount;

@@ -5,6 +5,7 @@
 // and frames are bit-identical across runs.
 #include "gl_support.h"
 #include "kajiya_kay_oracle.h"
+#include "render_support.h"
 #include "test_support.h"
 
 #include "core/errors.h"
@@ -18,19 +19,6 @@
 
 namespace hp {
 namespace {
-
-/// A camera at (0, 0, 1) looking at the origin, small image.
-View testView(int w = 320, int h = 240) {
-    View v;
-    v.camera.position = Vec3f(0.f, 0.f, 1.f);
-    v.camera.target = Vec3f::Zero();
-    v.camera.fovY = 40.f;
-    v.camera.width = w;
-    v.camera.height = h;
-    v.lights = {Light{}};
-    v.lights[0].direction = Vec3f(-1.f, -1.f, -1.f);
-    return v;
-}
 
 /// Focal length in pixels of a view's camera.
 float focalPixels(const View& v) { return 0.5f * float(v.camera.height) / std::tan(0.5f * v.camera.fovY * float(M_PI) / 180.f); }
@@ -82,7 +70,7 @@ TEST(Preview, ShadersCompileAndLink) {
     PreviewRenderer renderer(s);
     StrandFrame f;
     addLine(f, Vec3f(-0.1f, 0.f, 0.f), Vec3f(0.1f, 0.f, 0.f), 0.001f, 5);
-    const View v = testView(64, 48);
+    const View v = test::frontView(64, 48);
     PreviewFrame frame;
     frame.strands = &f;
     for (bool perFragment : {false, true}) {
@@ -119,7 +107,7 @@ TEST(Preview, MissingGlIsAClearError) {
 /// sub-pixel ones (minimum width + alpha), with both curve types.
 TEST(Preview, CoverageMatchesProjectedArea) {
     HP_REQUIRE_GL();
-    const View v = testView(320, 240);
+    const View v = test::frontView(320, 240);
     const float f = focalPixels(v);  // strands lie at depth 1: 1 m = f pixels
     for (float widthPx : {4.f, 0.3f}) {
         for (CurveType curve : {CurveType::CatmullRom, CurveType::BSpline}) {
@@ -150,7 +138,7 @@ TEST(Preview, CoverageMatchesProjectedArea) {
 /// per vertex and per fragment, one and two lobes.
 TEST(Preview, KajiyaKayMatchesCpuReference) {
     HP_REQUIRE_GL();
-    View v = testView(320, 240);
+    View v = test::frontView(320, 240);
     v.lights[0].direction = Vec3f(-0.3f, -1.f, -0.6f);
     v.lights[0].intensity = 2.f;
     const float f = focalPixels(v);
@@ -192,7 +180,7 @@ TEST(Preview, KajiyaKayMatchesCpuReference) {
 /// use an orthographic light box, point lights a perspective frustum.
 TEST(Preview, VoxelShadowsDarkenStrandBehindSlab) {
     HP_REQUIRE_GL();
-    View v = testView(320, 240);
+    View v = test::frontView(320, 240);
     v.camera.position = Vec3f(0.f, 0.f, -1.f);  // looks at the lit strand from behind the slab's shadow side
     StrandFrame strands;
     for (int i = 0; i < 120; ++i)
@@ -236,7 +224,7 @@ TEST(Preview, VoxelShadowsDarkenStrandBehindSlab) {
 /// The head's shadow map darkens hair in the head's shadow.
 TEST(Preview, ShadowMapDarkensHairBehindHead) {
     HP_REQUIRE_GL();
-    View v = testView(320, 240);
+    View v = test::frontView(320, 240);
     v.camera.position = Vec3f(0.f, 0.f, -1.f);
     v.lights[0].direction = Vec3f(0.f, 0.f, -1.f);
     const TriangleMesh head = makeSphereMesh(Vec3f(0.f, 0.f, 0.1f), 0.05f, 16, 32);
@@ -322,7 +310,7 @@ std::vector<float> cpuVoxelize(const std::vector<std::pair<Vec3f, Vec3f>>& lines
 // light, sum of 2 r |segment| sin(theta) (theta between strand and light).
 TEST(Preview, VoxelCrossingsAddUpToProjectedArea) {
     HP_REQUIRE_GL();
-    View v = testView(64, 48);
+    View v = test::frontView(64, 48);
     v.lights[0].direction = Vec3f(0.f, 0.f, -1.f);
     StrandFrame strands;
     uint32_t seed = 777;
@@ -364,7 +352,7 @@ TEST(Preview, VoxelCrossingsAddUpToProjectedArea) {
 
 TEST(Preview, VoxelTransmittanceMatchesCpuVoxelization) {
     HP_REQUIRE_GL();
-    View v = testView(64, 48);
+    View v = test::frontView(64, 48);
     v.lights[0].direction = Vec3f(0.f, 0.f, -1.f);  // the grid's u, v follow world x, y
     StrandFrame strands;
     std::vector<std::pair<Vec3f, Vec3f>> lines;
@@ -431,7 +419,7 @@ TEST(Preview, VoxelTransmittanceMatchesCpuVoxelization) {
 /// triangle, and bends with the force.
 TEST(Preview, GeneratedHairGrowsOnRegionAndBends) {
     HP_REQUIRE_GL();
-    View v = testView(240, 180);
+    View v = test::frontView(240, 180);
     v.camera.position = Vec3f(0.f, 0.f, 0.6f);
     const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 12, 24);
     PreviewSettings s = noShadows();
@@ -508,7 +496,7 @@ TEST(Preview, IdenticalImagesAcrossRuns) {
     hs.strands = 3000;
     const StrandFrame strands = makeSyntheticHair(hs);
     const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
-    View v = testView(240, 180);
+    View v = test::frontView(240, 180);
     v.camera.position = Vec3f(0.f, 0.05f, 0.9f);
     PreviewSettings s;
     s.shadow.resolution = 64;

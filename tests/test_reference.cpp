@@ -3,6 +3,7 @@
 // against projected width, shadow transmittance, determinism across thread
 // counts, no memory growth across frames, clear errors.
 #include "kajiya_kay_oracle.h"
+#include "render_support.h"
 #include "test_support.h"
 
 #include "core/errors.h"
@@ -24,16 +25,10 @@ using namespace hp::test;
 
 namespace {
 
-/// Camera at (0, 0, 1) looking at the origin, one directional light.
+/// frontView (camera at (0, 0, 1) looking at the origin) with a warm light
+/// of intensity 2 and a black environment.
 View testView(int width, int height, const Vec3f& lightDirection) {
-    View v;
-    v.camera.position = Vec3f(0.f, 0.f, 1.f);
-    v.camera.target = Vec3f::Zero();
-    v.camera.fovY = 40.f;
-    v.camera.width = width;
-    v.camera.height = height;
-    v.lights = {Light{}};
-    v.lights[0].direction = lightDirection;
+    View v = frontView(width, height, lightDirection);
     v.lights[0].intensity = 2.f;
     v.lights[0].color = Vec3f(1.f, 0.9f, 0.8f);
     v.environment = Vec3f::Zero();

@@ -12,6 +12,7 @@
 #include "render/gl_context.h"
 #include "render/preview.h"
 #include "render/reference.h"
+#include "render/simple_view.h"
 #include "sim/strands/synthetic.h"
 
 #include <cstdlib>
@@ -39,14 +40,8 @@ Image renderPreview(const std::string& name, const View& view, const StrandFrame
 /// The default scene's look, scaled down: a sphere head of radius 0.1 m with
 /// synthetic drooping hair, seen from the front-right and lit from the upper right.
 View smallView(int w, int h) {
-    View v;
-    v.camera.position = Vec3f(0.42f, 0.08f, 0.62f) * 1.1f;
-    v.camera.target = Vec3f(0.f, -0.04f, -0.02f);
-    v.camera.fovY = 38.f;
-    v.camera.width = w;
-    v.camera.height = h;
-    v.lights = {Light{}};
-    v.lights[0].direction = Vec3f(-1.f, -1.f, -1.f);
+    View v = simpleView(Vec3f(0.42f, 0.08f, 0.62f) * 1.1f, Vec3f(0.f, -0.04f, -0.02f), 38.f, w, h,
+                        Vec3f(-1.f, -1.f, -1.f));
     v.lights[0].intensity = 3.f;
     return v;
 }
@@ -160,14 +155,7 @@ TEST(RenderParity, ThreePointRigAndSkinMatch) {
 // pixels are the same with and without that hair.
 TEST(RenderParity, HairBehindHeadIsHidden) {
     HP_REQUIRE_GL();
-    View view;
-    view.camera.position = Vec3f(0.f, 0.f, 0.6f);
-    view.camera.target = Vec3f::Zero();
-    view.camera.fovY = 30.f;
-    view.camera.width = 96;
-    view.camera.height = 96;
-    view.lights = {Light{}};
-    view.lights[0].direction = Vec3f(0.f, 0.f, -1.f);
+    View view = simpleView(Vec3f(0.f, 0.f, 0.6f), Vec3f::Zero(), 30.f, 96, 96, Vec3f(0.f, 0.f, -1.f));
     view.hair.color = Vec3f(1.f, 0.f, 0.f);
     view.hair.specularColor = Vec3f(1.f, 0.f, 0.f);
     StrandFrame hair;

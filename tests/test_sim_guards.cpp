@@ -5,6 +5,7 @@
 #include "pipeline/scene/scene.h"
 #include "pipeline/scene/sim_settings.h"
 #include "sim/strands/fibonacci.h"
+#include "sim/strands/sphere_roots.h"
 #include "sim/guides/guides.h"
 
 #include <gtest/gtest.h>
@@ -33,16 +34,7 @@ HeadPose shaken(double t) {
 }
 
 std::vector<SurfaceFrame> roots(const std::vector<Vec3f>& dirs, const HeadPose& pose) {
-    std::vector<SurfaceFrame> out(dirs.size());
-    for (size_t i = 0; i < dirs.size(); ++i) {
-        const Vec3f& n = dirs[i];
-        Vec3f t = Vec3f::UnitY().cross(n);
-        t = t.squaredNorm() > 1e-8f ? Vec3f(t.normalized()) : Vec3f(n.unitOrthogonal());
-        out[i].position = pose.transform * (kRadius * n);
-        out[i].normal = pose.transform.linear() * n;
-        out[i].tangent = pose.transform.linear() * t;
-    }
-    return out;
+    return sphereRootFrames(dirs, kRadius, pose);
 }
 
 float maxSpeed(const StrandFrame& f) {

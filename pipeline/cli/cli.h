@@ -5,6 +5,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hp {
@@ -28,7 +29,12 @@ struct OptionSpec {
     std::string help;
 };
 
+/// @brief A command: its help text, options and handler. Each command's
+/// function (commands.h) writes `CommandSpec c{name, usage, summary};` and
+/// sets what else it has.
 struct CommandSpec {
+    CommandSpec(std::string commandName, std::string usageLine, std::string summaryLine)
+        : name(std::move(commandName)), usage(std::move(usageLine)), summary(std::move(summaryLine)) {}
     std::string name;
     std::string usage;     ///< "[options] scene.yaml"
     std::string summary;

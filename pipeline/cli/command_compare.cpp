@@ -142,10 +142,8 @@ int runCompare(const CommandLine& cl) {
 }  // namespace
 
 CommandSpec compareCommandSpec() {
-    CommandSpec c;
-    c.name = "compare";
-    c.usage = "[options] A B   (or: --scene scene.yaml [A B])";
-    c.summary = "compare two image sequences: FLIP, SSIM, PSNR, RMSE, difference images, HTML report";
+    CommandSpec c{"compare", "[options] A B   (or: --scene scene.yaml [A B])",
+                  "compare two image sequences: FLIP, SSIM, PSNR, RMSE, difference images, HTML report"};
     c.details =
         "A and B are frame templates (render.####.exr or render.%04d.exr), e.g. the preview\n"
         "against the Embree reference, another renderer, or yesterday's output; any\n"

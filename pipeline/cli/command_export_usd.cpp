@@ -16,10 +16,8 @@ namespace fs = std::filesystem;
 namespace hp {
 
 CommandSpec exportUsdCommandSpec() {
-    CommandSpec c;
-    c.name = "export-usd";
-    c.usage = "[--output FILE] [options] scene.yaml";
-    c.summary = "write the shot's strands from the cache as one animated USD BasisCurves file";
+    CommandSpec c{"export-usd", "[--output FILE] [options] scene.yaml",
+                  "write the shot's strands from the cache as one animated USD BasisCurves file"};
     c.details =
         "Reads the strand cache (run `hairpipe sim` first) of the shot's frames (or --frames)\n"
         "and writes one .usda: curveVertexCounts once, points, velocities and widths as time\n"

@@ -12,15 +12,6 @@ namespace hp {
 
 namespace {
 
-long integerOption(const CommandLine& cl, const std::string& option, long lo, long hi) {
-    const std::string text = cl.value(option);
-    char* end = nullptr;
-    const long n = std::strtol(text.c_str(), &end, 10);
-    if (text.empty() || *end != '\0' || n < lo || n > hi)
-        throw UsageError(cat("option ", option, " expects an integer in [", lo, ", ", hi, "], got '", text, "'"));
-    return n;
-}
-
 int submit(const CommandLine& cl) {
     const std::string engine = cl.value("--engine", "slurm");
     if (engine != "slurm" && engine != "local")
@@ -71,10 +62,8 @@ int status(const CommandLine& cl) {
 }  // namespace
 
 CommandSpec farmCommandSpec() {
-    CommandSpec c;
-    c.name = "farm";
-    c.usage = "submit|status [options] scene.yaml";
-    c.summary = "run a shot as farm jobs (Slurm, or locally) and report its progress";
+    CommandSpec c{"farm", "submit|status [options] scene.yaml",
+                  "run a shot as farm jobs (Slurm, or locally) and report its progress"};
     c.details =
         "farm submit: writes a plan into <output>/farm/ and runs it. The plan is one\n"
         "simulation job (hairpipe sim, the strand cache), a job array of frame chunks\n"

@@ -62,10 +62,8 @@ void printSummary(const Scene& scene, const ShotSettings& shot) {
 }  // namespace
 
 CommandSpec simCommandSpec() {
-    CommandSpec c;
-    c.name = "sim";
-    c.usage = "[options] scene.yaml";
-    c.summary = "simulate the shot and write the strand cache, statistics and checkpoints";
+    CommandSpec c{"sim", "[options] scene.yaml",
+                  "simulate the shot and write the strand cache, statistics and checkpoints"};
     c.details =
         "The simulation is sequential from the scene's first frame. Frames already in the\n"
         "cache are skipped; a stopped simulation resumes from its latest checkpoint with\n"

@@ -4,25 +4,20 @@
 namespace hp {
 
 CommandSpec vdbCommandSpec() {
-    CommandSpec c;
-    c.name = "vdb";
-    c.usage = "[options] scene.yaml";
-    c.summary = "write the OpenVDB density caches (one .vdb per frame)";
+    CommandSpec c{"vdb", "[options] scene.yaml", "write the OpenVDB density caches (one .vdb per frame)"};
     c.details =
         "Voxelizes each frame's strands into a fog-volume grid named 'density' (hair volume\n"
         "fraction, m^3 of hair per m^3) at vdb.voxel_size, optionally with a 'velocity' grid,\n"
         "and writes vdb.output (default vdb/hair.####.vdb) under the output folder. Frames\n"
         "whose file exists are skipped unless --force. The scene must set vdb.enabled: true\n"
         "(or pass --set vdb.enabled=true).";
-    c.options = {{"--jobs", "N", "write N frames at once in child processes (simulating missing cache frames first)"},
-                 {"--chunk", "N", "--jobs: frames per child process"}};
-    c.run = [](const CommandLine& cl) {
-        CommandContext ctx(cl);
+    c.options = jobOptions("write N frames at once in child processes (simulating missing cache frames first)");
+    c.run = runStages([](const CommandContext& ctx, const CommandLine&) {
         if (!ctx.scene.flag("vdb.enabled"))
             throw UsageError(cat("hairpipe vdb: ", ctx.scene.name(),
                                  " has vdb.enabled: false; enable it in the scene or pass --set vdb.enabled=true"));
-        return runShotCommand(ctx, {"vdb"});
-    };
+        return std::set<std::string>{"vdb"};
+    });
     return c;
 }
 

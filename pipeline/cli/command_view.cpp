@@ -54,22 +54,11 @@ class SourceFrames {
     int current_ = INT_MIN;
 };
 
-long intOption(const CommandLine& cl, const std::string& option, long min, long max) {
-    const std::string text = cl.value(option);
-    char* end = nullptr;
-    const long n = std::strtol(text.c_str(), &end, 10);
-    if (text.empty() || *end != '\0' || n < min || n > max)
-        throw UsageError(cat("option ", option, " expects an integer in [", min, ", ", max, "], got '", text, "'"));
-    return n;
-}
-
 }  // namespace
 
 CommandSpec viewCommandSpec() {
-    CommandSpec c;
-    c.name = "view";
-    c.usage = "[options] scene.yaml";
-    c.summary = "show the GL preview in a window: play, scrub, orbit, toggle shadows";
+    CommandSpec c{"view", "[options] scene.yaml",
+                  "show the GL preview in a window: play, scrub, orbit, toggle shadows"};
     c.details =
         "Keys: space play/pause, left/right step, home/end, V voxel shadows, M shadow map,\n"
         "B voxel mode (binary-nearest, additive-nearest, additive-trilinear), S sum along\n"
@@ -97,7 +86,7 @@ CommandSpec viewCommandSpec() {
         options.frames = shot.frames;
         options.fps = shot.fps;
         options.play = !cl.has("--paused");
-        if (cl.has("--exit-after")) options.exitAfter = int(intOption(cl, "--exit-after", 1, 1000000));
+        if (cl.has("--exit-after")) options.exitAfter = int(integerOption(cl, "--exit-after", 1, 1000000));
         if (cl.has("--screenshot")) {
             if (!options.exitAfter) throw UsageError("option --screenshot needs --exit-after N");
             options.screenshot = cl.value("--screenshot");
@@ -113,7 +102,7 @@ CommandSpec viewCommandSpec() {
         TriangleMesh sphere;
         if (cl.has("--synthetic")) {
             SyntheticHairSettings hs;
-            hs.strands = size_t(intOption(cl, "--synthetic", 1, 10000000));
+            hs.strands = size_t(integerOption(cl, "--synthetic", 1, 10000000));
             synthetic = makeSyntheticHair(hs);
             sphere = makeSphereMesh(Vec3f::Zero(), hs.headRadius, 32, 64);
         }

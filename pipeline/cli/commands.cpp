@@ -51,20 +51,11 @@ std::string sceneArgument(const CommandLine& cl) {
     return cl.positional[0];
 }
 
-long positiveInteger(const CommandLine& cl, const std::string& option, long max) {
-    const std::string text = cl.value(option);
-    char* end = nullptr;
-    const long n = std::strtol(text.c_str(), &end, 10);
-    if (text.empty() || *end != '\0' || n < 1 || n > max)
-        throw UsageError(cat("option ", option, " expects an integer in [1, ", max, "], got '", text, "'"));
-    return n;
-}
-
 /// --jobs, --chunk (run, render, vdb) and --stages, --cache-only,
 /// --no-report (run); a command that does not list one never sees it.
 void parseBatchOptions(const CommandLine& cl, RunOptions& options) {
-    if (cl.has("--jobs")) options.jobs = int(positiveInteger(cl, "--jobs", 256));
-    if (cl.has("--chunk")) options.chunk = int(positiveInteger(cl, "--chunk", 1000000));
+    if (cl.has("--jobs")) options.jobs = int(integerOption(cl, "--jobs", 1, 256));
+    if (cl.has("--chunk")) options.chunk = int(integerOption(cl, "--chunk", 1, 1000000));
     options.cacheOnly = cl.has("--cache-only");
     options.noReport = cl.has("--no-report");
     if (cl.has("--stages")) {
@@ -87,6 +78,15 @@ void parseBatchOptions(const CommandLine& cl, RunOptions& options) {
 
 }  // namespace
 
+long integerOption(const CommandLine& cl, const std::string& option, long lo, long hi) {
+    const std::string text = cl.value(option);
+    char* end = nullptr;
+    const long n = std::strtol(text.c_str(), &end, 10);
+    if (text.empty() || *end != '\0' || n < lo || n > hi)
+        throw UsageError(cat("option ", option, " expects an integer in [", lo, ", ", hi, "], got '", text, "'"));
+    return n;
+}
+
 CommandContext::CommandContext(const CommandLine& cl) {
     std::vector<std::string> sets;
     if (cl.has("--set")) sets = cl.values.at("--set");
@@ -98,7 +98,7 @@ CommandContext::CommandContext(const CommandLine& cl) {
         sets.push_back("seed=" + seed);
     }
     if (cl.has("--threads")) {
-        const long n = positiveInteger(cl, "--threads", 1024);
+        const long n = integerOption(cl, "--threads", 1, 1024);
         threads_ = std::make_shared<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(n));
         options.threads = int(n);
     }
@@ -147,11 +147,19 @@ int runShotCommand(const CommandContext& ctx, const std::set<std::string>& only)
     return report.failures.empty() ? kExitOk : kExitFrameFailed;
 }
 
+std::function<int(const CommandLine&)> runStages(StageChoice choose) {
+    return [choose](const CommandLine& cl) {
+        CommandContext ctx(cl);
+        return runShotCommand(ctx, choose(ctx, cl));
+    };
+}
+
+std::vector<OptionSpec> jobOptions(const std::string& jobs, const std::string& chunk) {
+    return {{"--jobs", "N", jobs}, {"--chunk", "N", chunk}};
+}
+
 CommandSpec runCommandSpec() {
-    CommandSpec c;
-    c.name = "run";
-    c.usage = "[options] scene.yaml";
-    c.summary = "run every stage the scene enables, frame by frame";
+    CommandSpec c{"run", "[options] scene.yaml", "run every stage the scene enables, frame by frame"};
     c.details =
         "Frames whose outputs all exist are skipped (use --force to redo them), so an\n"
         "interrupted batch resumes where it stopped. Each file is written under a\n"
@@ -160,46 +168,36 @@ CommandSpec runCommandSpec() {
         "frame stages run in N child processes at a time, each a chunk of frames read\n"
         "from the cache; outputs are identical to --jobs 1. --stages, --cache-only and\n"
         "--no-report run one chunk of a larger run (what --jobs and farm tasks run).";
-    c.options = {
-        {"--jobs", "N", "run the frame stages in N processes at once (after the simulation)"},
-        {"--chunk", "N", "--jobs: frames per child process (default: about 4 chunks per job)"},
+    c.options = jobOptions("run the frame stages in N processes at once (after the simulation)",
+                           "--jobs: frames per child process (default: about 4 chunks per job)");
+    c.options.insert(c.options.end(), {
         {"--stages", "LIST", "run only these stages, e.g. preview,vdb (sim, preview, reference, vdb, compare)"},
         {"--cache-only", "", "read strands only from the strand cache; a frame without one fails"},
         {"--no-report", "", "skip whole-run outputs (the compare report): for one chunk of a larger run"},
-    };
-    c.run = [](const CommandLine& cl) {
-        CommandContext ctx(cl);
-        return runShotCommand(ctx, ctx.options.only);
-    };
+    });
+    c.run = runStages([](const CommandContext& ctx, const CommandLine&) { return ctx.options.only; });
     return c;
 }
 
 CommandSpec renderCommandSpec() {
-    CommandSpec c;
-    c.name = "render";
-    c.usage = "[--preview] [--reference] [options] scene.yaml";
-    c.summary = "render preview (GL) and/or reference (Embree) frames";
+    CommandSpec c{"render", "[--preview] [--reference] [options] scene.yaml",
+                  "render preview (GL) and/or reference (Embree) frames"};
     c.details = "Without --preview or --reference, renders whichever of the two the scene enables.";
-    c.options = {{"--preview", "", "render the GL preview"},
-                 {"--reference", "", "render the Embree reference"},
-                 {"--jobs", "N", "render N frames at once in child processes (simulating missing cache frames first)"},
-                 {"--chunk", "N", "--jobs: frames per child process"}};
-    c.run = [](const CommandLine& cl) {
-        CommandContext ctx(cl);
+    c.options = {{"--preview", "", "render the GL preview"}, {"--reference", "", "render the Embree reference"}};
+    for (const OptionSpec& o : jobOptions("render N frames at once in child processes (simulating missing cache frames first)"))
+        c.options.push_back(o);
+    c.run = runStages([](const CommandContext&, const CommandLine& cl) {
         std::set<std::string> only;
         if (cl.has("--preview")) only.insert("preview");
         if (cl.has("--reference")) only.insert("reference");
         if (only.empty()) only = {"preview", "reference"};
-        return runShotCommand(ctx, only);
-    };
+        return only;
+    });
     return c;
 }
 
 CommandSpec validateCommandSpec() {
-    CommandSpec c;
-    c.name = "validate";
-    c.usage = "[options] scene.yaml";
-    c.summary = "check a scene file (types, ranges, files) without running it";
+    CommandSpec c{"validate", "[options] scene.yaml", "check a scene file (types, ranges, files) without running it"};
     c.run = [](const CommandLine& cl) {
         CommandContext ctx(cl);
         resolveShot(ctx.scene, ctx.options);
@@ -239,10 +237,8 @@ void printClipCuts(const Scene& scene, const ShotSettings& shot) {
 }  // namespace
 
 CommandSpec infoCommandSpec() {
-    CommandSpec c;
-    c.name = "info";
-    c.usage = "[options] scene.yaml";
-    c.summary = "print what a scene resolves to (frames, assets, strand counts, every key)";
+    CommandSpec c{"info", "[options] scene.yaml",
+                  "print what a scene resolves to (frames, assets, strand counts, every key)"};
     c.run = [](const CommandLine& cl) {
         CommandContext ctx(cl);
         const ShotSettings shot = resolveShot(ctx.scene, ctx.options);
@@ -266,10 +262,7 @@ CommandSpec infoCommandSpec() {
 }
 
 CommandSpec helpCommandSpec() {
-    CommandSpec c;
-    c.name = "help";
-    c.usage = "[command | scene]";
-    c.summary = "show help for a command, or 'help scene' for the scene file reference";
+    CommandSpec c{"help", "[command | scene]", "show help for a command, or 'help scene' for the scene file reference"};
     c.sceneOptions = false;
     c.run = [](const CommandLine& cl) {
         if (cl.positional.empty()) {

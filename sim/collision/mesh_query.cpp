@@ -1,6 +1,7 @@
 #include "sim/collision/mesh_query.h"
 
 #include "core/errors.h"
+#include "core/embree_ray.h"
 #include "core/log.h"
 
 #include <embree3/rtcore.h>
@@ -186,21 +187,7 @@ RayHit MeshQuery::intersect(const Vec3f& origin, const Vec3f& direction, float t
     if (impl_->primToTri.empty()) return result;
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    RTCRayHit rh;
-    rh.ray.org_x = origin.x();
-    rh.ray.org_y = origin.y();
-    rh.ray.org_z = origin.z();
-    rh.ray.dir_x = direction.x();
-    rh.ray.dir_y = direction.y();
-    rh.ray.dir_z = direction.z();
-    rh.ray.tnear = tMin;
-    rh.ray.tfar = tMax;
-    rh.ray.time = 0.f;
-    rh.ray.mask = 0xFFFFFFFFu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    RTCRayHit rh = embree::rayHit(origin, direction, tMin, tMax);
     rtcIntersect1(impl_->scene, &context, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return result;
     // Embree's (u, v) weight the second and third corner, as SurfacePoint does.

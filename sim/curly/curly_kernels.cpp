@@ -54,15 +54,38 @@ void transportFrames(const Vec3f* d, size_t edges, const Mat3f& root, Mat3f* fra
     }
 }
 
+namespace {
+/// The axial spring-damper that the stretch spring (eq. 1) and the core
+/// spring (eq. 5) both are, on an edge e with velocity difference Δv:
+///   f = k(|e| - L)ê + c(Δv·ê)ê,
+/// with |e| and êêᵀ kept for the callers' Jacobians. A (near) zero edge has
+/// no direction: `valid` is false and the spring exerts nothing.
+struct AxialSpring {
+    bool valid = false;
+    float length = 0.f;  ///< |e|
+    Mat3f uu;            ///< êêᵀ
+    Vec3f force;
+};
+
+AxialSpring axialSpring(const Vec3f& e, const Vec3f& dv, float restLength, float k, float c) {
+    AxialSpring a;
+    a.length = e.norm();
+    if (!(a.length > 1e-12f)) return a;
+    const Vec3f u = e / a.length;
+    a.valid = true;
+    a.uu = u * u.transpose();
+    a.force = k * (a.length - restLength) * u + c * dv.dot(u) * u;
+    return a;
+}
+}  // namespace
+
 PairForce stretchSpring(const Vec3f& e, const Vec3f& dv, float restLength, float ks, float cs) {
     PairForce p;
-    const float len = e.norm();
-    if (!(len > 1e-12f)) return p;
-    const Vec3f u = e / len;
-    const Mat3f uu = u * u.transpose();
-    p.force = ks * (len - restLength) * u + cs * dv.dot(u) * u;
-    p.K = ks * (uu + std::max(0.f, 1.f - restLength / len) * (Mat3f::Identity() - uu));
-    p.C = cs * uu;
+    const AxialSpring a = axialSpring(e, dv, restLength, ks, cs);
+    if (!a.valid) return p;
+    p.force = a.force;
+    p.K = ks * (a.uu + std::max(0.f, 1.f - restLength / a.length) * (Mat3f::Identity() - a.uu));
+    p.C = cs * a.uu;
     return p;
 }
 
@@ -78,13 +101,11 @@ PairForce bendingSpring(const Vec3f& e, const Vec3f& dv, const Vec3f& target, fl
 
 PairForce coreSpring(const Vec3f& b, float restLength, const Vec3f& nu, float kc, float cc, float tap) {
     PairForce p;
-    const float len = b.norm();
-    if (!(len > 1e-12f)) return p;
-    const Vec3f u = b / len;
-    const Mat3f uu = u * u.transpose();
-    p.force = kc * (len - restLength) * u + cc * nu.dot(u) * u;
-    p.K = kc * tap * uu;
-    p.C = cc * tap * uu;
+    const AxialSpring a = axialSpring(b, nu, restLength, kc, cc);
+    if (!a.valid) return p;
+    p.force = a.force;
+    p.K = kc * tap * a.uu;
+    p.C = cc * tap * a.uu;
     return p;
 }
 

@@ -16,6 +16,7 @@
 // that the compiler vectorizes.
 #pragma once
 
+#include "core/hash.h"
 #include "sim/strands/head.h"
 
 #include <Eigen/Geometry>
@@ -74,16 +75,11 @@ HP_FOLLOWER_KERNEL float interpolationWeight(float d1, float d2) {
 // rand_xy: a value in [-1, 1) fixed per (seed, follower, segment), made by
 // hashing instead of storing 23 floats per follower or carrying RNG state.
 
-/// MurmurHash3's 32-bit finaliser: a bijection with full avalanche.
-/// U: uint32_t or a vector of them.
+/// MurmurHash3's 32-bit finaliser (fmix32, core/hash.h): a bijection with
+/// full avalanche. U: uint32_t or a vector of them.
 template <typename U>
 HP_FOLLOWER_KERNEL U mix32(U h) {
-    h ^= h >> 16;
-    h *= 0x85ebca6bu;
-    h ^= h >> 13;
-    h *= 0xc2b2ae35u;
-    h ^= h >> 16;
-    return h;
+    return hash::murmur3Fmix32(h);
 }
 
 /// Per-follower part of the hash (computed once per follower and update).

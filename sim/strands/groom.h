@@ -18,11 +18,13 @@ namespace hp {
 /// normal, or combed toward a direction.
 enum class GroomStyle { Straight, Combed };
 
-/// @brief The groom's shape (scene keys hair.groom.*).
+/// @brief The groom's shape (scene keys hair.groom.*): the strand's
+/// segments and length, which every style has, then the style and what
+/// combing adds.
 struct GroomSettings {
-    GroomStyle style = GroomStyle::Straight;
     int segments = 23;
     float length = 0.25f;          ///< m
+    GroomStyle style = GroomStyle::Straight;
     /// Combed: how far the strand turns toward `direction`, 0 (straight) to
     /// 1 (the tip points along it).
     float droop = 0.85f;

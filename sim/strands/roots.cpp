@@ -1,6 +1,7 @@
 #include "sim/strands/roots.h"
 
 #include "core/errors.h"
+#include "core/hash.h"
 #include "sim/strands/fibonacci.h"
 #include "sim/collision/mesh_query.h"
 
@@ -26,14 +27,10 @@ Vec3f pointOf(const TriangleMesh& m, const SurfacePoint& s) {
     return (1.f - s.b1 - s.b2) * m.positions[t[0]] + s.b1 * m.positions[t[1]] + s.b2 * m.positions[t[2]];
 }
 
-/// splitmix64: a counter-based generator, so candidate i's numbers do not
-/// depend on which thread draws them.
-uint64_t mix(uint64_t x) {
-    x += 0x9e3779b97f4a7c15ull;
-    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-    return x ^ (x >> 31);
-}
+/// splitmix64 (its golden-ratio increment, then its finaliser in core/hash.h):
+/// a counter-based generator, so candidate i's numbers do not depend on which
+/// thread draws them.
+uint64_t mix(uint64_t x) { return hash::splitMix64(x + 0x9e3779b97f4a7c15ull); }
 
 double uniform(uint64_t seed, uint64_t index, uint64_t stream) {
     return double(mix(mix(seed ^ (stream * 0xd1b54a32d192ed03ull)) + index) >> 11) * 0x1.0p-53;

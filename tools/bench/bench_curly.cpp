@@ -15,6 +15,8 @@
 #include "sim/curly/curly_wet.h"
 #include "sim/strands/fibonacci.h"
 #include "sim/strands/head.h"
+#include "sim/strands/sphere_roots.h"
+#include "tools/bench/bench_support.h"
 
 #include <tbb/global_control.h>
 
@@ -29,31 +31,12 @@ namespace {
 
 using namespace hp;
 
-double cpuSeconds() {
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
 struct Result {
     double stepsPerSecond = 0;
     double cpuMsPerStep = 0;  ///< process CPU time (all threads) per timed step
     StepStats stats;
     Eigen::Vector2f curl = Eigen::Vector2f::Zero();
 };
-
-std::vector<SurfaceFrame> rootFrames(const std::vector<Vec3f>& dirs, const HeadPose& pose, float radius) {
-    std::vector<SurfaceFrame> roots(dirs.size());
-    for (size_t i = 0; i < dirs.size(); ++i) {
-        const Vec3f n = dirs[i];
-        Vec3f t = Vec3f::UnitY().cross(n);
-        if (t.squaredNorm() < 1e-8f) t = Vec3f::UnitX();
-        roots[i].position = pose.transform * (radius * n);
-        roots[i].normal = pose.transform.linear() * n;
-        roots[i].tangent = pose.transform.linear() * t.normalized();
-    }
-    return roots;
-}
 
 Result run(size_t guides, const std::string& mode, int threads, int warmup, int timed) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -66,21 +49,21 @@ Result run(size_t guides, const std::string& mode, int threads, int warmup, int 
     const std::vector<Vec3f> dirs = fibonacciCap(guides);
     CurlyWetSolver solver(s);
     HeadPose pose = head.sample(0.0);
-    solver.initialize(rootFrames(dirs, pose, radius), pose);
+    solver.initialize(sphereRootFrames(dirs, radius, pose, Vec3f::UnitX()), pose);
     Result r;
     StepStats acc;
     bool first = true;
     double ms = 0, cpu = 0;
     for (int k = 1; k <= warmup + timed; ++k) {
-        if (k == warmup + 1) cpu = cpuSeconds();
+        if (k == warmup + 1) cpu = bench::processCpuSeconds();
         pose = head.sample(k * double(s.timeStep));
-        const StepStats& st = solver.step(rootFrames(dirs, pose, radius), pose);
+        const StepStats& st = solver.step(sphereRootFrames(dirs, radius, pose, Vec3f::UnitX()), pose);
         if (k <= warmup) continue;
         ms += st.msPerStep;
         if (first) acc = st, first = false;
         else acc.accumulate(st);
     }
-    r.cpuMsPerStep = 1000.0 * (cpuSeconds() - cpu) / timed;
+    r.cpuMsPerStep = 1000.0 * (bench::processCpuSeconds() - cpu) / timed;
     r.stepsPerSecond = 1000.0 * timed / ms;
     r.stats = acc;
     r.curl = solver.measureCurl();

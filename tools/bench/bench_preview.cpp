@@ -15,6 +15,8 @@
 #include "render/gl_context.h"
 #include "render/preview.h"
 #include "sim/strands/synthetic.h"
+#include "tools/bench/b_render_view.h"
+#include "tools/bench/bench_support.h"
 
 #include <sys/resource.h>
 
@@ -32,12 +34,6 @@ using namespace hp;
 
 namespace {
 
-double cpuSeconds() {
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return double(t.tv_sec) + double(t.tv_nsec) * 1e-9;
-}
-
 double wallSeconds() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -46,15 +42,6 @@ double peakMiB() {
     rusage u{};
     getrusage(RUSAGE_SELF, &u);
     return double(u.ru_maxrss) / 1024.0;
-}
-
-struct Stats {
-    double median, min, max;
-};
-
-Stats stats(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return {v[v.size() / 2], v.front(), v.back()};
 }
 
 }  // namespace
@@ -86,16 +73,7 @@ int main(int argc, char** argv) {
     }
     try {
         auto context = GlContext::createHeadless();
-        View view;  // the defaults are B-render's camera, light and black background
-        view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
-        view.camera.target = Vec3f::Zero();
-        view.camera.fovY = 40.f;
-        view.camera.width = 1920;
-        view.camera.height = 1080;
-        view.lights = {Light{}};
-        view.lights[0].direction = Vec3f(-1.f, -1.f, -1.f);
-        view.lights[0].intensity = 3.f;
-        view.environment = Vec3f::Zero();
+        const View view = bench::bRenderView(1920, 1080);
         PreviewSettings settings;  // 4x MSAA, voxels (additive, nearest, 256^3) + 2048^2 PCF shadow map
         const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 32, 64);
         std::printf("bench_preview: %s\n", context->description().c_str());
@@ -117,15 +95,15 @@ int main(int argc, char** argv) {
             std::vector<double> wall, cpu;
             for (int f = 0; f < warmup + frames; ++f) {
                 frame.time = f / 24.0;
-                const double w0 = wallSeconds(), c0 = cpuSeconds();
+                const double w0 = wallSeconds(), c0 = bench::processCpuSeconds();
                 renderer.draw(view, frame);
                 renderer.finish();
-                if (f >= warmup) wall.push_back((wallSeconds() - w0) * 1e3), cpu.push_back((cpuSeconds() - c0) * 1e3);
+                if (f >= warmup) wall.push_back((wallSeconds() - w0) * 1e3), cpu.push_back((bench::processCpuSeconds() - c0) * 1e3);
             }
             const double r0 = wallSeconds();
             const Image image = renderer.readback();
             const double readbackMs = (wallSeconds() - r0) * 1e3;
-            const Stats w = stats(wall), c = stats(cpu);
+            const bench::Stats w = bench::stats(wall), c = bench::stats(cpu);
             std::printf("%9zu %9zu | %12.0f %10.0f %10.0f | %12.0f | %11.0f | %8.0f\n", count,
                         renderer.stats().strandSegments, w.median, w.min, w.max, c.median, readbackMs, peakMiB());
             if (!png.empty() && count == counts.back()) writeImage(png, image);

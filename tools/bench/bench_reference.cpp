@@ -15,6 +15,7 @@
 #include "render/reference.h"
 #include "sim/strands/head.h"
 #include "sim/strands/synthetic.h"
+#include "tools/bench/b_render_view.h"
 
 #include <tbb/global_control.h>
 
@@ -92,17 +93,8 @@ int main(int argc, char** argv) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
 
     // docs/benchmarks.md B-render camera and light.
-    View view;
-    view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
-    view.camera.target = Vec3f::Zero();
-    view.camera.fovY = 40.f;
-    view.camera.width = width;
-    view.camera.height = height;
-    view.lights = {Light{}};
-    view.lights[0].type = LightType::Directional;
-    view.lights[0].direction = Vec3f(-1.f, -1.f, -1.f).normalized();
-    view.lights[0].intensity = 3.f;
-    view.environment = Vec3f::Zero();
+    View view = bench::bRenderView(width, height);
+    view.lights[0].direction.normalize();
     const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 32, 64);
 
     std::printf("# bench_reference: %dx%d, %d spp, %d bounces (physical), %d threads, head %s, shadow roulette %g, synthetic hair\n",

@@ -37,6 +37,8 @@
 #include "sim/collision/level_set.h"
 #include "sim/collision/mesh_collider.h"
 #include "sim/strands/fibonacci.h"
+#include "sim/strands/sphere_roots.h"
+#include "tools/bench/bench_support.h"
 #include "sim/guides/guides.h"
 
 #include <algorithm>
@@ -59,29 +61,6 @@ std::vector<std::string> split(const std::string& s) {
     std::stringstream in(s);
     for (std::string item; std::getline(in, item, ',');) out.push_back(item);
     return out;
-}
-
-/// Root frames of the B-sim head at time t: the lattice directions carried by
-/// the head's rotation (a root bound to a rigid head moves with it).
-std::vector<SurfaceFrame> rootsAt(const std::vector<Vec3f>& dirs, float radius, const HeadPose& pose) {
-    std::vector<SurfaceFrame> roots(dirs.size());
-    for (size_t i = 0; i < dirs.size(); ++i) {
-        const Vec3f& n = dirs[i];
-        Vec3f t = Vec3f::UnitY().cross(n);
-        t = t.squaredNorm() > 1e-8f ? Vec3f(t.normalized()) : Vec3f(n.unitOrthogonal());
-        roots[i].position = pose.transform * (radius * n);
-        roots[i].normal = pose.transform.linear() * n;
-        roots[i].tangent = pose.transform.linear() * t;
-    }
-    return roots;
-}
-
-/// CPU time of the whole process (all threads), s: on a machine shared with
-/// other jobs it measures the work, where wall-clock measures the contention.
-double processCpuSeconds() {
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 struct RunResult {
@@ -152,18 +131,18 @@ RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int 
     GuideSolver solver(settings);
     HeadPose pose = head.sample(0.0);
     colliders.apply(pose);
-    solver.initialize(rootsAt(dirs, radius, pose), pose);
+    solver.initialize(sphereRootFrames(dirs, radius, pose), pose);
     RunResult r;
     std::chrono::steady_clock::time_point start;
     double cpu0 = 0;
     for (int k = 1; k <= warmup + steps; ++k) {
         if (k == warmup + 1) {
             start = std::chrono::steady_clock::now();
-            cpu0 = processCpuSeconds();
+            cpu0 = bench::processCpuSeconds();
         }
         pose = head.sample(double(k) * settings.timeStep);
         colliders.apply(pose);
-        const StepStats& s = solver.step(rootsAt(dirs, radius, pose), pose);
+        const StepStats& s = solver.step(sphereRootFrames(dirs, radius, pose), pose);
         if (k > warmup) {
             if (k == warmup + 1) r.stats = s;
             else r.stats.accumulate(s);
@@ -173,7 +152,7 @@ RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int 
     // a shot driver pays them too (they are small next to the step).
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     r.stepsPerSecond = steps / seconds;
-    r.cpuMsPerStep = 1000.0 * (processCpuSeconds() - cpu0) / steps;
+    r.cpuMsPerStep = 1000.0 * (bench::processCpuSeconds() - cpu0) / steps;
     if (digest) r.digest = fnv1a(solver.saveState());
     return r;
 }

@@ -20,6 +20,7 @@
 #include "render/vdb_writer.h"
 #include "render/voxelizer.h"
 #include "sim/strands/synthetic.h"
+#include "tools/bench/bench_support.h"
 
 #include <Eigen/Geometry>
 #include <tbb/global_control.h>
@@ -44,14 +45,6 @@ double seconds(std::chrono::steady_clock::time_point since) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
-/// CPU seconds of the whole process (all threads): on a shared machine wall
-/// time also counts other people's jobs.
-double cpuSeconds() {
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
 /// Peak resident set (VmHWM) in MiB.
 double peakMiB() {
     std::ifstream status("/proc/self/status");
@@ -62,14 +55,6 @@ double peakMiB() {
 }
 
 void resetPeak() { std::ofstream("/proc/self/clear_refs") << "5"; }
-
-struct Stats {
-    double median, min, max;
-};
-Stats stats(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return {v[v.size() / 2], v.front(), v.back()};
-}
 
 }  // namespace
 
@@ -134,7 +119,7 @@ int main(int argc, char** argv) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads.front()));
         resetPeak();
         const auto ts = std::chrono::steady_clock::now();
-        const double cs = cpuSeconds();
+        const double cs = bench::processCpuSeconds();
         size_t bytes = 0;
         for (int f = 1; f <= sequence; ++f) {
             const Eigen::Matrix3f spin = Eigen::AngleAxisf(1.5707963f * float(f) / 24.f, Vec3f::UnitY()).toRotationMatrix();
@@ -154,7 +139,7 @@ int main(int argc, char** argv) {
         }
         std::printf("sequence of %d frames at %.2f mm, %d thread(s): %.2f s (cpu %.2f s), %.1f MiB in all, "
                     "peak RSS %.0f MiB -> %s\n",
-                    sequence, h * 1e3, threads.front(), seconds(ts), cpuSeconds() - cs, double(bytes) / (1 << 20),
+                    sequence, h * 1e3, threads.front(), seconds(ts), bench::processCpuSeconds() - cs, double(bytes) / (1 << 20),
                     peakMiB(), dir.c_str());
         if (keep.empty()) fs::remove_all(dir);
         return 0;
@@ -169,10 +154,10 @@ int main(int argc, char** argv) {
             const fs::path file = dir / ("hair_" + std::to_string(int(h * 1e6)) + "um.vdb");
             for (int r = 0; r < runs; ++r) {
                 auto t = std::chrono::steady_clock::now();
-                double c = cpuSeconds();
+                double c = bench::processCpuSeconds();
                 DensityGrid grid = voxelize(frame, GridTransform::uniform(h), vs);
                 tv.push_back(seconds(t));
-                cv.push_back(cpuSeconds() - c);
+                cv.push_back(bench::processCpuSeconds() - c);
                 activeVoxels = grid.activeVoxelCount();
                 blocks = grid.blockCount();
                 massError = std::abs(grid.totalVolume() - volume) / volume;
@@ -182,13 +167,13 @@ int main(int argc, char** argv) {
                 info.strandCount = frame.strandCount();
                 info.hairVolume = volume;
                 t = std::chrono::steady_clock::now();
-                c = cpuSeconds();
+                c = bench::processCpuSeconds();
                 writeDensityVdb(file, std::move(grid), info, ws);  // consumes the grid, as the stage does
                 tw.push_back(seconds(t));
-                cw.push_back(cpuSeconds() - c);
+                cw.push_back(bench::processCpuSeconds() - c);
                 bytes = size_t(fs::file_size(file));
             }
-            const Stats v = stats(tv), w = stats(tw), vc = stats(cv), wc = stats(cw);
+            const bench::Stats v = bench::stats(tv), w = bench::stats(tw), vc = bench::stats(cv), wc = bench::stats(cw);
             std::printf("voxel %.2f mm, %d thread%s: voxelize %.3f s [%.3f-%.3f] (cpu %.3f s), "
                         "write %.3f s [%.3f-%.3f] (cpu %.3f s), file %.1f MiB, %zu active voxels in %zu leaves, "
                         "peak RSS %.0f MiB, mass error %.2e\n",
