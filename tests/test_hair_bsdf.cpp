@@ -286,7 +286,9 @@ TEST(HairBsdf, MelaninColourFitInvertsChiangsFitAndIsMonotone) {
     for (float eu = 0.f; eu <= 8.f; eu += 0.25f) {
         const Vec3f c = hairColorFromAbsorption(hairAbsorptionFromMelanin(eu, 0.f), 0.3f);
         for (int k = 0; k < 3; ++k) EXPECT_LE(c[k], last[k]) << eu;
-        if (eu > 0.f) EXPECT_GT(c.x(), c.z()) << eu;
+        if (eu > 0.f) {
+            EXPECT_GT(c.x(), c.z()) << eu;
+        }
         last = c;
     }
     const Vec3f plain = hairColorFromAbsorption(hairAbsorptionFromMelanin(0.3f, 0.f), 0.3f);
