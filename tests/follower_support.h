@@ -18,6 +18,15 @@ inline SurfaceFrame frameAt(const Vec3f& position, const Vec3f& normal, const Ve
     return f;
 }
 
+/// A sphere groom (the synthetic_groom defaults) with `guides` guides and
+/// `followers` followers.
+inline FollowerGroom sphereGroom(size_t guides, size_t followers) {
+    SphereGroomSettings s;
+    s.guides = guides;
+    s.followers = followers;
+    return makeSphereGroom(s);
+}
+
 /// The follower tests' sphere scene at time t: a sphere groom of `guides`
 /// guides and `followers` followers, its guides as SyntheticGuides draws
 /// them (lying over the head, differing a lot between neighbours at the
@@ -28,10 +37,7 @@ struct SphereScene {
     std::vector<SurfaceFrame> guideRoots, followerRoots;
 
     SphereScene(size_t guideCount, size_t followerCount, double t) {
-        SphereGroomSettings s;
-        s.guides = guideCount;
-        s.followers = followerCount;
-        groom = makeSphereGroom(s);
+        groom = sphereGroom(guideCount, followerCount);
         const SyntheticGuides motion(groom, {});
         motion.sample(t, guides, guideRoots);
         rotateRoots(groom.followerRoots, motion.headRotation(t), followerRoots);

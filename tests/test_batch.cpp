@@ -24,6 +24,28 @@ std::string frameFile(const std::string& pattern, int frame) {
     return buf;
 }
 
+/// `hairpipe ARGS` exits 0; its exit code and output when it does not.
+::testing::AssertionResult hairpipeSucceeds(const std::string& args) {
+    const ProcessResult r = runHairpipe(args);
+    if (r.exitCode == 0) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << "hairpipe " << args << " exited " << r.exitCode << ":\n" << r.output;
+}
+
+/// Starts `hairpipe ARGS` in `dir` (its output to dir/killed.log), waits up
+/// to 120 s for `written` to appear, then kills it with SIGKILL; its wait
+/// status in `*status` when given.
+::testing::AssertionResult killedOnceWritten(const std::vector<std::string>& args, const TempDir& dir,
+                                             const fs::path& written, int* status = nullptr) {
+    Background process(args, dir.path(), dir / "killed.log");
+    if (process.pid() <= 0) return ::testing::AssertionFailure() << "hairpipe did not start";
+    if (!waitUntil([&] { return fs::exists(written); }, 120))
+        return ::testing::AssertionFailure() << written << " never appeared:\n" << readFile(dir / "killed.log");
+    process.kill(SIGKILL);
+    const int ended = process.wait();
+    if (status) *status = ended;
+    return ::testing::AssertionSuccess();
+}
+
 /// Processes whose command line mentions `needle` (children of a killed run).
 std::vector<std::string> processesMentioning(const std::string& needle) {
     std::vector<std::string> found;
@@ -158,18 +180,12 @@ TEST(Batch, StaleTemporariesOfDeadWritersAreRemoved) {
 TEST(Batch, SimKilledMidShotResumesFromItsCheckpointIdentically) {
     TempDir dir;
     const fs::path scene = writeSmallScene(dir.path(), "1-24");
-    const ProcessResult full = runHairpipe("sim -q " + q(scene) + " --out " + q(dir / "a"));
-    ASSERT_EQ(full.exitCode, 0) << full.output;
+    ASSERT_TRUE(hairpipeSucceeds("sim -q " + q(scene) + " --out " + q(dir / "a")));
 
-    {
-        Background sim({"sim", scene.string(), "--out", (dir / "b").string()}, dir.path(), dir / "killed.log");
-        ASSERT_GT(sim.pid(), 0);
-        ASSERT_TRUE(waitUntil([&] { return fs::exists(dir / "b/cache/strands.0006.hpc"); }, 120))
-            << readFile(dir / "killed.log");
-        sim.kill(SIGKILL);
-        const int status = sim.wait();
-        EXPECT_TRUE(WIFSIGNALED(status));
-    }
+    int status = 0;
+    ASSERT_TRUE(killedOnceWritten({"sim", scene.string(), "--out", (dir / "b").string()}, dir,
+                                  dir / "b/cache/strands.0006.hpc", &status));
+    EXPECT_TRUE(WIFSIGNALED(status));
     ASSERT_FALSE(fs::exists(dir / "b/cache/strands.0024.hpc")) << "the simulation ended before it was killed";
     const ProcessResult resumed = runHairpipe("sim " + q(scene) + " --out " + q(dir / "b"));
     ASSERT_EQ(resumed.exitCode, 0) << resumed.output;
@@ -181,19 +197,15 @@ TEST(Batch, SimKilledMidShotResumesFromItsCheckpointIdentically) {
 TEST(Batch, RenderKilledMidShotCompletesIdenticallyWithoutPartialFiles) {
     TempDir dir;
     const fs::path scene = writeSmallScene(dir.path());
-    ASSERT_EQ(runHairpipe("sim -q " + q(scene) + " --out " + q(dir / "a")).exitCode, 0);
-    const ProcessResult full = runHairpipe("render -q " + q(scene) + " --out " + q(dir / "a"));
-    ASSERT_EQ(full.exitCode, 0) << full.output;
+    ASSERT_TRUE(hairpipeSucceeds("sim -q " + q(scene) + " --out " + q(dir / "a")));
+    ASSERT_TRUE(hairpipeSucceeds("render -q " + q(scene) + " --out " + q(dir / "a")));
 
     const fs::path b = dir / "b";
-    ASSERT_EQ(runHairpipe("sim -q " + q(scene) + " --out " + q(b)).exitCode, 0);
-    {
-        Background render({"render", scene.string(), "--out", b.string()}, dir.path(), dir / "killed.log");
-        ASSERT_TRUE(waitUntil([&] { return fs::exists(b / "preview/preview.0002.png"); }, 120))
-            << readFile(dir / "killed.log");
-        render.kill(SIGKILL);
-        EXPECT_TRUE(WIFSIGNALED(render.wait()));
-    }
+    ASSERT_TRUE(hairpipeSucceeds("sim -q " + q(scene) + " --out " + q(b)));
+    int status = 0;
+    ASSERT_TRUE(killedOnceWritten({"render", scene.string(), "--out", b.string()}, dir, b / "preview/preview.0002.png",
+                                  &status));
+    EXPECT_TRUE(WIFSIGNALED(status));
     ASSERT_FALSE(fs::exists(b / "preview/preview.0006.png")) << "the render ended before it was killed";
     const ProcessResult resumed = runHairpipe("render " + q(scene) + " --out " + q(b));
     ASSERT_EQ(resumed.exitCode, 0) << resumed.output;
@@ -211,8 +223,7 @@ TEST(Batch, FullDiskFailsFramesWithoutPartialFilesAndARerunCompletes) {
     // each run gets further and must leave only finished files behind.
     TempDir dir;
     const fs::path scene = writeSmallScene(dir.path());
-    const ProcessResult full = runHairpipe("run -q " + q(scene) + " --out " + q(dir / "a"));
-    ASSERT_EQ(full.exitCode, 0) << full.output;
+    ASSERT_TRUE(hairpipeSucceeds("run -q " + q(scene) + " --out " + q(dir / "a")));
     const fs::path b = dir / "b";
     for (int blocks : {8, 32, 128, 256}) {
         SCOPED_TRACE(cat("ulimit -f ", blocks));
@@ -228,31 +239,22 @@ TEST(Batch, FullDiskFailsFramesWithoutPartialFilesAndARerunCompletes) {
         }
         expectOnlyFinishedOutputs(dir / "a", b);
     }
-    const ProcessResult rerun = runHairpipe("run -q " + q(scene) + " --out " + q(b));
-    ASSERT_EQ(rerun.exitCode, 0) << rerun.output;
+    ASSERT_TRUE(hairpipeSucceeds("run -q " + q(scene) + " --out " + q(b)));
     expectSameOutputs(dir / "a", b);
 }
 
 TEST(Batch, JobsRunKilledTakesItsChildrenAlongAndResumesIdentically) {
     TempDir dir;
     const fs::path scene = writeSmallScene(dir.path());
-    const ProcessResult full = runHairpipe("run -q " + q(scene) + " --out " + q(dir / "a"));
-    ASSERT_EQ(full.exitCode, 0) << full.output;
+    ASSERT_TRUE(hairpipeSucceeds("run -q " + q(scene) + " --out " + q(dir / "a")));
 
     const fs::path b = dir / "b";
-    {
-        Background run({"run", scene.string(), "--out", b.string(), "--jobs", "2", "--chunk", "3"}, dir.path(),
-                       dir / "killed.log");
-        ASSERT_TRUE(waitUntil([&] { return fs::exists(b / "preview/preview.0002.png"); }, 120))
-            << readFile(dir / "killed.log");
-        run.kill(SIGKILL);
-        run.wait();
-    }
+    ASSERT_TRUE(killedOnceWritten({"run", scene.string(), "--out", b.string(), "--jobs", "2", "--chunk", "3"}, dir,
+                                  b / "preview/preview.0002.png"));
     // The chunks were children of the killed process: they end with it.
     EXPECT_TRUE(waitUntil([&] { return processesMentioning(b.string()).empty(); }, 10))
         << "still running:\n" << ::testing::PrintToString(processesMentioning(b.string()));
-    const ProcessResult resumed = runHairpipe("run " + q(scene) + " --out " + q(b) + " --jobs 2 --chunk 3");
-    ASSERT_EQ(resumed.exitCode, 0) << resumed.output;
+    ASSERT_TRUE(hairpipeSucceeds("run " + q(scene) + " --out " + q(b) + " --jobs 2 --chunk 3"));
     expectSameOutputs(dir / "a", b);
 }
 
@@ -260,7 +262,7 @@ TEST(Batch, CorruptCacheFrameFailsThatFrameNamingTheFile) {
     TempDir dir;
     const fs::path scene = writeSmallScene(dir.path(), "1-5");
     const fs::path out = dir / "out";
-    ASSERT_EQ(runHairpipe("sim -q " + q(scene) + " --out " + q(out)).exitCode, 0);
+    ASSERT_TRUE(hairpipeSucceeds("sim -q " + q(scene) + " --out " + q(out)));
     const fs::path bad = out / "cache/strands.0003.hpc";
     std::string bytes = readFile(bad);
     bytes[bytes.size() / 2] ^= 0x01;
@@ -282,7 +284,7 @@ TEST(Batch, CorruptCacheFrameFailsThatFrameNamingTheFile) {
 TEST(Batch, FrameSubsetRenderedFromTheCacheEqualsTheFullRun) {
     TempDir dir;
     const fs::path scene = writeSmallScene(dir.path());
-    ASSERT_EQ(runHairpipe("run -q " + q(scene) + " --out " + q(dir / "a")).exitCode, 0);
+    ASSERT_TRUE(hairpipeSucceeds("run -q " + q(scene) + " --out " + q(dir / "a")));
     // Another folder (another machine) with only the cache.
     fs::create_directories(dir / "b");
     fs::copy(dir / "a/cache", dir / "b/cache", fs::copy_options::recursive);
@@ -311,7 +313,7 @@ TEST(Batch, FrameSubsetRenderedFromTheCacheEqualsTheFullRun) {
 TEST(Batch, JobsOutputsEqualOneProcessAndTheReportCoversEveryFrame) {
     TempDir dir;
     const fs::path scene = writeSmallScene(dir.path());
-    ASSERT_EQ(runHairpipe("run -q " + q(scene) + " --out " + q(dir / "a")).exitCode, 0);
+    ASSERT_TRUE(hairpipeSucceeds("run -q " + q(scene) + " --out " + q(dir / "a")));
     const ProcessResult r = runHairpipe("run " + q(scene) + " --out " + q(dir / "b") + " --jobs 2 --chunk 3");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("2 chunks"), std::string::npos) << r.output;
@@ -326,10 +328,9 @@ TEST(Batch, ChunkWithoutReportLeavesTheReportToTheLastStep) {
     TempDir dir;
     const fs::path scene = writeSmallScene(dir.path(), "1-6");
     const fs::path out = dir / "out";
-    ASSERT_EQ(runHairpipe("sim -q " + q(scene) + " --out " + q(out)).exitCode, 0);
-    const ProcessResult chunk = runHairpipe("run -q " + q(scene) + " --out " + q(out) +
-                                            " --frames 1-5 --stages preview,reference,compare --cache-only --no-report");
-    ASSERT_EQ(chunk.exitCode, 0) << chunk.output;
+    ASSERT_TRUE(hairpipeSucceeds("sim -q " + q(scene) + " --out " + q(out)));
+    ASSERT_TRUE(hairpipeSucceeds("run -q " + q(scene) + " --out " + q(out) +
+                                 " --frames 1-5 --stages preview,reference,compare --cache-only --no-report"));
     EXPECT_TRUE(fs::exists(out / "compare/metrics.0005.json"));
     EXPECT_FALSE(fs::exists(out / "compare/report.html"));
     EXPECT_FALSE(fs::exists(out / "vdb")) << "--stages limits the run";
@@ -352,9 +353,8 @@ TEST(Batch, ExportUsdWritesTheShotAsTimeSamplesFromTheCache) {
     const ProcessResult none = runHairpipe("export-usd " + q(scene) + " --out " + q(out));
     EXPECT_EQ(none.exitCode, 1);
     EXPECT_NE(none.output.find("strands.0001.hpc"), std::string::npos) << none.output;
-    ASSERT_EQ(runHairpipe("sim -q " + q(scene) + " --out " + q(out)).exitCode, 0);
-    const ProcessResult r = runHairpipe("export-usd " + q(scene) + " --out " + q(out));
-    ASSERT_EQ(r.exitCode, 0) << r.output;
+    ASSERT_TRUE(hairpipeSucceeds("sim -q " + q(scene) + " --out " + q(out)));
+    ASSERT_TRUE(hairpipeSucceeds("export-usd " + q(scene) + " --out " + q(out)));
     const std::string shot = readFile(out / "usd/hair.usda");
     EXPECT_EQ(shot.rfind("#usda 1.0", 0), 0u);
     EXPECT_NE(shot.find("def BasisCurves \"hair\""), std::string::npos);

@@ -5,6 +5,26 @@
 
 using namespace hp::test;
 
+namespace {
+
+/// A temporary folder holding one scene file.
+struct SceneDir {
+    TempDir dir;
+    SceneDir(const std::string& name, const std::string& yaml) { writeFile(dir / name, yaml); }
+    const std::filesystem::path& path() const { return dir.path(); }
+};
+
+/// Runs `hairpipe args` in `cwd` and checks that it fails as a usage or
+/// scene error (exit 1) whose output contains `message`.
+void expectUsageError(const std::string& args, const std::string& message, const std::filesystem::path& cwd = {}) {
+    SCOPED_TRACE("hairpipe " + args);
+    const ProcessResult r = runHairpipe(args, cwd);
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
+}
+
+}  // namespace
+
 TEST(Cli, HelpListsCommands) {
     const ProcessResult r = runHairpipe("--help");
     EXPECT_EQ(r.exitCode, 0) << r.output;
@@ -22,48 +42,32 @@ TEST(Cli, EveryCommandHasHelp) {
 TEST(Cli, NoArgumentsIsAUsageError) { EXPECT_EQ(runHairpipe("").exitCode, 1); }
 
 TEST(Cli, UnknownCommandAndOption) {
-    const ProcessResult a = runHairpipe("frobnicate x.yaml");
-    EXPECT_EQ(a.exitCode, 1);
-    EXPECT_NE(a.output.find("unknown command 'frobnicate'"), std::string::npos) << a.output;
-    const ProcessResult b = runHairpipe("validate --bogus x.yaml");
-    EXPECT_EQ(b.exitCode, 1);
-    EXPECT_NE(b.output.find("unknown option '--bogus'"), std::string::npos) << b.output;
+    expectUsageError("frobnicate x.yaml", "unknown command 'frobnicate'");
+    expectUsageError("validate --bogus x.yaml", "unknown option '--bogus'");
 }
 
 TEST(Cli, ValidateBrokenScenePrintsLocationAndKey) {
-    TempDir dir;
-    writeFile(dir / "broken.yaml", "frames: 1-3\nfps: 24\nseed: -4\n");
-    const ProcessResult r = runHairpipe("validate broken.yaml", dir.path());
-    EXPECT_EQ(r.exitCode, 1) << r.output;
-    EXPECT_NE(r.output.find("broken.yaml:3:7: 'seed': must be in [0, 2147483647]"), std::string::npos) << r.output;
+    const SceneDir dir("broken.yaml", "frames: 1-3\nfps: 24\nseed: -4\n");
+    expectUsageError("validate broken.yaml", "broken.yaml:3:7: 'seed': must be in [0, 2147483647]", dir.path());
 }
 
 TEST(Cli, ValidateGoodSceneAndSetOverride) {
-    TempDir dir;
-    writeFile(dir / "ok.yaml", "frames: 1-3\n");
+    const SceneDir dir("ok.yaml", "frames: 1-3\n");
     EXPECT_EQ(runHairpipe("validate ok.yaml", dir.path()).exitCode, 0);
-    const ProcessResult bad = runHairpipe("validate ok.yaml --set fps=-1", dir.path());
-    EXPECT_EQ(bad.exitCode, 1);
-    EXPECT_NE(bad.output.find("--set fps=-1: 'fps': must be in"), std::string::npos) << bad.output;
+    expectUsageError("validate ok.yaml --set fps=-1", "--set fps=-1: 'fps': must be in", dir.path());
 }
 
 TEST(Cli, MissingSceneFileIsNamed) {
-    const ProcessResult r = runHairpipe("validate /nonexistent/scene.yaml");
-    EXPECT_EQ(r.exitCode, 1);
-    EXPECT_NE(r.output.find("/nonexistent/scene.yaml: scene file not found"), std::string::npos) << r.output;
+    expectUsageError("validate /nonexistent/scene.yaml", "/nonexistent/scene.yaml: scene file not found");
 }
 
 TEST(Cli, BadFramesOption) {
-    TempDir dir;
-    writeFile(dir / "ok.yaml", "frames: 1-3\n");
-    const ProcessResult r = runHairpipe("info ok.yaml --frames 5-1", dir.path());
-    EXPECT_EQ(r.exitCode, 1);
-    EXPECT_NE(r.output.find("bad frame range '5-1'"), std::string::npos) << r.output;
+    const SceneDir dir("ok.yaml", "frames: 1-3\n");
+    expectUsageError("info ok.yaml --frames 5-1", "bad frame range '5-1'", dir.path());
 }
 
 TEST(Cli, InfoShowsResolvedFramesAndKeys) {
-    TempDir dir;
-    writeFile(dir / "ok.yaml", "frames: 1-10x3\nfps: 30\n");
+    const SceneDir dir("ok.yaml", "frames: 1-10x3\nfps: 30\n");
     const ProcessResult r = runHairpipe("info ok.yaml --seed 9", dir.path());
     EXPECT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("1-10x3 (4 frames at 30 fps)"), std::string::npos) << r.output;
@@ -71,8 +75,7 @@ TEST(Cli, InfoShowsResolvedFramesAndKeys) {
 }
 
 TEST(Cli, ThreadsMustBePositive) {
-    TempDir dir;
-    writeFile(dir / "ok.yaml", "frames: 1\n");
+    const SceneDir dir("ok.yaml", "frames: 1\n");
     EXPECT_EQ(runHairpipe("validate ok.yaml --threads 0", dir.path()).exitCode, 1);
     EXPECT_EQ(runHairpipe("validate ok.yaml --threads 2", dir.path()).exitCode, 0);
 }

@@ -26,6 +26,19 @@ Eigen::Isometry3f at(const Vec3f& t, float yawDegrees = 0.f) {
     return p;
 }
 
+/// The rope with nearly limp joints, 0.2 m long: hair that drapes fully, so
+/// a test measures the collider (what lies on it), not stiffness.
+GuideSettings limpRope() {
+    GuideSettings s;
+    s.formulation = GuideFormulation::Rope;
+    s.preload = false;
+    s.bendStiffness = 1e-7f;
+    s.limitStiffness = 1e-7f;
+    s.length = 0.2f;
+    s.strandsPerWorld = 8;
+    return s;
+}
+
 ColliderShape box(const Vec3f& half) {
     ColliderShape s;
     s.kind = ColliderShape::Kind::Box;
@@ -118,16 +131,7 @@ TEST(CollisionWorld, HairOnAShoulderBoxStaysOnIt) {
     const CollisionWorld shoulders({box({0.25f, 0.05f, 0.12f})});
     const std::vector<Vec3f> dirs = fibonacciCap(40, Vec3f::UnitY(), -0.2f);
     auto run = [&](bool withShoulders, size_t& below, size_t& resting, float& worstDepth, double& worstStretch) {
-        GuideSettings s;
-        // The rope with nearly limp joints: hair that drapes fully, so the
-        // test measures the collider (what lies on the box), not stiffness.
-        s.formulation = GuideFormulation::Rope;
-        s.preload = false;
-        s.bendStiffness = 1e-7f;
-        s.limitStiffness = 1e-7f;
-        s.length = 0.2f;
-        s.strandsPerWorld = 8;
-        GuideSolver solver(s);
+        GuideSolver solver(limpRope());
         HeadPose pose;
         auto posed = shoulders.posed({at({0, top - 0.05f, 0})});
         pose.transform = at(headCentre);
@@ -295,14 +299,7 @@ TEST(CollisionWorld, NonConvexPropKeepsItsHollowWhereAHullFillsIt) {
     const float headRadius = 0.05f;
     const std::vector<Vec3f> dirs = fibonacciCap(12, -Vec3f::UnitY(), 0.8f);
     auto hang = [&](const std::shared_ptr<const Collider>& prop, size_t& inHollow, float& worstDepth) {
-        GuideSettings s;
-        s.formulation = GuideFormulation::Rope;  // nearly limp: the test measures the collider
-        s.preload = false;
-        s.bendStiffness = 1e-7f;
-        s.limitStiffness = 1e-7f;
-        s.length = 0.2f;
-        s.strandsPerWorld = 8;
-        GuideSolver solver(s);
+        GuideSolver solver(limpRope());
         HeadPose pose;
         pose.transform = at(headCentre);
         pose.collider = std::make_shared<CompositeCollider>(std::make_shared<SphereCollider>(headCentre, headRadius), prop);

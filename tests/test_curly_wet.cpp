@@ -51,6 +51,14 @@ double meanNeighbourDistance(const StrandFrame& f, size_t from) {
     return sum / double(count);
 }
 
+/// A whole run's accumulated stats are sound: no NaN, no segment stretched
+/// past the strain limit (+1e-3), no vertex over 0.1 mm inside the head.
+void expectSoundRun(const StepStats& acc, const CurlyWetSettings& s) {
+    EXPECT_EQ(acc.nanCount, 0u) << "NaN vertices";
+    EXPECT_LE(acc.maxLengthError, s.maxStrain + 1e-3) << "stretch past the strain limit";
+    EXPECT_LT(acc.maxPenetration, 1e-4) << "m inside the head";
+}
+
 TEST(CurlyWet, RestShapeIsCurlyAndHoldsStill) {
     CurlyWetSettings s;
     CurlyWetSolver solver(s);
@@ -114,9 +122,7 @@ TEST(CurlyWet, CurlRadiusAndPitchSurviveABouncingHead) {
     EXPECT_NEAR(c.y(), s.curlPitch, 0.1f * s.curlPitch);
     EXPECT_LT(worstRadius, 0.1f) << "during the bounce";
     EXPECT_LT(worstPitch, 0.1f) << "during the bounce";
-    EXPECT_EQ(acc.nanCount, 0u);
-    EXPECT_LE(acc.maxLengthError, s.maxStrain + 1e-3);
-    EXPECT_LT(acc.maxPenetration, 1e-4);
+    expectSoundRun(acc, s);
 }
 
 TEST(CurlyWet, ZeroSaturationIsExactlyDryHair) {
@@ -253,11 +259,9 @@ TEST(CurlyWet, StableUnderFastRotationWithCohesion) {
     std::printf("spinning %g deg/s: kinetic energy %.3g J (steps 50-100), %.3g J (100-150), bound %.3g J; "
                 "max strain %.3f%%\n", rate, mid, late, bound, 100 * acc.maxLengthError);
     EXPECT_GT(neighbours, 0.5) << "cohesion was active";
-    EXPECT_EQ(acc.nanCount, 0u);
     EXPECT_LT(late, bound);
     EXPECT_LT(late, 1.5 * mid) << "no energy growth once spinning";
-    EXPECT_LE(acc.maxLengthError, s.maxStrain + 1e-3);
-    EXPECT_LT(acc.maxPenetration, 1e-4);
+    expectSoundRun(acc, s);
 }
 
 TEST(CurlyWet, SameResultForOneAndTwoThreads) {

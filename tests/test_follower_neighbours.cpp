@@ -18,6 +18,7 @@
 
 using namespace hp;
 using hp::test::frameAt;
+using hp::test::sphereGroom;
 
 // ---------------------------------------------------------------------------
 // Neighbours
@@ -65,10 +66,7 @@ TEST(FollowerNeighbours, GridEqualsBruteForce) {
 }
 
 TEST(FollowerNeighbours, FollowersUseTheTwoNearestGuideRootsInOrder) {
-    SphereGroomSettings s;
-    s.guides = 94;
-    s.followers = 751;
-    const FollowerGroom groom = makeSphereGroom(s);
+    const FollowerGroom groom = sphereGroom(94, 751);
     const Followers followers(groom, {});
     for (size_t f = 0; f < groom.followerRoots.size(); ++f) {
         std::vector<std::pair<float, uint32_t>> d;

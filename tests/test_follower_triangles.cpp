@@ -1,5 +1,6 @@
 // Barycentric followers (FollowerMode::Barycentric): the guide-root
 // triangulation (sim/followers/follower_triangles.h) and the three-guide blend.
+#include "follower_support.h"
 #include "sim/followers/follower_metrics.h"
 #include "sim/followers/follower_triangles.h"
 #include "sim/followers/followers.h"
@@ -14,6 +15,7 @@
 #include <vector>
 
 using namespace hp;
+using hp::test::sphereGroom;
 
 namespace {
 
@@ -26,10 +28,7 @@ std::vector<Vec3f> rootPositions(const std::vector<SurfaceFrame>& frames) {
 }  // namespace
 
 TEST(GuideTriangulation, DelaunayOnTheScalpCoversTheCap) {
-    SphereGroomSettings s;
-    s.guides = 200;
-    s.followers = 0;
-    const FollowerGroom groom = makeSphereGroom(s);
+    const FollowerGroom groom = sphereGroom(200, 0);
     const std::vector<Vec3f> roots = rootPositions(groom.guideRoots);
     const GuideTriangulation tri(roots);
     // Euler: a triangulated disc of n points with h on the hull has 2n - h - 2
@@ -62,10 +61,7 @@ TEST(GuideTriangulation, DelaunayOnTheScalpCoversTheCap) {
 }
 
 TEST(Followers, BarycentricReproducesAGuideAtItsRootAndIsContinuous) {
-    SphereGroomSettings s;
-    s.guides = 94;
-    s.followers = 0;
-    FollowerGroom groom = makeSphereGroom(s);
+    FollowerGroom groom = sphereGroom(94, 0);
     // Followers on every 5th guide root (with the guide's frame), then along
     // an arc over the crown at 0.5 mm steps, crossing many triangles.
     std::vector<size_t> onGuide;
@@ -77,7 +73,7 @@ TEST(Followers, BarycentricReproducesAGuideAtItsRootAndIsContinuous) {
     for (size_t i = 0; i < arcCount; ++i) {
         const float a = -0.75f + 1.5f * float(i) / float(arcCount - 1);  // radians over the crown
         const Vec3f d(std::sin(a), std::cos(a), 0.3f * std::sin(2.f * a));
-        groom.followerRoots.push_back(sphereRootFrame(d.normalized(), s.headRadius));
+        groom.followerRoots.push_back(sphereRootFrame(d.normalized(), SphereGroomSettings().headRadius));
     }
     FollowerSettings settings;
     settings.mode = FollowerMode::Barycentric;

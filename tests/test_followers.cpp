@@ -20,6 +20,7 @@
 
 using namespace hp;
 using hp::test::frameAt;
+using hp::test::sphereGroom;
 
 namespace {
 
@@ -36,6 +37,22 @@ StrandFrame guideFrame(const std::vector<std::vector<Vec3f>>& strands, const Vec
     }
     f.guideCount = uint32_t(strands.size());
     return f;
+}
+
+/// The groom's guides standing straight along their root normals (each
+/// vertex at its rest shape's height y), with `velocity` on every vertex when
+/// given and no velocities otherwise.
+StrandFrame straightGuides(const FollowerGroom& groom, const Vec3f* velocity = nullptr) {
+    StrandFrame guides;
+    for (size_t g = 0; g < groom.guideRoots.size(); ++g) {
+        std::vector<Vec3f> p;
+        for (uint32_t k = groom.guideShapes.offsets[g]; k < groom.guideShapes.offsets[g + 1]; ++k)
+            p.push_back(groom.guideRoots[g].position + groom.guideShapes.points[k].y() * groom.guideRoots[g].normal);
+        const std::vector<float> r(p.size(), 1e-4f);
+        const std::vector<Vec3f> v(velocity ? p.size() : 0, velocity ? *velocity : Vec3f::Zero());
+        guides.addStrand(uint32_t(g), p.data(), r.data(), p.size(), velocity ? v.data() : nullptr);
+    }
+    return guides;
 }
 
 /// A planar strand from `root`: segment y leaves at angle theta(y) from +Y toward +X.
@@ -191,10 +208,7 @@ TEST(Followers, FixedOffsetShapeWithStillGuidesAndDistanceWeightWhenInterpolatin
 }
 
 TEST(Followers, AtRestFollowersKeepTheGroomsShape) {
-    SphereGroomSettings s;
-    s.guides = 94;
-    s.followers = 751;
-    FollowerGroom groom = makeSphereGroom(s);
+    FollowerGroom groom = sphereGroom(94, 751);
     // A curved rest style shared by all guides (in each root frame).
     std::vector<Vec3f> style{Vec3f::Zero()};
     for (int y = 0; y < 23; ++y) style.push_back(style.back() + (0.25f / 23) * Vec3f(0.06f * y, 1.f, -0.02f * y).normalized());
@@ -227,10 +241,7 @@ TEST(Followers, AtRestFollowersKeepTheGroomsShape) {
 TEST(Followers, OwnRestShapesAreKeptAtRestInTheirOwnFrames) {
     // Followers with their own (curly, uneven) rest shapes, given in their own
     // mesh root frames, and guides at rest: every follower is its rest shape.
-    SphereGroomSettings s;
-    s.guides = 94;
-    s.followers = 751;
-    FollowerGroom groom = makeSphereGroom(s);
+    FollowerGroom groom = sphereGroom(94, 751);
     for (size_t f = 0; f < groom.followerRoots.size(); ++f) {
         std::vector<Vec3f> p{Vec3f::Zero()};
         for (int y = 0; y < 20; ++y)
@@ -238,14 +249,7 @@ TEST(Followers, OwnRestShapesAreKeptAtRestInTheirOwnFrames) {
                                        Vec3f(std::cos(0.9f * y + f), 1.2f, std::sin(0.9f * y + f)).normalized());
         groom.followerShapes.add(p.data(), p.size());
     }
-    StrandFrame guides;
-    for (size_t g = 0; g < groom.guideRoots.size(); ++g) {
-        std::vector<Vec3f> p;
-        for (uint32_t k = groom.guideShapes.offsets[g]; k < groom.guideShapes.offsets[g + 1]; ++k)
-            p.push_back(groom.guideRoots[g].position + groom.guideShapes.points[k].y() * groom.guideRoots[g].normal);
-        const std::vector<float> r(p.size(), 1e-4f);
-        guides.addStrand(uint32_t(g), p.data(), r.data(), p.size());
-    }
+    const StrandFrame guides = straightGuides(groom);
     for (FollowerMode mode : {FollowerMode::Varied, FollowerMode::Interpolate, FollowerMode::Cluster}) {
         FollowerSettings settings;
         settings.mode = mode;
@@ -267,10 +271,7 @@ TEST(Followers, OwnRestShapesAreKeptAtRestInTheirOwnFrames) {
 }
 
 TEST(Followers, RigidMotionOfTheWholeHeadMovesFollowersRigidly) {
-    SphereGroomSettings s;
-    s.guides = 94;
-    s.followers = 751;
-    const FollowerGroom groom = makeSphereGroom(s);
+    const FollowerGroom groom = sphereGroom(94, 751);
     SyntheticGuideSettings gs;
     gs.degreesPerSecond = 0;
     const SyntheticGuides motion(groom, gs);
@@ -302,10 +303,7 @@ TEST(Followers, RigidMotionOfTheWholeHeadMovesFollowersRigidly) {
 // Determinism, lengths, velocities, collision, errors
 
 TEST(Followers, SameBitsOnOneAndTwoThreadsAndSerial) {
-    SphereGroomSettings s;
-    s.guides = 200;
-    s.followers = 6000;
-    const FollowerGroom groom = makeSphereGroom(s);
+    const FollowerGroom groom = sphereGroom(200, 6000);
     const SyntheticGuides motion(groom, {});
     const SphereCollider head(Vec3f::Zero(), 0.1f);
     auto run = [&](int threads, bool parallel, FollowerMode mode) {
@@ -343,10 +341,7 @@ TEST(Followers, AFollowerDoesNotDependOnItsPacketMates) {
     // Followers run 8 to a vector (lanes); dropping the first follower moves
     // every other one to another lane and packet. In interpolate and cluster
     // modes (rand_xy hashes the follower index) the strands stay the same bits.
-    SphereGroomSettings s;
-    s.guides = 94;
-    s.followers = 1003;  // not a multiple of 8: a partial last packet either way
-    const FollowerGroom all = makeSphereGroom(s);
+    const FollowerGroom all = sphereGroom(94, 1003);  // not a multiple of 8: a partial last packet either way
     FollowerGroom rest = all;
     rest.followerRoots.erase(rest.followerRoots.begin());
     const SyntheticGuides motion(all, {});
@@ -374,10 +369,7 @@ TEST(Followers, AFollowerDoesNotDependOnItsPacketMates) {
 }
 
 TEST(Followers, SegmentLengthsArePreserved) {
-    SphereGroomSettings s;
-    s.guides = 60;
-    s.followers = 900;
-    FollowerGroom groom = makeSphereGroom(s);
+    FollowerGroom groom = sphereGroom(60, 900);
     // Three vertex counts (resampled guide tables) and per-follower lengths.
     groom.followerVertices.clear();
     groom.followerLengths.clear();
@@ -430,29 +422,19 @@ TEST(Followers, SegmentLengthsArePreserved) {
 }
 
 TEST(Followers, VelocitiesAreFiniteDifferencesOrGuideBlends) {
-    SphereGroomSettings s;
-    s.guides = 94;
-    s.followers = 751;
-    const FollowerGroom groom = makeSphereGroom(s);
+    const FollowerGroom groom = sphereGroom(94, 751);
     // First update: no previous positions, a blend of guide velocities; with
     // every guide moving at u, followers move at u.
     FollowerSettings cluster;
     cluster.mode = FollowerMode::Cluster;
     Followers still(groom, cluster);
-    StrandFrame guides;
-    for (size_t g = 0; g < groom.guideRoots.size(); ++g) {
-        std::vector<Vec3f> p;
-        for (uint32_t k = groom.guideShapes.offsets[g]; k < groom.guideShapes.offsets[g + 1]; ++k)
-            p.push_back(groom.guideRoots[g].position + groom.guideShapes.points[k].y() * groom.guideRoots[g].normal);
-        const std::vector<float> r(p.size(), 1e-4f);
-        const std::vector<Vec3f> v(p.size(), Vec3f(0.1f, -0.2f, 0.3f));
-        guides.addStrand(uint32_t(g), p.data(), r.data(), p.size(), v.data());
-    }
+    const Vec3f u(0.1f, -0.2f, 0.3f);
+    StrandFrame guides = straightGuides(groom, &u);
     StrandFrame out;
     const FollowerStats first = still.update({guides, groom.guideRoots, groom.followerRoots}, out);
     EXPECT_FALSE(first.differenceVelocities);
     EXPECT_TRUE(first.layoutWritten);
-    for (size_t i = guides.vertexCount(); i < out.vertexCount(); ++i) EXPECT_EQ(out.velocities[i], Vec3f(0.1f, -0.2f, 0.3f));
+    for (size_t i = guides.vertexCount(); i < out.vertexCount(); ++i) EXPECT_EQ(out.velocities[i], u);
 
     // Later updates into the same frame: (x - x_prev) / dt.
     const SyntheticGuides motion(groom, {});
@@ -475,10 +457,7 @@ TEST(Followers, VelocitiesAreFiniteDifferencesOrGuideBlends) {
 }
 
 TEST(Followers, InPlaceAppendEqualsSeparateOutput) {
-    SphereGroomSettings s;
-    s.guides = 94;
-    s.followers = 751;
-    const FollowerGroom groom = makeSphereGroom(s);
+    const FollowerGroom groom = sphereGroom(94, 751);
     const SyntheticGuides motion(groom, {});
     StrandFrame guides, out;
     std::vector<SurfaceFrame> guideRoots, followerRoots;
@@ -537,10 +516,7 @@ TEST(Followers, CollisionLeavesNoVertexInsideTheHead) {
 }
 
 TEST(Followers, BadInputIsReportedWithTheStrand) {
-    SphereGroomSettings s;
-    s.guides = 10;
-    s.followers = 50;
-    FollowerGroom groom = makeSphereGroom(s);
+    FollowerGroom groom = sphereGroom(10, 50);
     auto message = [](auto&& f) {
         try { f(); } catch (const Error& e) { return std::string(e.what()); }
         return std::string("no error");

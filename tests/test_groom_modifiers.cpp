@@ -2,6 +2,7 @@
 // (sim/followers/follower_metrics.h) and the followers' statistics: length error and
 // penetration when the head pushes a follower (sim/followers/followers.h).
 #include "core/errors.h"
+#include "follower_support.h"
 #include "pipeline/scene/follower_settings.h"
 #include "pipeline/stages/shot_simulation.h"
 #include "sim/followers/follower_metrics.h"
@@ -15,6 +16,7 @@
 #include <cstring>
 
 using namespace hp;
+using hp::test::SphereScene;
 
 namespace {
 
@@ -80,10 +82,8 @@ double worstLengthRatio(const RestShapes& base, const RestShapes& shapes) {
 }  // namespace
 
 TEST(GroomModifiers, ZeroSettingsGiveTodaysStrandsBitForBit) {
-    SphereGroomSettings s;
-    s.guides = 40;
-    s.followers = 600;
-    const FollowerGroom original = makeSphereGroom(s);
+    const SphereScene scene(40, 600, 0.7);
+    const FollowerGroom& original = scene.groom;
     FollowerGroom modified = original;
     GroomModifiers none;
     none.clumps = 500;  // a clump count without a clump weight changes nothing
@@ -91,13 +91,9 @@ TEST(GroomModifiers, ZeroSettingsGiveTodaysStrandsBitForBit) {
     EXPECT_EQ(modified.followerShapes.count(), 0u);
     EXPECT_FALSE(groomModifiers(Scene::parse("", "shot.yaml", ".")).active()) << "the schema's defaults are off";
 
-    const SyntheticGuides motion(original, {});
-    StrandFrame guides, a, b;
-    std::vector<SurfaceFrame> guideRoots, followerRoots;
-    motion.sample(0.7, guides, guideRoots);
-    rotateRoots(original.followerRoots, motion.headRotation(0.7), followerRoots);
-    Followers(original, {}).update({guides, guideRoots, followerRoots}, a);
-    Followers(modified, {}).update({guides, guideRoots, followerRoots}, b);
+    StrandFrame a, b;
+    Followers(original, {}).update({scene.guides, scene.guideRoots, scene.followerRoots}, a);
+    Followers(modified, {}).update({scene.guides, scene.guideRoots, scene.followerRoots}, b);
     ASSERT_EQ(a.positions.size(), b.positions.size());
     EXPECT_EQ(std::memcmp(a.positions.data(), b.positions.data(), a.positions.size() * sizeof(Vec3f)), 0);
 }
@@ -105,20 +101,14 @@ TEST(GroomModifiers, ZeroSettingsGiveTodaysStrandsBitForBit) {
 TEST(GroomModifiers, BaseShapesAreTheShapesFollowersTakeFromTheirGuide) {
     // Own rest shapes equal to followerBaseShapes give the followers of a
     // groom without own shapes, in motion too (to float rounding).
-    SphereGroomSettings s;
-    s.guides = 40;
-    s.followers = 600;
-    const FollowerGroom original = makeSphereGroom(s);
+    const SphereScene scene(40, 600, 0.9);
+    const FollowerGroom& original = scene.groom;
     FollowerGroom own = original;
     own.followerShapes = followerBaseShapes(original);
     ASSERT_EQ(own.followerShapes.count(), original.followerRoots.size());
-    const SyntheticGuides motion(original, {});
-    StrandFrame guides, a, b;
-    std::vector<SurfaceFrame> guideRoots, followerRoots;
-    motion.sample(0.9, guides, guideRoots);
-    rotateRoots(original.followerRoots, motion.headRotation(0.9), followerRoots);
-    Followers(original, {}).update({guides, guideRoots, followerRoots}, a);
-    Followers(own, {}).update({guides, guideRoots, followerRoots}, b);
+    StrandFrame a, b;
+    Followers(original, {}).update({scene.guides, scene.guideRoots, scene.followerRoots}, a);
+    Followers(own, {}).update({scene.guides, scene.guideRoots, scene.followerRoots}, b);
     float worst = 0.f;
     for (size_t v = 0; v < a.positions.size(); ++v) worst = std::max(worst, (a.positions[v] - b.positions[v]).norm());
     EXPECT_LT(worst, 2e-6f) << "m, over strands of 0.25 m";

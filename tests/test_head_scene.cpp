@@ -37,16 +37,25 @@ std::string sceneError(const std::function<void()>& f) {
     return "";
 }
 
+/// Whether tools/make_head, run with `flags`, writes exactly the bytes of the
+/// committed scenes/assets/`name` (make_head is deterministic).
+::testing::AssertionResult committedAssetIsToolOutput(const std::string& name, const std::string& flags) {
+    TempDir dir;
+    const std::string command =
+        std::string("'") + HAIRPIPE_MAKE_HEAD + "' '" + (dir / name).string() + "'" + flags + " > /dev/null";
+    if (std::system(command.c_str()) != 0) return ::testing::AssertionFailure() << command << " failed";
+    if (readFile(dir / name) != readFile(sourcePath("scenes/assets/" + name)))
+        return ::testing::AssertionFailure() << "scenes/assets/" << name << " is stale: regenerate it with "
+                                             << "'tools/make_head scenes/assets/" << name << flags << "'";
+    return ::testing::AssertionSuccess();
+}
+
 }  // namespace
 
 TEST(DefaultHead, CommittedAssetIsWhatTheToolWrites) {
     // The bytes: make_head is deterministic, so the committed file must be
     // exactly its output (regenerate with `build/tools/make_head scenes/assets/head.glb`).
-    TempDir dir;
-    const std::string command = std::string("'") + HAIRPIPE_MAKE_HEAD + "' '" + (dir / "head.glb").string() + "' > /dev/null";
-    ASSERT_EQ(std::system(command.c_str()), 0);
-    EXPECT_TRUE(readFile(dir / "head.glb") == readFile(sourcePath("scenes/assets/head.glb")))
-        << "scenes/assets/head.glb is stale: regenerate it with tools/make_head";
+    EXPECT_TRUE(committedAssetIsToolOutput("head.glb", ""));
 
     // The content, through assimp: the rig of pipeline/default_head.
     HeadImportSettings s;
@@ -75,12 +84,7 @@ TEST(DefaultHead, CommittedAssetIsWhatTheToolWrites) {
 
 TEST(DefaultHead, CommittedBodyIsWhatTheToolWrites) {
     // scenes/assets/body.glb: `make_head OUT --body`, the shoulders the default scene's hair rests on.
-    TempDir dir;
-    const std::string command =
-        std::string("'") + HAIRPIPE_MAKE_HEAD + "' '" + (dir / "body.glb").string() + "' --body > /dev/null";
-    ASSERT_EQ(std::system(command.c_str()), 0);
-    EXPECT_TRUE(readFile(dir / "body.glb") == readFile(sourcePath("scenes/assets/body.glb")))
-        << "scenes/assets/body.glb is stale: regenerate it with 'tools/make_head scenes/assets/body.glb --body'";
+    EXPECT_TRUE(committedAssetIsToolOutput("body.glb", " --body"));
     HeadImportSettings s;
     s.file = sourcePath("scenes/assets/body.glb");
     const HeadRig loaded = importHead(s);

@@ -60,6 +60,34 @@ PreviewSettings noShadows() {
     return s;
 }
 
+/// One frame of `strands` (and `head`, when given) through a fresh renderer
+/// with settings `s`; its stats in `*stats` when given.
+Image renderOnce(const PreviewSettings& s, const View& v, const StrandFrame& strands,
+                 const TriangleMesh* head = nullptr, PreviewStats* stats = nullptr) {
+    PreviewRenderer renderer(s);
+    PreviewFrame frame;
+    frame.strands = &strands;
+    frame.head = head;
+    Image img = renderer.render(v, frame);
+    if (stats) *stats = renderer.stats();
+    return img;
+}
+
+/// The shadow voxels a fresh renderer with settings `s` fills for one draw of `strands`.
+VoxelSnapshot voxelsOf(const PreviewSettings& s, const View& v, const StrandFrame& strands) {
+    PreviewRenderer renderer(s);
+    PreviewFrame frame;
+    frame.strands = &strands;
+    renderer.draw(v, frame);
+    return renderer.readVoxels();
+}
+
+/// Mean green over the 6 x 3 pixels around the image of segment ab's midpoint.
+double brightnessAt(const Image& img, const View& v, const Vec3f& a, const Vec3f& b) {
+    const Vec2f p = project(v, (a + b) * 0.5f);
+    return meanIn(img, 1, int(p.x()) - 3, int(p.y()) - 1, int(p.x()) + 3, int(p.y()) + 2);
+}
+
 TEST(Preview, ShadersCompileAndLink) {
     HP_REQUIRE_GL();
     // Every program (per-vertex shading) is built by the constructor; per-fragment
@@ -124,10 +152,7 @@ TEST(Preview, CoverageMatchesProjectedArea) {
             }
             PreviewSettings s = noShadows();
             s.curve = curve;
-            PreviewRenderer renderer(s);
-            PreviewFrame frame;
-            frame.strands = &strands;
-            const Image img = renderer.render(v, frame);
+            const Image img = renderOnce(s, v, strands);
             const double coverage = channelSum(img, 3);
             EXPECT_NEAR(coverage / area, 1.0, 0.03) << "width " << widthPx << " px, curve " << int(curve);
         }
@@ -151,10 +176,7 @@ TEST(Preview, KajiyaKayMatchesCpuReference) {
             v.hair.primaryShift = twoLobes ? 0.05f : 0.f;
             PreviewSettings s = noShadows();
             s.shadePerFragment = perFragment;
-            PreviewRenderer renderer(s);
-            PreviewFrame frame;
-            frame.strands = &strands;
-            const Image img = renderer.render(v, frame);
+            const Image img = renderOnce(s, v, strands);
             for (float t : {0.2f, 0.5f, 0.8f}) {
                 const Vec3f p = a + (b - a) * t;
                 const Vec2f px = project(v, p);
@@ -204,13 +226,10 @@ TEST(Preview, VoxelShadowsDarkenStrandBehindSlab) {
             PreviewSettings s;
             s.shadow.voxels = voxels;
             s.shadow.shadowMap = false;
-            PreviewRenderer renderer(s);
-            PreviewFrame frame;
-            frame.strands = &strands;
-            const Image img = renderer.render(v, frame);
-            EXPECT_EQ(renderer.stats().shadowed, voxels);
-            const Vec2f p = project(v, (a + b) * 0.5f);
-            return meanIn(img, 1, int(p.x()) - 3, int(p.y()) - 1, int(p.x()) + 3, int(p.y()) + 2);
+            PreviewStats stats;
+            const Image img = renderOnce(s, v, strands, nullptr, &stats);
+            EXPECT_EQ(stats.shadowed, voxels);
+            return brightnessAt(img, v, a, b);
         };
         const char* kind = light.type == LightType::Point ? "point light" : "directional light";
         const double off = brightness(false, shadowedA, shadowedB), on = brightness(true, shadowedA, shadowedB);
@@ -235,13 +254,7 @@ TEST(Preview, ShadowMapDarkensHairBehindHead) {
         PreviewSettings s;
         s.shadow.voxels = false;
         s.shadow.shadowMap = map;
-        PreviewRenderer renderer(s);
-        PreviewFrame frame;
-        frame.strands = &strands;
-        frame.head = &head;
-        const Image img = renderer.render(v, frame);
-        const Vec2f p = project(v, (a + b) * 0.5f);
-        return meanIn(img, 1, int(p.x()) - 3, int(p.y()) - 1, int(p.x()) + 3, int(p.y()) + 2);
+        return brightnessAt(renderOnce(s, v, strands, &head), v, a, b);
     };
     const double off = brightness(false), on = brightness(true);
     EXPECT_GT(off, 0.01);
@@ -332,11 +345,7 @@ TEST(Preview, VoxelCrossingsAddUpToProjectedArea) {
         s.shadow.resolution = 64;
         s.shadow.mode = VoxelMode::Additive;
         s.shadow.splat = splat;
-        PreviewRenderer renderer(s);
-        PreviewFrame frame;
-        frame.strands = &strands;
-        renderer.draw(v, frame);
-        const VoxelSnapshot snap = renderer.readVoxels();
+        const VoxelSnapshot snap = voxelsOf(s, v, strands);
         ASSERT_EQ(snap.resolution, 64);
         ASSERT_FALSE(snap.grid.perspective);
         double crossings = 0.0;
@@ -379,11 +388,7 @@ TEST(Preview, VoxelTransmittanceMatchesCpuVoxelization) {
         s.shadow.alpha = alpha;
         s.shadow.mode = mode;
         s.shadow.splat = splat;
-        PreviewRenderer renderer(s);
-        PreviewFrame frame;
-        frame.strands = &strands;
-        renderer.draw(v, frame);
-        const VoxelSnapshot snap = renderer.readVoxels();
+        const VoxelSnapshot snap = voxelsOf(s, v, strands);
         ASSERT_EQ(snap.resolution, res);
         const std::vector<float> cpu = cpuVoxelize(lines, snap.grid, res, mode, splat);
         double gpuTotal = 0.0, cpuTotal = 0.0, error = 0.0;

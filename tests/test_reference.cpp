@@ -35,6 +35,23 @@ View testView(int width, int height, const Vec3f& lightDirection) {
     return v;
 }
 
+/// 3000 synthetic strands on their 0.1 m sphere head (16 x 32 facets), seen
+/// from (0, 0.05, 0.9) in testView's light from (-1, -1, -1).
+struct HairOnHead {
+    StrandFrame strands;
+    TriangleMesh head;
+    View view;
+};
+
+HairOnHead hairOnHead(int width, int height) {
+    SyntheticHairSettings hs;
+    hs.strands = 3000;
+    HairOnHead h{makeSyntheticHair(hs), makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32),
+                 testView(width, height, Vec3f(-1.f, -1.f, -1.f))};
+    h.view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
+    return h;
+}
+
 /// One straight strand from a to b with n vertices of constant radius.
 void addLine(StrandFrame& f, uint32_t id, const Vec3f& a, const Vec3f& b, int n, float radius) {
     std::vector<Vec3f> p(n);
@@ -141,13 +158,8 @@ TEST(Reference, ShadowRaysCountEachStrandCrossingOnce) {
 }
 
 TEST(Reference, SameBitsForOneAndTwoThreads) {
-    SyntheticHairSettings hs;
-    hs.strands = 3000;
-    const StrandFrame strands = makeSyntheticHair(hs);
-    const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
-    View view = testView(80, 60, Vec3f(-1.f, -1.f, -1.f));
-    view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
-    view.environment = Vec3f(0.1f, 0.1f, 0.12f);
+    HairOnHead shot = hairOnHead(80, 60);
+    shot.view.environment = Vec3f(0.1f, 0.1f, 0.12f);
     for (ReferenceMode mode : {ReferenceMode::KajiyaKay, ReferenceMode::Physical}) {
         ReferenceSettings s;
         s.mode = mode;
@@ -157,8 +169,8 @@ TEST(Reference, SameBitsForOneAndTwoThreads) {
         s.diffuseSpecularLayers = true;
         s.strandIdLayer = true;
         Image one, two;
-        tbb::task_arena(1).execute([&] { one = ReferenceRenderer().render(view, &strands, &head, s); });
-        tbb::task_arena(2).execute([&] { two = ReferenceRenderer().render(view, &strands, &head, s); });
+        tbb::task_arena(1).execute([&] { one = ReferenceRenderer().render(shot.view, &shot.strands, &shot.head, s); });
+        tbb::task_arena(2).execute([&] { two = ReferenceRenderer().render(shot.view, &shot.strands, &shot.head, s); });
         ASSERT_EQ(one.pixels.size(), two.pixels.size());
         EXPECT_EQ(0, std::memcmp(one.pixels.data(), two.pixels.data(), one.pixels.size() * sizeof(float)))
             << referenceModeName(mode);
@@ -168,7 +180,7 @@ TEST(Reference, SameBitsForOneAndTwoThreads) {
         EXPECT_GT(coverage, 0.05 * one.width * one.height);  // hair and head are in the picture
         // A different frame draws different samples.
         s.frame = 2;
-        const Image other = ReferenceRenderer().render(view, &strands, &head, s);
+        const Image other = ReferenceRenderer().render(shot.view, &shot.strands, &shot.head, s);
         EXPECT_NE(0, std::memcmp(one.pixels.data(), other.pixels.data(), one.pixels.size() * sizeof(float)));
     }
 }
@@ -176,19 +188,14 @@ TEST(Reference, SameBitsForOneAndTwoThreads) {
 TEST(Reference, ShadowRouletteKeepsTheMeanAndSavesRays) {
     // Dark hair: most light samples are small, so roulette skips most of
     // their shadow rays; weighting the traced ones by 1/q keeps the mean.
-    SyntheticHairSettings hs;
-    hs.strands = 3000;
-    const StrandFrame strands = makeSyntheticHair(hs);
-    const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
-    View view = testView(64, 48, Vec3f(-1.f, -1.f, -1.f));
-    view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
+    const HairOnHead shot = hairOnHead(64, 48);
     ReferenceSettings s;
     s.mode = ReferenceMode::Physical;
     s.samplesPerPixel = 64;
     s.bounces = 2;
     auto render = [&](float threshold, ReferenceStats* stats) {
         s.shadowRouletteThreshold = threshold;
-        const Image img = ReferenceRenderer().render(view, &strands, &head, s, stats);
+        const Image img = ReferenceRenderer().render(shot.view, &shot.strands, &shot.head, s, stats);
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         for (int y = 0; y < img.height; ++y)
             for (int x = 0; x < img.width; ++x)
@@ -198,7 +205,7 @@ TEST(Reference, ShadowRouletteKeepsTheMeanAndSavesRays) {
     ReferenceStats all, roulette;
     const Eigen::Vector3d exact = render(0.f, &all);
     const Eigen::Vector3d skipped = render(0.25f, &roulette);
-    const double camera = double(view.camera.width) * view.camera.height * s.samplesPerPixel;
+    const double camera = double(shot.view.camera.width) * shot.view.camera.height * s.samplesPerPixel;
     EXPECT_LT(double(roulette.rays) - camera, 0.75 * (double(all.rays) - camera));  // shadow + bounce rays
     for (int c = 0; c < 3; ++c) {
         ASSERT_GT(exact[c], 1.0) << "channel " << c;  // the hair is lit
