@@ -88,7 +88,10 @@ class NullSource final : public FrameSource {
   public:
     FrameData get(int frame) override {
         ++calls;
-        return {frame, frame / 24.0, nullptr, nullptr};
+        FrameData data;
+        data.frame = frame;
+        data.time = frame / 24.0;
+        return data;
     }
     int calls = 0;
 };
