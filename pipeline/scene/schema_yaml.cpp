@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <set>
 
 namespace hp {
@@ -68,11 +69,19 @@ class SchemaFileReader {
         schema_.section(path, text(entry, "doc", path));
     }
 
-    static KeyType typeNamed(const std::string& name, bool& found) {
+    static std::optional<KeyType> typeNamed(const std::string& name) {
         for (KeyType t : {KeyType::Bool, KeyType::Int, KeyType::Float, KeyType::String, KeyType::Enum, KeyType::File,
                           KeyType::Vec3, KeyType::FrameRange, KeyType::Curve, KeyType::List})
-            if (name == keyTypeName(t)) return found = true, t;
-        return found = false, KeyType::String;
+            if (name == keyTypeName(t)) return t;
+        return std::nullopt;
+    }
+
+    bool flag(const YAML::Node& v, const std::string& key, const char* field) const {
+        try {
+            return v.as<bool>();
+        } catch (const YAML::Exception&) {
+            fail(v, key, cat("`", field, "` is true or false"));
+        }
     }
 
     /// The builder's number format for defaults: what `hairpipe help scene` shows.
@@ -94,12 +103,7 @@ class SchemaFileReader {
         }
         if (!v.IsScalar()) fail(v, k.path, "`default` must be a scalar (a list's default is YAML text)");
         switch (k.type) {
-        case KeyType::Bool:
-            try {
-                return v.as<bool>() ? "true" : "false";
-            } catch (const YAML::Exception&) {
-                fail(v, k.path, "a bool default is true or false");
-            }
+        case KeyType::Bool: return flag(v, k.path, "default") ? "true" : "false";
         case KeyType::Int: {
             const double x = number(v, k.path, "default");
             if (x != std::floor(x)) fail(v, k.path, "an integer default must be whole");
@@ -116,9 +120,9 @@ class SchemaFileReader {
         KeySpec k;
         k.path = text(entry, "key", "");
         onlyFields(entry, k.path, {"key", "type", "default", "range", "unit", "choices", "max_items", "required", "doc"});
-        bool known = false;
-        k.type = typeNamed(text(entry, "type", k.path), known);
-        if (!known) fail(entry["type"] ? entry["type"] : entry, k.path, "`type` must be one of keyTypeName's names");
+        const std::optional<KeyType> type = typeNamed(text(entry, "type", k.path));
+        if (!type) fail(entry["type"] ? entry["type"] : entry, k.path, "`type` must be one of keyTypeName's names");
+        k.type = *type;
         if (!entry["doc"]) fail(entry, k.path, "a key needs `doc`");
         k.doc = text(entry, "doc", k.path);
         k.unit = text(entry, "unit", k.path);
@@ -137,7 +141,7 @@ class SchemaFileReader {
             for (const YAML::Node& choice : c) k.choices.push_back(choice.Scalar());
         }
         if (k.type == KeyType::Enum && k.choices.empty()) fail(entry, k.path, "a choice needs `choices`");
-        k.required = entry["required"] && entry["required"].as<bool>();
+        k.required = entry["required"] && flag(entry["required"], k.path, "required");
         k.defaultYaml = defaultYaml(entry, k);
         if (schema_.find(k.path)) fail(entry, k.path, "key given twice");
         schema_.add(std::move(k));
