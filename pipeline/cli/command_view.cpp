@@ -30,18 +30,15 @@ class SourceFrames {
             if (!source_ || frame < current_) source_ = makeFrameSource(scene_, shot_);
             data_ = source_->get(frame);
             current_ = frame;
+            // The head with the visible colliders beside it: built once per
+            // frame, not on every redraw (the viewer asks ~60 times a second).
+            head_ = data_.head ? &drawnMesh(*data_.head, drawn_) : nullptr;
         }
         ViewerFrame f;
         f.time = data_.time;
         f.strands = data_.strands;
-        if (data_.head) {
-            f.head = &data_.head->mesh;
-            if (!data_.head->scenery.triangles.empty()) {  // the visible colliders beside the head
-                drawn_ = drawnMesh(*data_.head);
-                f.head = &drawn_;
-            }
-            f.headTransform = data_.head->transform;
-        }
+        f.head = head_;
+        if (data_.head) f.headTransform = data_.head->transform;
         return f;
     }
 
@@ -51,6 +48,7 @@ class SourceFrames {
     std::unique_ptr<FrameSource> source_;
     FrameData data_;
     TriangleMesh drawn_;  ///< the head and its scenery, while the frame is shown
+    const TriangleMesh* head_ = nullptr;  ///< drawn_, or data_'s head mesh when it has no scenery
     int current_ = INT_MIN;
 };
 

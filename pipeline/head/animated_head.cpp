@@ -51,9 +51,10 @@ void addScenery(TriangleMesh& scenery, const ColliderShape& shape, const Eigen::
 
 }  // namespace
 
-TriangleMesh drawnMesh(const HeadPose& pose) {
-    TriangleMesh m = pose.mesh;
-    if (pose.scenery.triangles.empty()) return m;
+const TriangleMesh& drawnMesh(const HeadPose& pose, TriangleMesh& storage) {
+    if (pose.scenery.triangles.empty()) return pose.mesh;
+    TriangleMesh& m = storage;
+    m = pose.mesh;
     if (m.normals.size() != m.positions.size()) m.computeNormals();
     appendMesh(m, pose.scenery);
     if (!m.uvs.empty()) m.uvs.resize(m.positions.size(), Vec2f::Zero());

@@ -94,7 +94,10 @@ class AnimatedHead final : public HeadMotion {
 
 /// @brief What a renderer draws of a pose: the head's mesh followed by its
 /// scenery (the visible mesh colliders), as one mesh.
-TriangleMesh drawnMesh(const HeadPose& pose);
+/// @param storage  filled with that mesh when the pose has scenery; without
+///                 scenery the result is pose.mesh itself (no copy).
+/// @return pose.mesh or `storage`; valid while both are.
+const TriangleMesh& drawnMesh(const HeadPose& pose, TriangleMesh& storage);
 
 /// @brief Least-squares rigid transform (Kabsch / Umeyama without scale)
 /// taking `from[i]` to `to[i]` for the listed indices (all when empty).

@@ -8,7 +8,6 @@ namespace hp {
 bool usesCurlyWetModel(const Scene& scene) { return scene.text("hair.model") == "curly-wet"; }
 
 CurlyWetSettings curlyWetSettings(const Scene& scene) {
-    auto f = [&](const char* key) { return float(scene.number(key)); };
     CurlyWetSettings s;
     readKeys(scene, s, {
         {"hair.curly.particles", &CurlyWetSettings::particles},
@@ -21,26 +20,11 @@ CurlyWetSettings curlyWetSettings(const Scene& scene) {
         {"hair.curly.time_step", &CurlyWetSettings::timeStep},
         {"hair.curly.substeps", &CurlyWetSettings::substeps},
         {"hair.curly.iterations", &CurlyWetSettings::iterations},
-    });
-    // The wisp's material: the rod formulation's keys (pipeline/scene/sim_settings.cpp).
-    s.material.youngs = f("hair.material.youngs_modulus");
-    s.material.shear = f("hair.material.shear_modulus");
-    s.material.density = f("hair.material.density");
-    s.material.hairsPerGuide = f("hair.material.hairs_per_guide");
-    s.material.radius = f("hair.radius.root");
-    // Mass and springs the scene gives are the seed's model; the others
-    // follow from the material (CurlyWetSettings::resolved).
-    auto given = [&](const char* key) { return scene.given(key) ? f(key) : kFromMaterial; };
-    s.massPerLength = given("hair.curly.mass_per_length");
-    s.gravity = scene.vec3f("hair.curly.gravity");
-    s.preload = scene.flag("hair.curly.preload");
-    s.stretchStiffness = given("hair.curly.stretch_stiffness");
-    s.stretchDamping = f("hair.curly.stretch_damping");
-    s.bendStiffness = given("hair.curly.bend_stiffness");
-    s.bendDamping = f("hair.curly.bend_damping");
-    s.bendSmoothing = f("hair.curly.bend_smoothing");
-    s.coreStiffness = given("hair.curly.core_stiffness");
-    readKeys(scene, s, {
+        {"hair.curly.gravity", &CurlyWetSettings::gravity},
+        {"hair.curly.preload", &CurlyWetSettings::preload},
+        {"hair.curly.stretch_damping", &CurlyWetSettings::stretchDamping},
+        {"hair.curly.bend_damping", &CurlyWetSettings::bendDamping},
+        {"hair.curly.bend_smoothing", &CurlyWetSettings::bendSmoothing},
         {"hair.curly.core_damping", &CurlyWetSettings::coreDamping},
         {"hair.curly.core_smoothing", &CurlyWetSettings::coreSmoothing},
         {"hair.curly.max_strain", &CurlyWetSettings::maxStrain},
@@ -49,18 +33,11 @@ CurlyWetSettings curlyWetSettings(const Scene& scene) {
         {"hair.curly.teleport_distance", &CurlyWetSettings::teleportDistance},
         {"hair.curly.teleport_angle", &CurlyWetSettings::teleportAngle},
         {"hair.curly.strands_per_world", &CurlyWetSettings::strandsPerWorld},
-    });
-
-    s.wetEffects = scene.flag("hair.wet.enabled");
-    s.saturation = sceneSaturation(scene, 0.0);
-    readKeys(scene, s, {
+        {"hair.wet.enabled", &CurlyWetSettings::wetEffects},
         {"hair.wet.saturation_root", &CurlyWetSettings::saturationRoot},
         {"hair.wet.saturation_tip", &CurlyWetSettings::saturationTip},
         {"hair.wet.helix_radius", &CurlyWetSettings::helixRadius},
         {"hair.wet.helix_pitch", &CurlyWetSettings::helixPitch},
-    });
-    s.helixWeight = given("hair.wet.helix_weight");
-    readKeys(scene, s, {
         {"hair.wet.cohesion", &CurlyWetSettings::cohesion},
         {"hair.wet.cohesion_tightness", &CurlyWetSettings::cohesionTightness},
         {"hair.wet.cohesion_radius", &CurlyWetSettings::cohesionRadius},
@@ -73,6 +50,23 @@ CurlyWetSettings curlyWetSettings(const Scene& scene) {
         {"hair.wet.dry_stiffness", &CurlyWetSettings::dryStiffness},
         {"hair.wet.stiffness_step", &CurlyWetSettings::stiffnessStep},
     });
+    s.saturation = sceneSaturation(scene, 0.0);
+    // The wisp's material: the rod formulation's keys (pipeline/scene/sim_settings.cpp).
+    readKeys(scene, s.material, {
+        {"hair.material.youngs_modulus", &rod::Material::youngs},
+        {"hair.material.shear_modulus", &rod::Material::shear},
+        {"hair.material.density", &rod::Material::density},
+        {"hair.material.hairs_per_guide", &rod::Material::hairsPerGuide},
+        {"hair.radius.root", &rod::Material::radius},
+    });
+    // Mass and springs the scene gives are the seed's model; the others
+    // follow from the material (CurlyWetSettings::resolved).
+    auto given = [&](const char* key) { return scene.given(key) ? float(scene.number(key)) : kFromMaterial; };
+    s.massPerLength = given("hair.curly.mass_per_length");
+    s.stretchStiffness = given("hair.curly.stretch_stiffness");
+    s.bendStiffness = given("hair.curly.bend_stiffness");
+    s.coreStiffness = given("hair.curly.core_stiffness");
+    s.helixWeight = given("hair.wet.helix_weight");
 
     if (s.adhesion && s.adhesionRadius <= 2.f * s.collisionRadius)
         scene.fail("hair.wet.adhesion_radius",

@@ -5,40 +5,42 @@ namespace hp {
 
 PreviewSettings makePreviewSettings(const Scene& s) {
     PreviewSettings p;
-    p.msaa = int(s.integer("preview.msaa"));
-    p.supersample = int(s.integer("preview.supersample"));
+    readKeys(s, p, {
+        {"preview.msaa", &PreviewSettings::msaa},
+        {"preview.supersample", &PreviewSettings::supersample},
+        {"preview.min_pixel_width", &PreviewSettings::minPixelWidth},
+        {"preview.blend_depth_scale", &PreviewSettings::blendDepthScale},
+        {"preview.head", &PreviewSettings::drawHead},
+        {"preview.tessellation.level", &PreviewSettings::tessellationLevel},
+        {"preview.tessellation.pixels", &PreviewSettings::tessellationPixels},
+    });
     p.shadePerFragment = s.text("preview.shading") == "fragment";
-    p.minPixelWidth = float(s.number("preview.min_pixel_width"));
     p.blend = s.text("preview.transparency") == "weighted" ? HairBlend::Weighted : HairBlend::Sorted;
-    p.blendDepthScale = float(s.number("preview.blend_depth_scale"));
-    p.drawHead = s.flag("preview.head");
     p.curve = s.text("preview.tessellation.curve") == "b-spline" ? CurveType::BSpline : CurveType::CatmullRom;
-    p.tessellationLevel = int(s.integer("preview.tessellation.level"));
-    p.tessellationPixels = float(s.number("preview.tessellation.pixels"));
 
     PreviewShadowSettings& sh = p.shadow;
-    sh.light = int(s.integer("preview.shadow.light"));
+    readKeys(s, sh, {
+        {"preview.shadow.light", &PreviewShadowSettings::light},
+        {"preview.shadow.voxels", &PreviewShadowSettings::voxels},
+        {"preview.shadow.sum", &PreviewShadowSettings::sumAlongLight},
+        {"preview.shadow.resolution", &PreviewShadowSettings::resolution},
+        {"preview.shadow.filter", &PreviewShadowSettings::filter},
+        {"preview.shadow.alpha", &PreviewShadowSettings::alpha},
+        {"preview.shadow.map", &PreviewShadowSettings::shadowMap},
+        {"preview.shadow.map_size", &PreviewShadowSettings::shadowMapSize},
+        {"preview.shadow.pcf_radius", &PreviewShadowSettings::pcfRadius},
+    });
     const size_t lights = s.count("render.lights");
     if (sh.light >= 0 && size_t(sh.light) >= lights)
         s.fail("preview.shadow.light",
                cat("names light ", sh.light, " but render.lights has ", lights, " (use -1 for no shadows)"));
-    sh.voxels = s.flag("preview.shadow.voxels");
     sh.mode = s.text("preview.shadow.voxel_mode") == "binary" ? VoxelMode::Binary : VoxelMode::Additive;
     sh.splat = s.text("preview.shadow.splat") == "trilinear" ? VoxelSplat::Trilinear : VoxelSplat::Nearest;
     if (sh.mode == VoxelMode::Binary && sh.splat == VoxelSplat::Trilinear)
         s.fail("preview.shadow.splat",
                "trilinear splatting spreads fractions of a fragment, which only adds up with voxel_mode: additive "
                "(seed 004 compares nearest/binary, nearest/additive and trilinear/additive)");
-    sh.sumAlongLight = s.flag("preview.shadow.sum");
-    sh.resolution = int(s.integer("preview.shadow.resolution"));
-    sh.filter = s.flag("preview.shadow.filter");
     sh.weight = s.text("preview.shadow.weight") == "fragments" ? VoxelWeight::Fragments : VoxelWeight::Crossings;
-    readKeys(s, sh, {
-        {"preview.shadow.alpha", &PreviewShadowSettings::alpha},
-        {"preview.shadow.map", &PreviewShadowSettings::shadowMap},
-        {"preview.shadow.map_size", &PreviewShadowSettings::shadowMapSize},
-        {"preview.shadow.pcf_radius", &PreviewShadowSettings::pcfRadius},
-    });
 
     GeneratedHairSettings& g = p.generated;
     readKeys(s, g, {

@@ -58,11 +58,13 @@ View makeView(const Scene& s) {
         {"render.hair.transmittance", &HairMaterial::transmittance},
     });
 
-    v.head.color = s.vec3f("render.head.color");
-    v.head.ambient = float(s.number("render.head.ambient"));
-    v.head.wrap = float(s.number("render.head.wrap"));
-    v.head.specular = float(s.number("render.head.specular"));
-    v.head.shininess = float(s.number("render.head.shininess"));
+    readKeys(s, v.head, {
+        {"render.head.color", &SurfaceMaterial::color},
+        {"render.head.ambient", &SurfaceMaterial::ambient},
+        {"render.head.wrap", &SurfaceMaterial::wrap},
+        {"render.head.specular", &SurfaceMaterial::specular},
+        {"render.head.shininess", &SurfaceMaterial::shininess},
+    });
     return v;
 }
 

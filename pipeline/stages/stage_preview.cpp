@@ -58,11 +58,7 @@ class PreviewStage final : public FrameStage {
         frame.strands = data.strands;
         TriangleMesh drawn;  // the head with the visible colliders beside it
         if (data.head) {
-            frame.head = &data.head->mesh;
-            if (!data.head->scenery.triangles.empty()) {
-                drawn = drawnMesh(*data.head);
-                frame.head = &drawn;
-            }
+            frame.head = &drawnMesh(*data.head, drawn);
             frame.headTransform = data.head->transform;
         }
         View view = view_;

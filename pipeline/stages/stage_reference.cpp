@@ -87,12 +87,9 @@ class ReferenceStage final : public FrameStage {
     }
 
     void run(const FrameData& data) override {
-        const TriangleMesh* head = data.head && !data.head->mesh.triangles.empty() ? &data.head->mesh : nullptr;
         TriangleMesh drawn;  // the head with the visible colliders beside it
-        if (head && !data.head->scenery.triangles.empty()) {
-            drawn = drawnMesh(*data.head);
-            head = &drawn;
-        }
+        const TriangleMesh* head =
+            data.head && !data.head->mesh.triangles.empty() ? &drawnMesh(*data.head, drawn) : nullptr;
         if (!data.strands && !head)
             throw FrameError(cat("frame ", data.frame,
                                  " has neither strands nor a head to render (no hair or head stage produced them)"));

@@ -24,6 +24,7 @@
 #include "sim/followers/followers.h"
 #include "sim/strands/groom_modifiers.h"
 #include "sim/strands/synthetic_groom.h"
+#include "tools/bench/bench_support.h"
 
 #include <tbb/task_arena.h>
 
@@ -72,12 +73,6 @@ GuideSource makeSyntheticSource(size_t guides, size_t followers, const GroomModi
     return src;
 }
 
-double cpuMs() {
-    timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
 struct Result {
     double median = 0, spread = 0, buildMs = 0;
     double cpu = 0;  ///< median CPU ms per step, all threads together
@@ -85,12 +80,6 @@ struct Result {
     double angle = 0;  ///< median neighbour angle after the last step, degrees
     uint64_t digest = 0;  ///< FNV-1a of the last step's positions and velocities
 };
-
-uint64_t fnv1a(const void* data, size_t bytes, uint64_t h = 1469598103934665603ull) {
-    const unsigned char* p = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
-    return h;
-}
 
 const char* modeName(FollowerMode m) {
     return m == FollowerMode::Varied ? "varied" : m == FollowerMode::Cluster ? "cluster"
@@ -121,10 +110,10 @@ Result measure(const GuideSource& src, FollowerMode mode, int threads, int steps
             for (int s = 0; s < steps; ++s, ++i) {
                 src.next(i, guides, guideRoots, followerRoots);  // not timed: the guides' side
                 const auto t0 = Clock::now();
-                const double c0 = cpuMs();
+                const double c0 = bench::processCpuSeconds();
                 const FollowerStats st =
                     followers.update({guides, guideRoots, followerRoots, src.head.get(), src.dt}, frame);
-                totalCpu += cpuMs() - c0;
+                totalCpu += 1e3 * (bench::processCpuSeconds() - c0);
                 total += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
                 r.projected += double(st.projected);
                 r.queries += double(st.collisionQueries);
@@ -135,8 +124,8 @@ Result measure(const GuideSource& src, FollowerMode mode, int threads, int steps
         }
         frame.validate();
         r.angle = medianNeighbourAngle(frame, frame.guideCount);
-        r.digest = fnv1a(frame.velocities.data(), frame.velocities.size() * sizeof(Vec3f),
-                         fnv1a(frame.positions.data(), frame.positions.size() * sizeof(Vec3f)));
+        r.digest = bench::fnv1a(frame.velocities.data(), frame.velocities.size() * sizeof(Vec3f),
+                                bench::fnv1a(frame.positions.data(), frame.positions.size() * sizeof(Vec3f)));
     });
     std::sort(runs.begin(), runs.end());
     r.median = runs[1];

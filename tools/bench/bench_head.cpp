@@ -12,6 +12,7 @@
 #include "pipeline/head/head_setup.h"
 #include "pipeline/head/scalp.h"
 #include "sim/strands/roots.h"
+#include "tools/bench/bench_support.h"
 
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
@@ -47,15 +48,12 @@ double threadSecondsOf(const std::function<void()>& f) {
     return double(b.tv_sec - a.tv_sec) + 1e-9 * double(b.tv_nsec - a.tv_nsec);
 }
 
-struct Stats {
-    double median, min, max;
-};
+using bench::Stats;
 
 Stats repeat(int n, const std::function<void()>& f, bool cpuTime = false) {
     std::vector<double> t;
     for (int i = 0; i < n; ++i) t.push_back(cpuTime ? threadSecondsOf(f) : secondsOf(f));
-    std::sort(t.begin(), t.end());
-    return {t[t.size() / 2], t.front(), t.back()};
+    return bench::stats(t);
 }
 
 /// The default head at ~100k triangles with every vertex weighted to four

@@ -70,13 +70,6 @@ struct RunResult {
     uint64_t digest = 0;
 };
 
-/// FNV-1a over bytes.
-uint64_t fnv1a(const std::vector<char>& bytes) {
-    uint64_t h = 1469598103934665603ull;
-    for (char c : bytes) h = (h ^ uint64_t(uint8_t(c))) * 1099511628211ull;
-    return h;
-}
-
 /// How far a Bullet mesh collider measures (beyond: a lower bound), m.
 float kRange = 0.05f;
 
@@ -153,7 +146,10 @@ RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int 
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     r.stepsPerSecond = steps / seconds;
     r.cpuMsPerStep = 1000.0 * (bench::processCpuSeconds() - cpu0) / steps;
-    if (digest) r.digest = fnv1a(solver.saveState());
+    if (digest) {
+        const std::vector<char> state = solver.saveState();
+        r.digest = bench::fnv1a(state.data(), state.size());
+    }
     return r;
 }
 
