@@ -43,7 +43,6 @@ struct GuideSet : solver::StrandState {
     std::vector<float> limitSpring;   ///< per segment: rope limit spring fraction per Bullet step
     std::vector<float> limitPerIteration;  ///< per segment: the same spread over Bullet's link iterations
     std::vector<float> minSpan, maxSpan;   ///< per segment: rope bend limits as spans (strand::bendLimitSpan)
-    std::vector<float> jointInertia;  ///< per segment: m_{j+1}·l_j², the joint drive's inertia, kg·m²
     std::vector<float> mass;          ///< per vertex (0 for the kinematic root)
 
     /// Bumped whenever x / v are written outside a group's own substep (a

@@ -166,7 +166,6 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
     set.limitPerIteration.assign(ns, 0.f);
     set.minSpan.assign(ns, 0.f);
     set.maxSpan.assign(ns, 0.f);
-    set.jointInertia.assign(ns, 0.f);
     set.restBend.assign(ns, 0.f);
     set.cosMostBend.assign(ns, 0.f);
     set.cosLeastBend.assign(ns, 0.f);
@@ -200,7 +199,6 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
             // The joint drive acts on its own segment (inertia m·l² about the
             // joint); what hangs beyond is carried along (strand::relaxJoints).
             const float inertia = set.mass[set.vertex(g, j + 1)] * set.restLength[seg] * set.restLength[seg];
-            set.jointInertia[seg] = inertia;
             set.springDir[seg] = set.groomDir[seg];
             const float h = s.timeStep / float(s.substeps);
             set.spring[seg] = strand::springFraction(s.bendStiffness, inertia, h);
