@@ -87,6 +87,9 @@ struct SubstepContext {
     strand::HeadQuery head;    ///< head collider as seen at this Bullet step's end
     Eigen::Isometry3f headTransform = Eigen::Isometry3f::Identity();  ///< rigid head pose at the end
     bool headCollision = true; ///< false: skip projection (head.collider may still be set)
+
+    /// The head the kernels project out of: null when collision is off or there is no collider.
+    const strand::HeadQuery* collidingHead() const { return headCollision && head.collider ? &head : nullptr; }
 };
 
 /// One Bullet world advancing guides [begin, end) of a GuideSet.

@@ -271,7 +271,7 @@ void GuideSolver::Impl::substep(const solver::Substep& sub) {
     ctx.headCollision = set.settings.headCollision;
     forGroups([&](guides::GuideGroup& grp) { grp.substep(ctx); });
     if (contacts) {
-        const strand::HeadQuery* hq = ctx.headCollision && ctx.head.collider ? &ctx.head : nullptr;
+        const strand::HeadQuery* hq = ctx.collidingHead();
         strandContacts += contacts->solve(set, ctx.h, [&](size_t g) { relax(g, hq); });
         ++set.version;
     }

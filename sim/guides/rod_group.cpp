@@ -97,7 +97,7 @@ class RodGroup final : public GuideGroup {
 
 void RodGroup::substep(const SubstepContext& ctx) {
     const GuideSettings& s = set_.settings;
-    const strand::HeadQuery* head = ctx.headCollision && ctx.head.collider ? &ctx.head : nullptr;
+    const strand::HeadQuery* head = ctx.collidingHead();
     // The rod's own steps inside the solver's substep: root targets
     // interpolated over [alpha0, alpha].
     const int k = std::max(1, s.rodSubsteps);

@@ -288,7 +288,7 @@ void RopeGroup::substep(const SubstepContext& ctx) {
 void RopeGroup::relax(size_t g, const SubstepContext& ctx) {
     const GuideSettings& s = set_.settings;
     const float h = ctx.h;
-    const strand::HeadQuery* head = ctx.headCollision && ctx.head.collider ? &ctx.head : nullptr;
+    const strand::HeadQuery* head = ctx.collidingHead();
     const size_t b = g - begin_;
     const int n = set_.vertices;
     for (int i = 0; i < n; ++i) x_[i] = ei(bundle_.node(b, i).m_x);
