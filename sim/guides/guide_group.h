@@ -13,6 +13,7 @@
 #include "sim/guides/joint_kernels.h"
 #include "sim/solver/damping.h"
 #include "sim/solver/length_kernels.h"
+#include "sim/solver/skeleton.h"
 #include "sim/solver/strand_state.h"
 
 #include <cmath>
@@ -80,12 +81,10 @@ struct GuideSet : solver::StrandState {
     float maxBend(size_t begin, size_t end) const;
 };
 
-/// What one Bullet step (a substep of the solver's step, solver::Substep) needs.
-struct SubstepContext {
-    float h = 0.02f;           ///< Bullet step, s
-    float alpha = 1.f;         ///< fraction of the solver step at this Bullet step's end
-    strand::HeadQuery head;    ///< head collider as seen at this Bullet step's end
-    Eigen::Isometry3f headTransform = Eigen::Isometry3f::Identity();  ///< rigid head pose at the end
+/// What one Bullet step needs: the skeleton's substep (h, alpha, the head
+/// collider and the head's rigid pose at this Bullet step's end) and whether
+/// the guides collide with the head.
+struct SubstepContext : solver::Substep {
     bool headCollision = true; ///< false: skip projection (head.collider may still be set)
 
     /// The head the kernels project out of: null when collision is off or there is no collider.

@@ -264,10 +264,7 @@ void GuideSolver::Impl::resetToRest(const HeadPose& head) {
 
 void GuideSolver::Impl::substep(const solver::Substep& sub) {
     guides::SubstepContext ctx;
-    ctx.h = sub.h;
-    ctx.alpha = sub.alpha;
-    ctx.headTransform = sub.headTransform;
-    ctx.head = sub.head;
+    static_cast<solver::Substep&>(ctx) = sub;
     ctx.headCollision = set.settings.headCollision;
     forGroups([&](guides::GuideGroup& grp) { grp.substep(ctx); });
     if (contacts) {
