@@ -93,11 +93,6 @@ struct CurlyWetSolver::Impl final : solver::StrandModel {
         set.settings = s;
     }
 
-    template <typename F>
-    void parallel(size_t count, size_t grain, F&& f) {
-        skeleton.parallel(count, grain, std::forward<F>(f));
-    }
-
     void updateWet() {
         set.wet = false;
         if (!set.settings.wetEffects) return;
@@ -117,7 +112,7 @@ struct CurlyWetSolver::Impl final : solver::StrandModel {
         const size_t total = set.x.size();
         set.cohesion.resize(total);
         grid.build(set.x.data(), strandOf.data(), total, s.cohesionRadius);
-        parallel(total, 1024, [&](size_t b, size_t e) {
+        skeleton.parallel(total, 1024, [&](size_t b, size_t e) {
             curly::cohesionTargets(grid, set.sigma.data(), b, e, s.cohesionRadius, s.cohesionTightness,
                                    set.cohesion.data());
         });
@@ -140,7 +135,7 @@ struct CurlyWetSolver::Impl final : solver::StrandModel {
         for (size_t g = 0; g < set.count; ++g) set.resetGuide(g);
     }
     void substep(const solver::Substep& sub) override {
-        parallel(groups.size(), 1, [&](size_t b, size_t e) {
+        skeleton.parallel(groups.size(), 1, [&](size_t b, size_t e) {
             for (size_t i = b; i < e; ++i) counters[i] = groups[i]->substep(sub);
         });
         for (const curly::GroupCounters& c : counters) failures += c.failed;

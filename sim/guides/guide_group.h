@@ -13,6 +13,7 @@
 #include "sim/guides/joint_kernels.h"
 #include "sim/solver/damping.h"
 #include "sim/solver/length_kernels.h"
+#include "sim/solver/skeleton.h"
 #include "sim/solver/strand_state.h"
 
 #include <cmath>
@@ -43,7 +44,6 @@ struct GuideSet : solver::StrandState {
     std::vector<float> limitSpring;   ///< per segment: rope limit spring fraction per Bullet step
     std::vector<float> limitPerIteration;  ///< per segment: the same spread over Bullet's link iterations
     std::vector<float> minSpan, maxSpan;   ///< per segment: rope bend limits as spans (strand::bendLimitSpan)
-    std::vector<float> jointInertia;  ///< per segment: m_{j+1}·l_j², the joint drive's inertia, kg·m²
     std::vector<float> mass;          ///< per vertex (0 for the kinematic root)
 
     /// Bumped whenever x / v are written outside a group's own substep (a
@@ -81,13 +81,14 @@ struct GuideSet : solver::StrandState {
     float maxBend(size_t begin, size_t end) const;
 };
 
-/// What one Bullet step (a substep of the solver's step, solver::Substep) needs.
-struct SubstepContext {
-    float h = 0.02f;           ///< Bullet step, s
-    float alpha = 1.f;         ///< fraction of the solver step at this Bullet step's end
-    strand::HeadQuery head;    ///< head collider as seen at this Bullet step's end
-    Eigen::Isometry3f headTransform = Eigen::Isometry3f::Identity();  ///< rigid head pose at the end
+/// What one Bullet step needs: the skeleton's substep (h, alpha, the head
+/// collider and the head's rigid pose at this Bullet step's end) and whether
+/// the guides collide with the head.
+struct SubstepContext : solver::Substep {
     bool headCollision = true; ///< false: skip projection (head.collider may still be set)
+
+    /// The head the kernels project out of: null when collision is off or there is no collider.
+    const strand::HeadQuery* collidingHead() const { return headCollision && head.collider ? &head : nullptr; }
 };
 
 /// One Bullet world advancing guides [begin, end) of a GuideSet.

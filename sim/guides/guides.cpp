@@ -166,7 +166,6 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
     set.limitPerIteration.assign(ns, 0.f);
     set.minSpan.assign(ns, 0.f);
     set.maxSpan.assign(ns, 0.f);
-    set.jointInertia.assign(ns, 0.f);
     set.restBend.assign(ns, 0.f);
     set.cosMostBend.assign(ns, 0.f);
     set.cosLeastBend.assign(ns, 0.f);
@@ -200,7 +199,6 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
             // The joint drive acts on its own segment (inertia m·l² about the
             // joint); what hangs beyond is carried along (strand::relaxJoints).
             const float inertia = set.mass[set.vertex(g, j + 1)] * set.restLength[seg] * set.restLength[seg];
-            set.jointInertia[seg] = inertia;
             set.springDir[seg] = set.groomDir[seg];
             const float h = s.timeStep / float(s.substeps);
             set.spring[seg] = strand::springFraction(s.bendStiffness, inertia, h);
@@ -266,14 +264,11 @@ void GuideSolver::Impl::resetToRest(const HeadPose& head) {
 
 void GuideSolver::Impl::substep(const solver::Substep& sub) {
     guides::SubstepContext ctx;
-    ctx.h = sub.h;
-    ctx.alpha = sub.alpha;
-    ctx.headTransform = sub.headTransform;
-    ctx.head = sub.head;
+    static_cast<solver::Substep&>(ctx) = sub;
     ctx.headCollision = set.settings.headCollision;
     forGroups([&](guides::GuideGroup& grp) { grp.substep(ctx); });
     if (contacts) {
-        const strand::HeadQuery* hq = ctx.headCollision && ctx.head.collider ? &ctx.head : nullptr;
+        const strand::HeadQuery* hq = ctx.collidingHead();
         strandContacts += contacts->solve(set, ctx.h, [&](size_t g) { relax(g, hq); });
         ++set.version;
     }

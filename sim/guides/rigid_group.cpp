@@ -343,7 +343,7 @@ void RigidGroup::project(size_t g, const SubstepContext& ctx) {
             body->setWorldTransform(btTransform(bt(Quatf(Bp)), bt(centre)));
         }
         // Head projection (signed distance), both ends and the middle.
-        if (ctx.headCollision && ctx.head.collider) {
+        if (ctx.collidingHead()) {
             const btTransform& t = body->getWorldTransform();
             const Vec3f c = ei(t.getOrigin()), axis = ei(t.getBasis().getColumn(1));
             strand::Contact deepest;

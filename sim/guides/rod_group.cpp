@@ -45,7 +45,8 @@ rod::Material materialOf(const GuideSettings& s) {
 
 class RodGroup final : public GuideGroup {
   public:
-    RodGroup(GuideSet& set, size_t begin, size_t end) : GuideGroup(set, begin, end) {
+    RodGroup(GuideSet& set, size_t begin, size_t end)
+        : GuideGroup(set, begin, end), bendStiffness_(materialOf(set.settings).bendStiffness()) {
         const size_t n = end - begin;
         invMass_.resize(n * size_t(set.vertices));
         curvature_.resize(n * size_t(set.segments));
@@ -56,17 +57,11 @@ class RodGroup final : public GuideGroup {
         for (size_t g = begin; g < end; ++g) computeCurvature(g, 0.f);
     }
 
-    void reset() override { set_.resetGuides(begin_, end_); }
     void preload(const SubstepContext& ctx) override {
         const float h = ctx.h / float(std::max(1, set_.settings.rodSubsteps));
         for (size_t g = begin_; g < end_; ++g) computeCurvature(g, set_.settings.preload ? h : 0.f);
     }
     void substep(const SubstepContext& ctx) override;
-    double kineticEnergy() const override { return set_.kineticEnergy(begin_, end_); }
-    void jointAngles(float& bend, float& twist) const override {
-        bend = set_.maxBend(begin_, end_);
-        twist = 0.f;
-    }
     size_t takePinned() override { return std::exchange(pinned_, size_t(0)); }
 
   private:
@@ -77,7 +72,7 @@ class RodGroup final : public GuideGroup {
         s.invMass = &invMass_[(g - begin_) * size_t(set_.vertices)];
         s.restCurvature = &curvature_[(g - begin_) * size_t(set_.segments)];
         s.ghostDir = set_.groomDir[set_.segment(g, 0)];
-        s.bendStiffness = materialOf(set_.settings).bendStiffness();
+        s.bendStiffness = bendStiffness_;
         return s;
     }
     /// Rest curvatures of guide g from its rest shape at the end-of-step
@@ -93,6 +88,7 @@ class RodGroup final : public GuideGroup {
         if (preloadStep > 0.f) rod::preload(s, x.data(), R, set_.settings.gravity, preloadStep, c, scratch_);
     }
 
+    const double bendStiffness_;  ///< EI of the settings' material (the same for every guide)
     std::vector<float> invMass_;
     std::vector<rod::Vec2f> curvature_;
     rod::RodScratch scratch_;
@@ -101,7 +97,7 @@ class RodGroup final : public GuideGroup {
 
 void RodGroup::substep(const SubstepContext& ctx) {
     const GuideSettings& s = set_.settings;
-    const strand::HeadQuery* head = ctx.headCollision && ctx.head.collider ? &ctx.head : nullptr;
+    const strand::HeadQuery* head = ctx.collidingHead();
     // The rod's own steps inside the solver's substep: root targets
     // interpolated over [alpha0, alpha].
     const int k = std::max(1, s.rodSubsteps);

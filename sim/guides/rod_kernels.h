@@ -102,12 +102,6 @@ struct RodStepTarget {
 Vec2f bendConstraint(const Vec3f& parentDir, float parentLen, const Vec3f& e, const Vec3f& a, const Vec2f& c,
                      bool ghost, Vec3f g[2][3]);
 
-/// Parallel transport of a ⊥ d onto d' (the rotation-minimising frame):
-///   a' = a - (d'·a)/(1 + d·d') · (d + d').
-inline Vec3f transportVector(const Vec3f& a, const Vec3f& d, const Vec3f& dNext) {
-    return a - (dNext.dot(a) / (1.f + d.dot(dNext))) * (d + dNext);
-}
-
 /// A unit vector ⊥ d taken from the root frame R (its tangent, else its
 /// bitangent): the start of the transported frame at the ghost segment.
 Vec3f frameStart(const Mat3f& R, const Vec3f& d);

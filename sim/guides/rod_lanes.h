@@ -167,7 +167,7 @@ inline void advanceFrame(V3<T>& u, T& ulen, V3<T>& a, const V3<T>& e) {
     const T len = norm(e);
     const V3<T> d = select(len > 0.f, e / len, u);
     const T cosTurn = 1.f + dot(u, d);
-    // transportVector: a - (d·a)/(1 + u·d) · (u + d)
+    // Parallel transport of a ⊥ u onto d: a - (d·a)/(1 + u·d) · (u + d)
     const V3<T> moved = a - (dot(d, a) / cosTurn) * (u + d);
     a = select(cosTurn > 1e-4f, moved, a);
     a = normalized(a - dot(a, d) * d);

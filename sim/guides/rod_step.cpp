@@ -34,13 +34,8 @@ namespace {
 
 static_assert(kLanes == 4, "rod_lanes.h packs four strands per SIMD register");
 
-/// One mass-weighted Newton step on the stretch constraints alone,
-/// C_j = |x_{j+1} - x_j| - l_j: J W Jᵀ is tridiagonal,
-///   A_jj = w_j + w_{j+1},  A_{j,j+1} = -w_{j+1} d_j·d_{j+1},
-/// solved by the Thomas algorithm; x_j -= w_j d_j Δλ_j, x_{j+1} += w_{j+1} d_j Δλ_j.
-/// Momentum-conserving, unlike follow-the-leader; it leaves a stretch error
-/// of the second order, which the final exact placement then removes
-/// without visible bias.
+/// rod::stretchSolve (rod_kernels.h gives its equations) in four lanes;
+/// diag, rhs, dir and cosine are scratch of n entries.
 void stretchSolve(V3* x, const F4* w, const F4* rest, int n, D4* diag, D4* rhs, V3* dir, F4* cosine) {
     const int S = n - 1;
     for (int j = 0; j < S; ++j) {

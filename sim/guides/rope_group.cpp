@@ -97,8 +97,10 @@ constexpr int kLimitStride = 4;
 
 class StrandSoftBodySolver final : public btDefaultSoftBodySolver {
   public:
-    StrandSoftBodySolver(GuideSet& set, size_t begin) : set_(set), begin_(begin) {
-        for (size_t k = 0; k < set.minSpan.size(); ++k) {
+    /// Solves guides [begin, end) of `set`: squares their spans (only theirs:
+    /// every group has its own solver).
+    StrandSoftBodySolver(GuideSet& set, size_t begin, size_t end) : set_(set), begin_(begin) {
+        for (size_t k = set.segment(begin, 0); k < set.segment(end, 0); ++k) {
             minSpan2_.push_back(set.minSpan[k] * set.minSpan[k]);
             maxSpan2_.push_back(set.maxSpan[k] * set.maxSpan[k]);
         }
@@ -154,12 +156,13 @@ class StrandSoftBodySolver final : public btDefaultSoftBodySolver {
   private:
     void limits(int b) {
         const size_t s0 = set_.segment(begin_ + size_t(b), 0);
+        const size_t own0 = size_t(b) * size_t(set_.segments);  // rope b's first span in minSpan2_ / maxSpan2_
         for (int j = 0; j < set_.segments; ++j) {
             btSoftBody::Node& child = bundle_.node(b, j + 1);
             const btVector3& from = j == 0 ? follicle_[b] : bundle_.node(b, j - 1).m_x;
             // Most joints are inside their limits: test squared spans first.
             const btScalar d2 = (child.m_x - from).length2();
-            if (d2 >= minSpan2_[s0 + j] && d2 <= maxSpan2_[s0 + j]) continue;
+            if (d2 >= minSpan2_[own0 + j] && d2 <= maxSpan2_[own0 + j]) continue;
             Vec3f a = ei(from), b1 = ei(child.m_x);
             const float wa = j == 0 ? 0.f : bundle_.node(b, j - 1).m_im;
             strand::limitSpan(a, b1, wa, child.m_im, set_.minSpan[s0 + j], set_.maxSpan[s0 + j],
@@ -180,7 +183,7 @@ class StrandSoftBodySolver final : public btDefaultSoftBodySolver {
     std::vector<Mat3f> frames_;
     std::vector<strand::JointParams> joints_;
     btAlignedObjectArray<btVector3> follicle_;
-    std::vector<btScalar> minSpan2_, maxSpan2_;
+    std::vector<btScalar> minSpan2_, maxSpan2_;  ///< squared spans of the group's guides, per segment
 };
 
 class RopeGroup final : public GuideGroup {
@@ -196,7 +199,7 @@ class RopeGroup final : public GuideGroup {
     void loadAll(float h, float alpha);
     void relax(size_t g, const SubstepContext& ctx);
 
-    StrandSoftBodySolver softSolver_{set_, begin_};
+    StrandSoftBodySolver softSolver_{set_, begin_, end_};
     // Ropes never touch anything in their world, so its contact pools stay tiny.
     bullet::RopeWorld world_{set_.settings.gravity, &softSolver_, bullet::smallPools()};
     std::unique_ptr<btSoftBody> body_;
@@ -285,7 +288,7 @@ void RopeGroup::substep(const SubstepContext& ctx) {
 void RopeGroup::relax(size_t g, const SubstepContext& ctx) {
     const GuideSettings& s = set_.settings;
     const float h = ctx.h;
-    const strand::HeadQuery* head = ctx.headCollision && ctx.head.collider ? &ctx.head : nullptr;
+    const strand::HeadQuery* head = ctx.collidingHead();
     const size_t b = g - begin_;
     const int n = set_.vertices;
     for (int i = 0; i < n; ++i) x_[i] = ei(bundle_.node(b, i).m_x);

@@ -68,7 +68,6 @@ class Skeleton {
 
     /// @brief Starts the clock at head.time with the head's pose (after the model set its state up).
     void start(const HeadPose& head);
-    bool started() const { return started_; }
     /// @brief Throws hp::Error unless started (`what`: the call, for the message).
     void requireStarted(const char* what) const;
 
