@@ -231,8 +231,8 @@ TEST(Settle, ConvergesLiesOnTheHeadHoldsStillAndIsReusedByteForByte) {
     // Followers copy their nearest guide's hanging shape (in world space, not
     // in their own root frame, which would turn it out from the crown).
     size_t followersBelow = 0;
-    for (size_t s = first.guideCount(); s < f1.strandCount(); ++s)
-        followersBelow += f1.positions[f1.first(s) + f1.vertexCount(s) - 1].y() < f1.positions[f1.first(s)].y() - 0.05f;
+    for (size_t f = first.guideCount(); f < f1.strandCount(); ++f)
+        followersBelow += f1.positions[f1.first(f) + f1.vertexCount(f) - 1].y() < f1.positions[f1.first(f)].y() - 0.05f;
     EXPECT_GT(followersBelow, first.followerCount() * 3 / 4) << "most follower tips hang 5 cm below their roots";
     // The settled shape is the rest shape: the head is still over the clip's
     // first frames, and so is the hair (no sag, no bounce).
