@@ -301,7 +301,11 @@ TEST(CompareFiles, MismatchedResolutionNamesBothFiles) {
     test::TempDir dir;
     writeImage((dir / "a.0001.exr").string(), texture(160, 120));
     writeImage((dir / "b.0001.exr").string(), texture(80, 60));
-    CompareJob job{(dir / "a.####.exr").string(), (dir / "b.####.exr").string(), dir / "out", {}, {}, {}, 64, {}};
+    CompareJob job;
+    job.a = (dir / "a.####.exr").string();
+    job.b = (dir / "b.####.exr").string();
+    job.outputDir = dir / "out";
+    job.reportWidth = 64;
     try {
         compareFrame(job, 1);
         FAIL() << "expected an error";
@@ -323,7 +327,11 @@ TEST(CompareFiles, FrameRecordRoundTripsThroughJson) {
     test::TempDir dir;
     writeImage((dir / "a.0003.png").string(), texture());
     writeImage((dir / "b.0003.exr").string(), withNoise(texture(), 0.02f));
-    CompareJob job{(dir / "a.####.png").string(), (dir / "b.####.exr").string(), dir / "out", {}, {}, {}, 64, {}};
+    CompareJob job;
+    job.a = (dir / "a.####.png").string();
+    job.b = (dir / "b.####.exr").string();
+    job.outputDir = dir / "out";
+    job.reportWidth = 64;
     const FrameRecord r = compareFrame(job, 3);
     for (const fs::path& p : frameOutputs(job, 3)) EXPECT_TRUE(fs::exists(p)) << p;
     const FrameRecord back = loadFrameRecord(job, 3);
