@@ -10,13 +10,7 @@ namespace {
 
 /// Parses `yaml` expecting a SceneError; returns it.
 SceneError parseError(const std::string& yaml, const std::vector<std::string>& sets = {}) {
-    try {
-        Scene::parse(yaml, "shot.yaml", ".", sets);
-    } catch (const SceneError& e) {
-        return e;
-    }
-    ADD_FAILURE() << "no error for:\n" << yaml;
-    return SceneError({}, "", "");
+    return test::sceneErrorOf([&] { Scene::parse(yaml, "shot.yaml", ".", sets); }, yaml);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include "core/errors.h"
 #include "pipeline/scene/schema_yaml.h"
 #include "render/view.h"
+#include "test_support.h"
 
 #include <cmath>
 
@@ -23,13 +24,7 @@ Schema read(const char* text) {
 
 /// Reads `text` expecting a SceneError; returns it.
 SceneError readError(const char* text) {
-    try {
-        read(text);
-    } catch (const SceneError& e) {
-        return e;
-    }
-    ADD_FAILURE() << "no error for:\n" << text;
-    return SceneError({}, "", "");
+    return test::sceneErrorOf([&] { read(text); }, text);
 }
 
 }  // namespace

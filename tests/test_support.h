@@ -2,6 +2,8 @@
 // running the hairpipe executable as a subprocess.
 #pragma once
 
+#include "core/errors.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -50,5 +52,18 @@ ProcessResult runHairpipe(const std::string& args, const std::filesystem::path& 
 
 /// Source tree path ("scenes/default.yaml" -> absolute).
 std::filesystem::path sourcePath(const std::string& relative);
+
+/// Runs `action`, which should throw a SceneError, and returns the error; a
+/// test failure naming `input` (and an empty error) if nothing was thrown.
+template <typename Action>
+SceneError sceneErrorOf(Action&& action, const std::string& input) {
+    try {
+        action();
+    } catch (const SceneError& e) {
+        return e;
+    }
+    ADD_FAILURE() << "no error for:\n" << input;
+    return SceneError({}, "", "");
+}
 
 }  // namespace hp::test
