@@ -1,5 +1,5 @@
 // @brief The Embree 3 ray set-up shared by the two Embree adapters: the
-// reference renderer's scene (render/embree_scene.cpp) and the exact mesh
+// reference renderer's scene (render/reference/embree_scene.cpp) and the exact mesh
 // queries of the collision code (sim/collision/mesh_query.cpp).
 //
 // Header-only, and included ONLY by those two .cpp files: Embree is a heavy

@@ -1,5 +1,5 @@
 // @brief Integer hash finalisers of the xorshift-multiply family, shared by
-// the renderer's sample hashing (render/sampling.h) and the followers' and
+// the renderer's sample hashing (render/reference/sampling.h) and the followers' and
 // groom modifiers' per-strand randomness (sim/followers/follower_kernels.h).
 //
 // Both finalisers in use are the same three xorshifts around two odd

@@ -1,5 +1,5 @@
 // Shared by every preview program: the per-pass uniform block (mirrors
-// FrameUniforms in render/preview_gpu.h, std140) and small helpers.
+// FrameUniforms in render/preview/preview_gpu.h, std140) and small helpers.
 
 layout(std140, binding = 0) uniform Frame {
     mat4 uViewProj;     // world -> clip of this pass (camera, or the light for shadow passes)
@@ -17,7 +17,7 @@ layout(std140, binding = 0) uniform Frame {
     vec4 uSecondColor;  // rgb, secondary ks
     vec4 uHairShape;    // shininess, secondary shininess, primary shift, secondary shift
     vec4 uHeadColor;    // rgb albedo, ambient
-    vec4 uHeadSkin;     // wrap, specular weight, shininess (render/view.h skinShade)
+    vec4 uHeadSkin;     // wrap, specular weight, shininess (render/view/view.h skinShade)
     vec4 uShadow;       // optical depth per unit of C, pcf radius, 1 / shadow map size, shadow-map depth bias
     vec4 uTess;         // max level, target pixels per piece, curve (0 Catmull-Rom, 1 B-spline), min width (px)
     vec4 uBlend;        // reference depth (m), depth scale (m), thin strands drawn as lines (0/1)
@@ -34,10 +34,10 @@ const int kFlagVoxelFilter = 4;
 
 // Fixed point of the r32ui voxel grid: this many units make 1 (one strand
 // crossing, or one fragment in the seed's count). Mirrors kVoxelUnit in
-// render/preview_gpu.h.
+// render/preview/preview_gpu.h.
 const float kVoxelUnit = 4096.0;
 
-// Grid coordinates of a world point in the light's box (render/light_grid.h).
+// Grid coordinates of a world point in the light's box (render/preview/light_grid.h).
 vec3 lightGrid(vec3 world) {
     vec4 v = uLightView * vec4(world, 1.0);
     float depth = -v.z;
@@ -45,7 +45,7 @@ vec3 lightGrid(vec3 world) {
     return vec3(q * uGridMap.xy + uGridMap.zw, (depth - uGridDepth.x) / (uGridDepth.y - uGridDepth.x));
 }
 
-// Unit direction from p toward light i, and its radiance there (render/view.cpp Light::toLight).
+// Unit direction from p toward light i, and its radiance there (render/view/view.cpp Light::toLight).
 vec3 toLight(int i, vec3 p, out vec3 radiance) {
     if (uLightVec[i].w < 0.5) {
         radiance = uLightRad[i].rgb;

@@ -3,7 +3,7 @@
 // toward the force: d <- normalize(d + weight * force). The hair type (colour,
 // segment count and length, force weight, root and tip radius) is read from
 // the hair-type texture. The force is gravity plus gusting wind, travelling
-// along the wind (render/generated_hair.h, hairForce).
+// along the wind (render/preview/generated_hair.h, hairForce).
 // Camera pass: one ribbon strip per strand. VOXEL_PASS: a line strip.
 #include "common.glsl"
 

@@ -24,7 +24,7 @@ void main() {
         vec3 radiance;
         vec3 l = toLight(i, vWorld, radiance);
         float c = dot(n, l);
-        // skinShade (render/view.cpp): wrapped diffuse plus a Blinn-Phong sheen.
+        // skinShade (render/view/view.cpp): wrapped diffuse plus a Blinn-Phong sheen.
         vec3 f = uHeadColor.rgb * max(0.0, (c + w) / (1.0 + w));
         if (c > 0.0 && uHeadSkin.y > 0.0) f += vec3(uHeadSkin.y * pow(max(0.0, dot(n, normalize(l + v))), uHeadSkin.z));
         if (max(f.r, max(f.g, f.b)) > 0.0) color += f * radiance * hairOnlyVisibility(i, vWorld);

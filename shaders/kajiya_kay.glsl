@@ -1,5 +1,5 @@
 // Kajiya-Kay hair shading, a line-for-line mirror of kajiyaKay() in
-// render/view.cpp (the Embree reference calls that function), so preview and
+// render/view/view.cpp (the Embree reference calls that function), so preview and
 // reference shade the same model: kd*color*sin(t,l) + ks*spec*sin(t',h)^alpha
 // with h = normalize(l + v) (seed 004 eq. 4, 5) and the optional second,
 // shifted-tangent lobe.

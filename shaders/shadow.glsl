@@ -2,7 +2,7 @@
 // exp(-k C) = alpha^C from the summed voxel grid, times the PCF shadow map of
 // the head. C counts strand crossings in front of the point (or fragments,
 // the seed's count) and k = uShadow.x is the optical depth of one: 1 - T for
-// a per-crossing transmittance T (render/preview.h says why), -ln(alpha) for
+// a per-crossing transmittance T (render/preview/preview.h says why), -ln(alpha) for
 // the seed's alpha.
 
 layout(binding = 0) uniform sampler3D uDensity;        // C (or V when the sum is off), trilinear
@@ -38,7 +38,7 @@ float voxelDensity(vec3 world) {
 }
 
 // The head's own visibility: hair shadows only, as in the reference
-// (render/embree_scene.h RayStart::throughHead: a low-poly head shadowing
+// (render/reference/embree_scene.h RayStart::throughHead: a low-poly head shadowing
 // itself cuts its smooth shading into a staircase along the terminator).
 float hairOnlyVisibility(int light, vec3 world) {
     if (light != uCounts.y || (uCounts.z & kFlagVoxels) == 0) return 1.0;

@@ -1,6 +1,6 @@
 // Simulated strands: a patch is a whole strand (or a chunk of a long one):
 // the vertex before its first segment, its segments' vertices, the vertex
-// after (render/preview_buffers.cpp). Chooses how many pieces the strand's
+// after (render/preview/preview_buffers.cpp). Chooses how many pieces the strand's
 // curve is cut into: enough for about uTess.y pixels each on screen, at most
 // uTess.x per segment. The count is per strand, not per segment, so a strand
 // far away costs few triangles (software rasterizers pay per triangle) and a

@@ -3,7 +3,7 @@
 // killed, and a comparison of two output folders that must be identical.
 #pragma once
 
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>

@@ -2,7 +2,7 @@
 #pragma once
 
 #include "core/errors.h"
-#include "render/gl_context.h"
+#include "render/preview/gl_context.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // The test oracle for Kajiya-Kay shading, written from seed 004's equations
-// and not from render/view.cpp, so the renderers' shading is checked against
+// and not from render/view/view.cpp, so the renderers' shading is checked against
 // the paper rather than against itself:
 //   diffuse  = kd · sin(t, l) · colour
 //   specular = ks · sin(t', h)^α · specular colour,  h = (l + v)/|l + v|,
@@ -9,7 +9,7 @@
 // lobe). A second lobe, when on, adds its own ks, exponent, shift and colour.
 #pragma once
 
-#include "render/view.h"
+#include "render/view/view.h"
 
 #include <cmath>
 

@@ -2,7 +2,7 @@
 // draw their strands in.
 #pragma once
 
-#include "render/simple_view.h"
+#include "render/view/simple_view.h"
 
 namespace hp::test {
 

@@ -1,4 +1,4 @@
-// Camera auto (render/camera_framing.h, pipeline/stages/camera_track.h): for the
+// Camera auto (render/view/camera_framing.h, pipeline/stages/camera_track.h): for the
 // project's head, a sphere-and-neck head built here and the Fox asset, the
 // framed camera keeps the whole head and the hair's bounds inside the frame
 // on every frame. The checks project, with the camera's own view and
@@ -15,7 +15,7 @@
 #include "pipeline/scene/scene.h"
 #include "pipeline/stages/stages.h"
 #include "pipeline/scene/view_settings.h"
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 
 #include <cmath>
 

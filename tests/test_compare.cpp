@@ -1,4 +1,4 @@
-// Image comparison: the metrics (render/compare.h, flip.h, ssim.h), the
+// Image comparison: the metrics (render/compare/compare.h, flip.h, ssim.h), the
 // per-frame files and tables (pipeline/compare/compare_job.h), `hairpipe compare`,
 // the compare stage of `hairpipe run`, and the HTML report in headless Chromium
 // (the tables and the report's labels: test_compare_report.cpp).
@@ -6,10 +6,10 @@
 #include "pipeline/compare/compare_job.h"
 #include "pipeline/compare/compare_table.h"
 #include "pipeline/batch/path_template.h"
-#include "render/colormap.h"
-#include "render/compare.h"
-#include "render/image_io.h"
-#include "render/ssim.h"
+#include "render/image/colormap.h"
+#include "render/compare/compare.h"
+#include "render/image/image_io.h"
+#include "render/compare/ssim.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>

@@ -1,8 +1,8 @@
-// The physically based hair BSDF (render/hair_bsdf.h): energy conservation
+// The physically based hair BSDF (render/reference/hair_bsdf.h): energy conservation
 // (white furnace), reciprocity, and consistency of its importance sampling
 // with its evaluation.
-#include "render/hair_bsdf.h"
-#include "render/sampling.h"
+#include "render/reference/hair_bsdf.h"
+#include "render/reference/sampling.h"
 
 #include <gtest/gtest.h>
 
@@ -294,7 +294,7 @@ TEST(HairBsdf, MelaninColourFitInvertsChiangsFitAndIsMonotone) {
     const Vec3f plain = hairColorFromAbsorption(hairAbsorptionFromMelanin(0.3f, 0.f), 0.3f);
     const Vec3f red = hairColorFromAbsorption(hairAbsorptionFromMelanin(0.3f, 0.8f), 0.3f);
     EXPECT_GT(red.x() / red.y(), plain.x() / plain.y());
-    // The values render/hair_bsdf.h and the README document (β_n = 0.3).
+    // The values render/reference/hair_bsdf.h and the README document (β_n = 0.3).
     EXPECT_LT((plain - Vec3f(0.124f, 0.068f, 0.023f)).cwiseAbs().maxCoeff(), 1e-3f) << plain.transpose();
     EXPECT_LT((red - Vec3f(0.046f, 0.014f, 0.001f)).cwiseAbs().maxCoeff(), 1e-3f) << red.transpose();
 }

@@ -4,7 +4,7 @@
 #include "pipeline/head/animated_head.h"
 #include "pipeline/head/default_head.h"
 #include "pipeline/head/head_import.h"
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 #include "sim/collision/mesh_query.h"
 #include "sim/strands/roots.h"
 #include "test_support.h"

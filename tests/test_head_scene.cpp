@@ -4,7 +4,7 @@
 #include "pipeline/head/default_head.h"
 #include "pipeline/head/head_setup.h"
 #include "pipeline/stages/head_source.h"
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 #include "sim/collision/mesh_collider.h"
 #include "test_support.h"
 

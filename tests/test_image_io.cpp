@@ -1,6 +1,6 @@
 #include "core/errors.h"
-#include "render/display_transform.h"
-#include "render/image_io.h"
+#include "render/image/display_transform.h"
+#include "render/image/image_io.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>

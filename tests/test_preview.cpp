@@ -9,8 +9,8 @@
 #include "test_support.h"
 
 #include "core/errors.h"
-#include "render/gl_context.h"
-#include "render/preview.h"
+#include "render/preview/gl_context.h"
+#include "render/preview/preview.h"
 #include "sim/strands/synthetic.h"
 
 #include <cmath>

@@ -5,8 +5,8 @@
 #include "pipeline/scene/preview_settings.h"
 #include "pipeline/scene/scene.h"
 #include "pipeline/stages/stages.h"
-#include "render/gl_context.h"
-#include "render/image_io.h"
+#include "render/preview/gl_context.h"
+#include "render/image/image_io.h"
 #include "sim/strands/synthetic.h"
 
 #include <chrono>

@@ -1,4 +1,4 @@
-// The Embree reference renderer (render/reference.h, render/embree_scene.h)
+// The Embree reference renderer (render/reference/reference.h, render/reference/embree_scene.h)
 // and its pipeline stage: Kajiya-Kay pixels against the formula, coverage
 // against projected width, shadow transmittance, determinism across thread
 // counts, no memory growth across frames, clear errors.
@@ -9,8 +9,8 @@
 #include "core/errors.h"
 #include "pipeline/scene/scene.h"
 #include "pipeline/stages/stages.h"
-#include "render/embree_scene.h"
-#include "render/reference.h"
+#include "render/reference/embree_scene.h"
+#include "render/reference/reference.h"
 #include "sim/strands/synthetic.h"
 
 #include <tbb/task_arena.h>

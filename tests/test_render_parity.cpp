@@ -8,11 +8,11 @@
 #include "test_support.h"
 
 #include "core/errors.h"
-#include "render/compare.h"
-#include "render/gl_context.h"
-#include "render/preview.h"
-#include "render/reference.h"
-#include "render/simple_view.h"
+#include "render/compare/compare.h"
+#include "render/preview/gl_context.h"
+#include "render/preview/preview.h"
+#include "render/reference/reference.h"
+#include "render/view/simple_view.h"
 #include "sim/strands/synthetic.h"
 
 #include <cstdlib>

@@ -154,11 +154,11 @@ TEST(Schema, ReferencePageIsUpToDate) {
 }
 
 #include "pipeline/scene/view_settings.h"
-#include "render/hair_bsdf.h"
+#include "render/reference/hair_bsdf.h"
 
 TEST(SceneLists, DefaultListAndItemDefaults) {
     const Scene s = Scene::parse("", "shot.yaml", ".");
-    // The default list is the three-point rig of render/view.cpp.
+    // The default list is the three-point rig of render/view/view.cpp.
     ASSERT_EQ(s.count("render.lights"), 3u);
     EXPECT_EQ(s.text("render.lights[0].type"), "directional");
     EXPECT_EQ(s.text("render.lights[0].space"), "camera");

@@ -3,7 +3,7 @@
 // entry names its keys/<file>:line:column and key.
 #include "core/errors.h"
 #include "pipeline/scene/schema_yaml.h"
-#include "render/view.h"
+#include "render/view/view.h"
 #include "test_support.h"
 
 #include <cmath>

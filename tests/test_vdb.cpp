@@ -5,8 +5,8 @@
 #include "pipeline/scene/scene.h"
 #include "pipeline/stages/shot.h"
 #include "pipeline/stages/stages.h"
-#include "render/vdb_writer.h"
-#include "render/voxelizer.h"
+#include "render/volume/vdb_writer.h"
+#include "render/volume/voxelizer.h"
 #include "sim/strands/synthetic.h"
 #include "test_support.h"
 

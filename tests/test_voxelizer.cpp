@@ -2,7 +2,7 @@
 // straight strand, ray integrals, affine (light-space) grids, velocity,
 // thread-count invariance and error messages.
 #include "core/errors.h"
-#include "render/voxelizer.h"
+#include "render/volume/voxelizer.h"
 #include "sim/strands/synthetic.h"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // `hairpipe view scene.yaml`: the preview pass in an interactive window
-// (render/viewer.h), fed by the scene's frame source.
+// (render/preview/viewer.h), fed by the scene's frame source.
 #include "core/log.h"
 #include "pipeline/head/animated_head.h"
 #include "pipeline/stages/camera_track.h"
@@ -7,7 +7,7 @@
 #include "pipeline/scene/preview_settings.h"
 #include "pipeline/stages/stages.h"
 #include "pipeline/scene/view_settings.h"
-#include "render/viewer.h"
+#include "render/preview/viewer.h"
 #include "sim/strands/synthetic.h"
 
 #include <climits>

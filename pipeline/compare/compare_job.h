@@ -1,4 +1,4 @@
-// Comparing two image sequences frame by frame (render/compare.h), shared by
+// Comparing two image sequences frame by frame (render/compare/compare.h), shared by
 // the `hairpipe compare` command and the "compare" stage of `hairpipe run`.
 //
 // Per frame, compareFrame writes into the job's output folder
@@ -12,8 +12,8 @@
 // resumed run, which skips frames already compared, still report every frame.
 #pragma once
 
-#include "render/compare.h"
-#include "render/display_transform.h"
+#include "render/compare/compare.h"
+#include "render/image/display_transform.h"
 
 #include <filesystem>
 #include <string>

@@ -4,7 +4,7 @@
 #include "core/log.h"
 #include "pipeline/compare/compare_table.h"
 #include "pipeline/batch/path_template.h"
-#include "render/image_encode.h"
+#include "render/image/image_encode.h"
 
 #include <tbb/parallel_for.h>
 

@@ -1,7 +1,7 @@
 #include "pipeline/head/scalp.h"
 
 #include "core/errors.h"
-#include "render/image_io.h"
+#include "render/image/image_io.h"
 #include "sim/strands/roots.h"
 
 #include <algorithm>

@@ -1,9 +1,9 @@
-// Maps the scene's preview.* keys onto render/preview.h's PreviewSettings
+// Maps the scene's preview.* keys onto render/preview/preview.h's PreviewSettings
 // (shared by the preview stage and the viewer).
 #pragma once
 
 #include "pipeline/scene/scene.h"
-#include "render/preview.h"
+#include "render/preview/preview.h"
 
 namespace hp {
 

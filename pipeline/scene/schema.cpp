@@ -2,7 +2,7 @@
 
 #include "core/errors.h"
 #include "pipeline/scene/schema_yaml.h"
-#include "render/view.h"
+#include "render/view/view.h"
 
 #include <algorithm>
 #include <iterator>
@@ -37,7 +37,7 @@ const char* const kSceneKeyFileOrder[] = {"shot.yaml",      "head.yaml",    "hai
                                           "preview.yaml",   "reference.yaml", "vdb.yaml",   "compare.yaml",
                                           "budget.yaml"};
 
-/// render.lights' default: render/view.cpp's threePointRig() as a YAML list,
+/// render.lights' default: render/view/view.cpp's threePointRig() as a YAML list,
 /// so the rig is written down once (keys/render.yaml leaves it out).
 std::string lightRigYaml() {
     std::ostringstream out;

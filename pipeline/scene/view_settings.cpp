@@ -2,7 +2,7 @@
 #include "pipeline/scene/key_fields.h"
 
 #include "core/errors.h"
-#include "render/hair_bsdf.h"
+#include "render/reference/hair_bsdf.h"
 
 namespace hp {
 

@@ -1,9 +1,9 @@
-// Maps the scene's render.* keys onto render/view.h's View and the display transform.
+// Maps the scene's render.* keys onto render/view/view.h's View and the display transform.
 #pragma once
 
 #include "pipeline/scene/scene.h"
-#include "render/display_transform.h"
-#include "render/view.h"
+#include "render/image/display_transform.h"
+#include "render/view/view.h"
 
 namespace hp {
 

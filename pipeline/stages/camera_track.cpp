@@ -95,7 +95,7 @@ void checkCameraKeys(const Scene& scene) {
 namespace {
 
 /// Adds to `sample` the cached hair's extreme points along the four fit
-/// normals of its view (render/camera_framing.h): the only strand points
+/// normals of its view (render/view/camera_framing.h): the only strand points
 /// that can touch the frame's border.
 void addCachedHair(FramingSample& sample, const StrandFrame& hair, const std::array<Vec3f, 4>& normals) {
     if (hair.positions.empty()) return;

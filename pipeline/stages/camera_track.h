@@ -1,12 +1,12 @@
 // The shot's camera at each frame: the scene's fixed camera, or camera auto
 // (render.camera.mode: auto / follow), which frames the head and its hair
-// over the whole clip (render/camera_framing.h). The track depends only on
+// over the whole clip (render/view/camera_framing.h). The track depends only on
 // the scene, never on the frames a run renders, so every chunk of a
 // parallel or farm run sees the same camera.
 #pragma once
 
 #include "pipeline/scene/scene.h"
-#include "render/camera_framing.h"
+#include "render/view/camera_framing.h"
 #include "sim/strands/head.h"
 
 #include <map>

@@ -1,5 +1,5 @@
 // The "preview" frame stage: renders each frame's strands, head and generated
-// hair with the GL preview (render/preview.h) and writes EXR (+ PNG) frames.
+// hair with the GL preview (render/preview/preview.h) and writes EXR (+ PNG) frames.
 // One headless GL context serves the whole run, created on the first frame
 // that needs it (so resumed runs with nothing to do never touch GL).
 #include "core/log.h"
@@ -10,7 +10,7 @@
 #include "pipeline/scene/preview_settings.h"
 #include "pipeline/stages/stages.h"
 #include "pipeline/scene/view_settings.h"
-#include "render/gl_context.h"
+#include "render/preview/gl_context.h"
 
 #include <optional>
 

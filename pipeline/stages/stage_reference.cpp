@@ -1,5 +1,5 @@
 // The "reference" frame stage: renders each frame's strands and head with the
-// Embree reference renderer (render/reference.h) and writes EXR (+ PNG).
+// Embree reference renderer (render/reference/reference.h) and writes EXR (+ PNG).
 #include "core/log.h"
 #include "pipeline/head/animated_head.h"
 #include "pipeline/stages/camera_track.h"
@@ -7,7 +7,7 @@
 #include "pipeline/batch/path_template.h"
 #include "pipeline/stages/stages.h"
 #include "pipeline/scene/view_settings.h"
-#include "render/reference.h"
+#include "render/reference/reference.h"
 
 #include <algorithm>
 #include <cmath>

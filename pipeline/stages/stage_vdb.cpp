@@ -1,12 +1,12 @@
-// The "vdb" frame stage: voxelizes the frame's strands (render/voxelizer.h)
-// and writes one OpenVDB file per frame (render/vdb_writer.h).
+// The "vdb" frame stage: voxelizes the frame's strands (render/volume/voxelizer.h)
+// and writes one OpenVDB file per frame (render/volume/vdb_writer.h).
 #include "pipeline/stages/stages.h"
 
 #include "core/log.h"
 #include "pipeline/batch/output.h"
 #include "pipeline/batch/path_template.h"
-#include "render/vdb_writer.h"
-#include "render/voxelizer.h"
+#include "render/volume/vdb_writer.h"
+#include "render/volume/voxelizer.h"
 
 #include <chrono>
 

@@ -4,7 +4,7 @@
 // the benchmark.
 #pragma once
 
-#include "render/simple_view.h"
+#include "render/view/simple_view.h"
 
 namespace hp::bench {
 

@@ -2,8 +2,8 @@
 // SSIM, LDR-FLIP (67 PPD) and the whole compareImages (RMSE/PSNR through
 // OpenImageIO, SSIM, FLIP, |A−B|), on 1 and 2 threads; median of 3 runs, the
 // spread (max − min) and the process CPU time. Usage: bench_compare [runs]
-#include "render/compare.h"
-#include "render/ssim.h"
+#include "render/compare/compare.h"
+#include "render/compare/ssim.h"
 
 #include <tbb/task_arena.h>
 

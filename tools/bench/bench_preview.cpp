@@ -12,8 +12,8 @@
 // wall and process CPU time, llvmpipe's threads included), readback time,
 // peak resident memory; --profile adds a per-pass breakdown of one extra frame.
 #include "core/errors.h"
-#include "render/gl_context.h"
-#include "render/preview.h"
+#include "render/preview/gl_context.h"
+#include "render/preview/preview.h"
 #include "sim/strands/synthetic.h"
 #include "tools/bench/b_render_view.h"
 #include "tools/bench/bench_support.h"

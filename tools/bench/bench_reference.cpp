@@ -12,7 +12,7 @@
 //                   [--width 1920] [--height 1080] [--spp 16] [--bounces 4]
 //                   [--repeat 1] [--threads 2] [--out DIR] [--no-head] [--no-shadows]
 //                   [--melanin 1.3] [--shadow-roulette 0.03125 (0: off)] [--seed 1]
-#include "render/reference.h"
+#include "render/reference/reference.h"
 #include "sim/strands/head.h"
 #include "sim/strands/synthetic.h"
 #include "tools/bench/b_render_view.h"

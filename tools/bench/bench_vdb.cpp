@@ -17,8 +17,8 @@
 //                  [--sequence F] (instead: write frames 1..F of the hair spinning with the
 //                                  B-sim head, 90°/s about +Y at 24 fps, as hair.####.vdb —
 //                                  the whole-sequence time, and files to check in a DCC)
-#include "render/vdb_writer.h"
-#include "render/voxelizer.h"
+#include "render/volume/vdb_writer.h"
+#include "render/volume/voxelizer.h"
 #include "sim/strands/synthetic.h"
 #include "tools/bench/bench_support.h"
 

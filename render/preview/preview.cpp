@@ -1,0 +1,570 @@
+// The preview's passes per frame: upload, shadow map, voxelization + sum
+// along the light, the camera pass (opaque head, then hair with weighted
+// blended transparency), and the resolve. See render/preview/preview.h.
+#include "render/preview/preview.h"
+
+#include "core/errors.h"
+#include "core/log.h"
+#include "render/preview/gl_program.h"
+#include "render/preview/preview_gpu.h"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <ctime>
+
+namespace hp {
+
+namespace {
+
+using Files = std::vector<std::pair<ShaderStage, std::string>>;
+
+/// Segments per patch when hair is sorted: short enough that a piece of
+/// strand rarely straddles another in depth, long enough to keep the
+/// per-patch cost of software rasterizers down.
+constexpr int kSortedPatchSegments = 4;
+
+void copyMatrix(float* dst, const Mat4f& m) { std::memcpy(dst, m.data(), 16 * sizeof(float)); }
+void set4(float* dst, float a, float b, float c, float d) { dst[0] = a, dst[1] = b, dst[2] = c, dst[3] = d; }
+void set3(float* dst, const Vec3f& v, float w) { set4(dst, v.x(), v.y(), v.z(), w); }
+
+double cpuMilliseconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);  // all threads, llvmpipe's rasterizers included
+    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
+double wallMilliseconds() {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+struct PreviewRenderer::Impl {
+    PreviewSettings settings;
+    PreviewStats stats;
+    GlProgram strand, strandLines, strandVoxel, fur, furVoxel, head, headDepth, prefix, resolveMs, resolveSs, present;
+    StrandBuffers strands;
+    HeadBuffers headBuffers;
+    RenderTargets targets;
+    ShadowTargets shadows;
+    GLuint cameraUbo = 0, lightUbo = 0, emptyVao = 0, query = 0;
+    GLsync fence = nullptr;
+    int maxSamples = 1;
+    bool pipelineStatistics = false;
+    bool voxelsDrawn = false;
+    bool warnedUnshadowed = false;
+    int strandPatchSize = 0;
+    bool strandsVisible = false, headVisible = false, furVisible = false;  // what this frame draws
+    bool shadedPerFragment = false;
+    LightGrid grid;
+
+    explicit Impl(const PreviewSettings& s) : settings(s) {
+        if (!epoxy_has_gl_extension("GL_ARB_shader_image_load_store") && epoxy_gl_version() < 42)
+            throw Error("preview: the OpenGL driver lacks image load/store (needed for voxel shadows)");
+        const Files furStages = {{ShaderStage::Vertex, "fur.vert"},
+                                 {ShaderStage::TessControl, "fur.tesc"},
+                                 {ShaderStage::TessEvaluation, "fur.tese"}};
+        auto with = [](Files f, std::initializer_list<std::pair<ShaderStage, std::string>> more) {
+            f.insert(f.end(), more);
+            return f;
+        };
+        furVoxel = GlProgram("generated hair voxelization",
+                             with(furStages, {{ShaderStage::Geometry, "fur.geom"},
+                                              {ShaderStage::Fragment, "voxelize.frag"}}),
+                             {"VOXEL_PASS"});
+        head = GlProgram("head", {{ShaderStage::Vertex, "head.vert"}, {ShaderStage::Fragment, "head.frag"}});
+        headDepth = GlProgram("head shadow map", {{ShaderStage::Vertex, "head.vert"}, {ShaderStage::Fragment, "head.frag"}},
+                              {"DEPTH_ONLY"});
+        prefix = GlProgram("voxel sum", {{ShaderStage::Compute, "prefix.comp"}});
+        const Files resolveStages = {{ShaderStage::Vertex, "fullscreen.vert"}, {ShaderStage::Fragment, "resolve.frag"}};
+        resolveMs = GlProgram("resolve (multisampled)", resolveStages, {"MULTISAMPLE"});
+        resolveSs = GlProgram("resolve", resolveStages);
+        present = GlProgram("present", {{ShaderStage::Vertex, "fullscreen.vert"}, {ShaderStage::Fragment, "present.frag"}});
+
+        strands.create();
+        compileHairPrograms(std::min(strands.maxPatchVertices, 26));  // 24-vertex strands (docs/benchmarks.md)
+        headBuffers.create();
+        glCreateBuffers(1, &cameraUbo);
+        glNamedBufferStorage(cameraUbo, sizeof(FrameUniforms), nullptr, GL_DYNAMIC_STORAGE_BIT);
+        glCreateBuffers(1, &lightUbo);
+        glNamedBufferStorage(lightUbo, sizeof(FrameUniforms), nullptr, GL_DYNAMIC_STORAGE_BIT);
+        glCreateVertexArrays(1, &emptyVao);
+        GLint samples = 1, colorSamples = 1, depthSamples = 1;
+        glGetIntegerv(GL_MAX_SAMPLES, &samples);
+        glGetIntegerv(GL_MAX_COLOR_TEXTURE_SAMPLES, &colorSamples);
+        glGetIntegerv(GL_MAX_DEPTH_TEXTURE_SAMPLES, &depthSamples);
+        maxSamples = std::max(1, std::min({samples, colorSamples, depthSamples}));
+        pipelineStatistics = epoxy_gl_version() >= 46 || epoxy_has_gl_extension("GL_ARB_pipeline_statistics_query");
+        if (pipelineStatistics) glGenQueries(1, &query);
+        stats.renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    }
+
+    ~Impl() {
+        if (fence) glDeleteSync(fence);
+        strands.destroy();
+        headBuffers.destroy();
+        targets.destroy();
+        shadows.destroy();
+        GLuint buffers[] = {cameraUbo, lightUbo};
+        glDeleteBuffers(2, buffers);
+        glDeleteVertexArrays(1, &emptyVao);
+        if (query) glDeleteQueries(1, &query);
+    }
+
+    /// The hair programs are specialised for the strand patch size and the
+    /// shading rate; recompiled when either changes.
+    void compileHairPrograms(int patchSize) {
+        const bool perFragment = settings.shadePerFragment;
+        if (patchSize == strandPatchSize && perFragment == shadedPerFragment && strand.id()) return;
+        const std::vector<std::string> shading = perFragment ? std::vector<std::string>{"SHADE_PER_FRAGMENT"}
+                                                             : std::vector<std::string>{};
+        const Files stages = {{ShaderStage::Vertex, "strand.vert"},
+                              {ShaderStage::TessControl, "strand.tesc"},
+                              {ShaderStage::TessEvaluation, "strand.tese"}};
+        std::vector<std::string> defines = shading;
+        defines.push_back(cat("PATCH_SIZE ", patchSize));
+        Files camera = stages, lines = stages, voxel = stages;
+        camera.push_back({ShaderStage::Geometry, "ribbon.geom"});
+        camera.push_back({ShaderStage::Fragment, "hair.frag"});
+        lines.push_back({ShaderStage::Fragment, "hair.frag"});
+        voxel.push_back({ShaderStage::Fragment, "voxelize.frag"});
+        std::vector<std::string> thick = defines, thin = defines;
+        thick.push_back("THICK_PASS");
+        thin.push_back("THIN_PASS");
+        thin.push_back("LINE_OUTPUT");
+        strand = GlProgram("strand ribbons", camera, thick);
+        strandLines = GlProgram("strand lines", lines, thin);
+        strandVoxel = GlProgram("strand voxelization", voxel, {cat("PATCH_SIZE ", patchSize)});
+        fur = GlProgram("generated hair",
+                        {{ShaderStage::Vertex, "fur.vert"},
+                         {ShaderStage::TessControl, "fur.tesc"},
+                         {ShaderStage::TessEvaluation, "fur.tese"},
+                         {ShaderStage::Geometry, "fur.geom"},
+                         {ShaderStage::Fragment, "hair.frag"}},
+                        shading);
+        strandPatchSize = patchSize;
+        shadedPerFragment = perFragment;
+    }
+
+    /// Thin strands are drawn as lines of the minimum width when the
+    /// rasterizer draws multisampled lines as exact rectangles of that width
+    /// (GL spec 14.5.2.2), which keeps their coverage right.
+    float linePathWidth() const {
+        const float width = settings.minPixelWidth * float(supersample());
+        if (samples() < 2) return 0.f;
+        GLfloat range[2] = {1.f, 1.f};
+        glGetFloatv(GL_SMOOTH_LINE_WIDTH_RANGE, range);
+        return width >= range[0] && width <= range[1] ? width : 0.f;
+    }
+
+    int samples() const { return std::clamp(settings.msaa, 1, maxSamples); }
+    int supersample() const { return std::clamp(settings.supersample, 1, 4); }
+
+    void fillUniforms(FrameUniforms& u, const View& view, const PreviewFrame& frame, float blendReference) const {
+        std::memset(&u, 0, sizeof(u));
+        const Camera& cam = view.camera;
+        const Mat4f proj = cam.projection(), viewM = cam.view();
+        const int ss = supersample();
+        const float tw = float(cam.width * ss), th = float(cam.height * ss);
+        copyMatrix(u.viewProj, proj * viewM);
+        copyMatrix(u.view, viewM);
+        copyMatrix(u.lightClip, grid.clip());
+        copyMatrix(u.lightView, grid.view);
+        set3(u.eye, cam.position, proj(1, 1) * 0.5f * th);
+        set4(u.viewport, tw, th, 1.f / tw, 1.f / th);
+        set4(u.gridMap, grid.scale.x(), grid.scale.y(), grid.offset.x(), grid.offset.y());
+        set4(u.gridDepth, grid.nearDepth, grid.farDepth, grid.perspective ? 1.f : 0.f, float(settings.shadow.resolution));
+        const size_t lights = std::min<size_t>(view.lights.size(), 16);
+        for (size_t i = 0; i < lights; ++i) {
+            const Light& l = view.lights[i];
+            if (l.type == LightType::Directional) set3(u.lightVec[i], -l.direction.normalized(), 0.f);
+            else set3(u.lightVec[i], l.position, 1.f);
+            set3(u.lightRad[i], l.color * l.intensity, 0.f);
+        }
+        const HairMaterial& h = view.hair;
+        set3(u.hairColor, h.color, h.kd);
+        set3(u.specColor, h.specularColor, h.ks);
+        set3(u.secondColor, h.secondaryColor, h.secondaryKs);
+        set4(u.hairShape, h.shininess, h.secondaryShininess, h.primaryShift, h.secondaryShift);
+        set3(u.headColor, view.head.color, view.head.ambient);
+        set4(u.headSkin, view.head.wrap, view.head.specular, view.head.shininess, 0.f);
+        const PreviewShadowSettings& sh = settings.shadow;
+        // Optical depth of one unit of C (shaders/shadow.glsl).
+        const float depthPerUnit = sh.weight == VoxelWeight::Crossings
+                                       ? 1.f - std::clamp(h.transmittance, 0.f, 1.f)
+                                       : -std::log(std::clamp(sh.alpha, 1e-6f, 1.f));
+        set4(u.shadow, depthPerUnit, float(std::max(0, sh.pcfRadius)), 1.f / float(std::max(1, sh.shadowMapSize)),
+             0.002f);
+        set4(u.tess, float(std::clamp(settings.tessellationLevel, 1, 64)), settings.tessellationPixels * float(ss),
+             settings.curve == CurveType::BSpline ? 1.f : 0.f, settings.minPixelWidth * float(ss));
+        set4(u.blend, blendReference, std::max(settings.blendDepthScale, 1e-5f), 0.f, 0.f);
+        const GeneratedHairSettings& g = settings.generated;
+        set3(u.gravity, g.gravity, 0.f);
+        set3(u.wind, g.wind, g.gust);
+        set4(u.furTime, float(frame.time), g.gustFrequency, std::max(g.gustWavelength, 1e-4f),
+             float(std::clamp(g.innerLevel, 1, 64)));
+        set4(u.furLevels, float(std::clamp(g.outerLevel, 1, 64)), 0.f, 0.f, 0.f);
+        u.counts[0] = int(lights);
+        u.counts[3] = h.twoLobes ? 1 : 0;
+    }
+
+    void drawStrands(const GlProgram& program) {
+        if (!strandsVisible || !strands.indexCount) return;
+        program.use();
+        glBindVertexArray(strands.vao);
+        glPatchParameteri(GL_PATCH_VERTICES, strands.patchSize);
+        glDrawElements(GL_PATCHES, GLsizei(strands.indexCount), GL_UNSIGNED_INT, nullptr);
+    }
+
+    void drawFur(const GlProgram& program) {
+        if (!furVisible || !headBuffers.furIndexCount) return;
+        program.use();
+        glBindVertexArray(headBuffers.vao);
+        glVertexArrayElementBuffer(headBuffers.vao, headBuffers.furIndices);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, headBuffers.furTypes);
+        glBindTextureUnit(2, headBuffers.hairTypes);
+        glPatchParameteri(GL_PATCH_VERTICES, 3);
+        glDrawElements(GL_PATCHES, GLsizei(headBuffers.furIndexCount), GL_UNSIGNED_INT, nullptr);
+    }
+
+    void drawHead(const GlProgram& program) {
+        if (!headVisible || !headBuffers.indexCount) return;
+        program.use();
+        glBindVertexArray(headBuffers.vao);
+        glVertexArrayElementBuffer(headBuffers.vao, headBuffers.indices);
+        glDrawElements(GL_TRIANGLES, GLsizei(headBuffers.indexCount), GL_UNSIGNED_INT, nullptr);
+    }
+
+    void shadowPasses(bool headDrawn, bool mapOn, bool voxelsOn) {
+        const PreviewShadowSettings& sh = settings.shadow;
+        shadows.ensure(std::clamp(sh.shadowMapSize, 16, 16384), std::clamp(sh.resolution, 4, 1024));
+        glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightUbo);
+        glDisable(GL_BLEND);
+        if (mapOn && headDrawn) {
+            glBindFramebuffer(GL_FRAMEBUFFER, shadows.mapFbo);
+            glViewport(0, 0, shadows.mapSize, shadows.mapSize);
+            glEnable(GL_DEPTH_TEST);
+            glDepthFunc(GL_LESS);
+            glDepthMask(GL_TRUE);
+            const float one = 1.f;
+            glClearNamedFramebufferfv(shadows.mapFbo, GL_DEPTH, 0, &one);
+            glEnable(GL_POLYGON_OFFSET_FILL);
+            glPolygonOffset(2.f, 4.f);
+            drawHead(headDepth);
+            glDisable(GL_POLYGON_OFFSET_FILL);
+            mark("shadow map");
+        }
+        if (voxelsOn) {
+            const GLuint zero = 0;
+            glClearTexImage(shadows.voxels, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+            mark("voxel clear");
+            glBindFramebuffer(GL_FRAMEBUFFER, shadows.voxelFbo);
+            glViewport(0, 0, shadows.resolution, shadows.resolution);
+            glDisable(GL_DEPTH_TEST);
+            glDepthMask(GL_FALSE);
+            glBindImageTexture(0, shadows.voxels, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
+            const int mode = sh.mode == VoxelMode::Binary ? 0 : (sh.splat == VoxelSplat::Trilinear ? 2 : 1);
+            for (const GlProgram* p : {&strandVoxel, &furVoxel}) {
+                glProgramUniform1i(p->id(), p->uniform("uMode"), mode);
+                glProgramUniform1i(p->id(), p->uniform("uCrossings"), sh.weight == VoxelWeight::Crossings ? 1 : 0);
+            }
+            drawStrands(strandVoxel);
+            drawFur(furVoxel);
+            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+            mark("voxelize");
+            prefix.use();
+            glProgramUniform1i(prefix.id(), prefix.uniform("uSum"), sh.sumAlongLight ? 1 : 0);
+            glBindImageTexture(0, shadows.voxels, 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32UI);
+            glBindImageTexture(1, shadows.density, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+            const GLuint groups = GLuint((shadows.resolution + 7) / 8);
+            glDispatchCompute(groups, groups, 1);
+            glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+            mark("voxel sum");
+        }
+    }
+
+    void cameraPass(bool voxelsOn, bool mapOn, float lineWidth) {
+        glBindBufferBase(GL_UNIFORM_BUFFER, 0, cameraUbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, targets.msFbo);
+        glViewport(0, 0, targets.width * targets.supersample, targets.height * targets.supersample);
+        const float zero[4] = {0, 0, 0, 0}, one[4] = {1, 1, 1, 1};
+        const float inf[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
+        const GLenum all[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
+        glDrawBuffers(4, all);
+        glDisable(GL_BLEND);
+        glDepthMask(GL_TRUE);
+        glClearBufferfv(GL_COLOR, 0, zero);
+        glClearBufferfv(GL_COLOR, 1, zero);
+        glClearBufferfv(GL_COLOR, 2, one);
+        glClearBufferfv(GL_COLOR, 3, inf);
+        glClearBufferfv(GL_DEPTH, 0, one);
+        mark("camera clear");
+        glBindTextureUnit(0, voxelsOn ? shadows.density : shadows.dummyDensity);
+        glBindTextureUnit(1, mapOn ? shadows.map : shadows.dummyMap);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glEnable(GL_MULTISAMPLE);
+
+        // Opaque head: colour into attachment 0, nearest depth (min) into 3.
+        const GLenum opaque[] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT3};
+        glDrawBuffers(4, opaque);
+        glEnablei(GL_BLEND, 3);
+        glBlendEquationi(3, GL_MIN);
+        glBlendFunci(3, GL_ONE, GL_ONE);
+        drawHead(head);
+        mark("head");
+
+        // Hair: tested against the head's depth, never writing it; min depth
+        // into 3. Sorted: premultiplied colour over attachment 0 (the patches
+        // arrive back to front). Weighted: weighted sums into 1, revealage
+        // products into 2.
+        glDepthMask(GL_FALSE);
+        if (settings.blend == HairBlend::Sorted) {
+            const GLenum hair[] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT3};
+            glDrawBuffers(4, hair);
+            glEnablei(GL_BLEND, 0);
+            glBlendEquationi(0, GL_FUNC_ADD);
+            glBlendFunci(0, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+        } else {
+            const GLenum hair[] = {GL_NONE, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
+            glDrawBuffers(4, hair);
+            glEnablei(GL_BLEND, 1);
+            glBlendEquationi(1, GL_FUNC_ADD);
+            glBlendFunci(1, GL_ONE, GL_ONE);
+            glEnablei(GL_BLEND, 2);
+            glBlendEquationi(2, GL_FUNC_ADD);
+            glBlendFunci(2, GL_ZERO, GL_ONE_MINUS_SRC_COLOR);
+        }
+        if (lineWidth > 0.f) {
+            glLineWidth(lineWidth);
+            drawStrands(strandLines);
+            glLineWidth(1.f);
+        }
+        drawStrands(strand);
+        mark("strands");
+        if (query) glBeginQuery(GL_GEOMETRY_SHADER_INVOCATIONS, query);
+        drawFur(fur);
+        if (query) {
+            glEndQuery(GL_GEOMETRY_SHADER_INVOCATIONS);
+            GLuint64 invocations = 0;
+            glGetQueryObjectui64v(query, GL_QUERY_RESULT, &invocations);
+            stats.generatedStrands = size_t(invocations);
+        }
+        mark("generated hair");
+        glDisable(GL_BLEND);
+        glDepthMask(GL_TRUE);
+    }
+
+    void resolve(const View& view) {
+        glBindFramebuffer(GL_FRAMEBUFFER, targets.resolvedFbo);
+        glViewport(0, 0, targets.width, targets.height);
+        glDisable(GL_DEPTH_TEST);
+        glDisable(GL_BLEND);
+        const GlProgram& p = targets.samples > 1 ? resolveMs : resolveSs;
+        p.use();
+        glProgramUniform1i(p.id(), p.uniform("uSamples"), targets.samples);
+        glProgramUniform1i(p.id(), p.uniform("uSupersample"), targets.supersample);
+        glProgramUniform3f(p.id(), p.uniform("uEnvironment"), view.environment.x(), view.environment.y(),
+                           view.environment.z());
+        glBindTextureUnit(0, targets.opaque);
+        glBindTextureUnit(1, targets.accum);
+        glBindTextureUnit(2, targets.reveal);
+        glBindTextureUnit(3, targets.minDepth);
+        glBindVertexArray(emptyVao);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
+
+    double lastWall = 0.0, lastCpu = 0.0;
+    /// With settings.profile: finishes the GL work so far and records it as `pass`.
+    void mark(const char* pass) {
+        if (!settings.profile) return;
+        glFinish();
+        const double wall = wallMilliseconds(), cpu = cpuMilliseconds();
+        if (pass) stats.passes.push_back({pass, wall - lastWall, cpu - lastCpu});
+        lastWall = wall, lastCpu = cpu;
+    }
+
+    void draw(const View& view, const PreviewFrame& frame);
+};
+
+void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
+    if (fence) {
+        // The previous frame may still read the mapped buffers we are about to overwrite.
+        glClientWaitSync(fence, GL_SYNC_FLUSH_COMMANDS_BIT, GLuint64(60) * 1000000000ull);
+        glDeleteSync(fence);
+        fence = nullptr;
+    }
+    while (glGetError() != GL_NO_ERROR) {
+    }
+    stats.passes.clear();
+    mark(nullptr);
+    const Camera& cam = view.camera;
+    const bool drawStrandsNow = settings.drawStrands && frame.strands && frame.strands->vertexCount() > 0;
+    const bool headNow = frame.head && !frame.head->triangles.empty();
+    const bool headDrawn = headNow && settings.drawHead;
+    Eigen::AlignedBox3f bounds;
+    stats.strandSegments = 0;
+    if (drawStrandsNow) {
+        const bool sorted = settings.blend == HairBlend::Sorted;
+        strands.upload(*frame.strands, sorted ? kSortedPatchSegments : 0);
+        if (sorted)
+            strands.sortBackToFront(*frame.strands, cam.position, (cam.target - cam.position).normalized());
+        compileHairPrograms(strands.patchSize);
+        stats.strandSegments = strands.segments;
+        for (const Vec3f& p : frame.strands->positions) bounds.extend(p);
+    }
+    strandsVisible = drawStrandsNow;
+    compileHairPrograms(strandPatchSize);  // follows a changed shading rate
+    std::vector<uint8_t> types;
+    if (headNow) {
+        if (settings.generated.enabled) {
+            try {
+                types = assignHairTypes(*frame.head, settings.generated, frame.headTransform.inverse(), frame.scalpMask);
+            } catch (const FrameError&) {
+                throw;
+            } catch (const Error& e) {
+                throw FrameError(cat("preview: ", e.what()));
+            }
+        }
+        headBuffers.upload(*frame.head, types, settings.generated.types);
+        Eigen::AlignedBox3f hb = frame.head->bounds();
+        if (settings.generated.enabled && headBuffers.furIndexCount) {
+            const float pad = settings.generated.maxLength();
+            hb.extend(hb.min() - Vec3f::Constant(pad));
+            hb.extend(hb.max() + Vec3f::Constant(pad));
+        }
+        bounds.extend(hb);
+    }
+    headVisible = headDrawn;
+    furVisible = headNow && settings.generated.enabled && headBuffers.furIndexCount > 0;
+    stats.furTriangles = furVisible ? headBuffers.furIndexCount / 3 : 0;
+    stats.generatedStrands = 0;
+
+    mark("upload");
+
+    // Reference depth of the blend weights: the scene's nearest bound corner.
+    float blendReference = cam.nearClip;
+    if (!bounds.isEmpty()) {
+        float nearest = INFINITY;
+        const Mat4f viewM = cam.view();
+        for (int i = 0; i < 8; ++i)
+            nearest = std::min(nearest, -(viewM * bounds.corner(Eigen::AlignedBox3f::CornerType(i)).homogeneous()).z());
+        blendReference = std::max(nearest, cam.nearClip);
+    }
+
+    const PreviewShadowSettings& sh = settings.shadow;
+    grid = LightGrid();
+    const bool lightExists =
+        sh.light >= 0 && size_t(sh.light) < view.lights.size() && view.lights[size_t(sh.light)].castsShadows;
+    if (lightExists && (sh.voxels || sh.shadowMap) && !bounds.isEmpty()) {
+        grid = LightGrid::fit(view.lights[size_t(sh.light)], bounds);
+        if (!grid.valid && !warnedUnshadowed) {
+            logWarning("preview: the shadowed light (render.lights[", sh.light,
+                       "]) is a point light inside the scene's bounds; it casts no shadows");
+            warnedUnshadowed = true;
+        }
+    }
+    stats.shadowed = grid.valid;
+    const bool voxelsOn = grid.valid && sh.voxels;
+    const bool mapOn = grid.valid && sh.shadowMap && headDrawn;
+    voxelsDrawn = voxelsOn;
+
+    FrameUniforms u;
+    fillUniforms(u, view, frame, blendReference);
+    const float lineWidth = linePathWidth();
+    u.blend[2] = lineWidth > 0.f ? 1.f : 0.f;
+    u.counts[1] = grid.valid ? sh.light : -1;
+    u.counts[2] = (voxelsOn ? kFlagVoxels : 0) | (mapOn ? kFlagShadowMap : 0) |
+                  (voxelsOn && sh.filter ? kFlagVoxelFilter : 0);
+    glNamedBufferSubData(cameraUbo, 0, sizeof(u), &u);
+    if (voxelsOn || mapOn) {
+        FrameUniforms l = u;
+        copyMatrix(l.viewProj, grid.clip());
+        const float res = float(std::clamp(sh.resolution, 4, 1024));
+        set4(l.viewport, res, res, 1.f / res, 1.f / res);
+        glNamedBufferSubData(lightUbo, 0, sizeof(l), &l);
+        shadowPasses(headDrawn, mapOn, voxelsOn);
+    }
+    targets.ensure(cam.width, cam.height, samples(), supersample());
+    cameraPass(voxelsOn, mapOn, lineWidth);
+    resolve(view);
+    mark("resolve");
+    fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    const GLenum error = glGetError();
+    if (error != GL_NO_ERROR)
+        throw FrameError(cat("preview: OpenGL error 0x", std::hex, error, " while drawing (", stats.renderer, ")"));
+}
+
+PreviewRenderer::PreviewRenderer(const PreviewSettings& settings) : impl_(std::make_unique<Impl>(settings)) {}
+PreviewRenderer::~PreviewRenderer() = default;
+
+const PreviewSettings& PreviewRenderer::settings() const { return impl_->settings; }
+void PreviewRenderer::setSettings(const PreviewSettings& settings) { impl_->settings = settings; }
+const PreviewStats& PreviewRenderer::stats() const { return impl_->stats; }
+
+void PreviewRenderer::draw(const View& shotView, const PreviewFrame& frame) {
+    View view = shotView;
+    view.lights = shotView.worldLights();  // a camera-relative rig follows this frame's camera
+    impl_->draw(view, frame);
+}
+
+void PreviewRenderer::finish() const { glFinish(); }
+
+Image PreviewRenderer::render(const View& view, const PreviewFrame& frame) {
+    draw(view, frame);
+    return readback();
+}
+
+Image PreviewRenderer::readback() const {
+    const RenderTargets& t = impl_->targets;
+    if (!t.resolvedFbo) throw FrameError("preview: nothing drawn yet");
+    const int w = t.width, h = t.height;
+    std::vector<float> rgba(size_t(w) * h * 4), z(size_t(w) * h);
+    glGetTextureImage(t.resolvedColor, 0, GL_RGBA, GL_FLOAT, GLsizei(rgba.size() * sizeof(float)), rgba.data());
+    glGetTextureImage(t.resolvedDepth, 0, GL_RED, GL_FLOAT, GLsizei(z.size() * sizeof(float)), z.data());
+    Image image(w, h, {"R", "G", "B", "A", "Z"});
+    for (int y = 0; y < h; ++y) {
+        const size_t src = size_t(h - 1 - y) * w;  // GL rows start at the bottom
+        for (int x = 0; x < w; ++x) {
+            for (int c = 0; c < 4; ++c) image.at(x, y, c) = rgba[(src + x) * 4 + c];
+            image.at(x, y, 4) = z[src + x];
+        }
+    }
+    return image;
+}
+
+void PreviewRenderer::present(int x, int y, int width, int height) const {
+    const Impl& m = *impl_;
+    if (!m.targets.resolvedFbo) return;
+    glViewport(x, y, width, height);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    m.present.use();
+    glProgramUniform4i(m.present.id(), m.present.uniform("uRect"), x, y, width, height);
+    glBindTextureUnit(0, m.targets.resolvedColor);
+    glBindVertexArray(m.emptyVao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+VoxelSnapshot PreviewRenderer::readVoxels() const {
+    const Impl& m = *impl_;
+    VoxelSnapshot snap;
+    if (!m.voxelsDrawn) return snap;
+    const int r = m.shadows.resolution;
+    const size_t n = size_t(r) * r * r;
+    snap.resolution = r;
+    snap.grid = m.grid;
+    std::vector<uint32_t> raw(n);
+    glGetTextureImage(m.shadows.voxels, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(n * 4), raw.data());
+    snap.raw.resize(n);
+    for (size_t i = 0; i < n; ++i) snap.raw[i] = float(raw[i]) / kVoxelUnit;
+    snap.summed.resize(n);
+    glGetTextureImage(m.shadows.density, 0, GL_RED, GL_FLOAT, GLsizei(n * 4), snap.summed.data());
+    return snap;
+}
+
+}  // namespace hp

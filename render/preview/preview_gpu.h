@@ -1,0 +1,142 @@
+// GPU resources of the preview (internal to render/preview*.cpp). GL object
+// names are plain unsigned ints so this header needs no GL headers.
+#pragma once
+
+#include "render/preview/preview.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace hp {
+
+/// The per-pass uniform block, std140: mirrors `Frame` in shaders/common.glsl.
+struct FrameUniforms {
+    float viewProj[16];
+    float view[16];
+    float lightClip[16];
+    float lightView[16];
+    float eye[4];
+    float viewport[4];
+    float gridMap[4];
+    float gridDepth[4];
+    float lightVec[16][4];
+    float lightRad[16][4];
+    float hairColor[4];
+    float specColor[4];
+    float secondColor[4];
+    float hairShape[4];
+    float headColor[4];
+    float headSkin[4];
+    float shadow[4];
+    float tess[4];
+    float blend[4];
+    float gravity[4];
+    float wind[4];
+    float furTime[4];
+    float furLevels[4];
+    int counts[4];
+};
+
+inline constexpr int kFlagVoxels = 1;
+inline constexpr int kFlagShadowMap = 2;
+inline constexpr int kFlagVoxelFilter = 4;
+/// Fixed point of the r32ui voxel grid (kVoxelUnit in shaders/common.glsl).
+inline constexpr float kVoxelUnit = 4096.f;
+
+/// A buffer mapped once for writing and kept mapped (GL 4.4 persistent,
+/// coherent mapping): per-frame uploads are a memcpy, and the storage is only
+/// reallocated when a frame needs more bytes than any before.
+class PersistentBuffer {
+  public:
+    PersistentBuffer() = default;
+    ~PersistentBuffer();
+    PersistentBuffer(const PersistentBuffer&) = delete;
+    PersistentBuffer& operator=(const PersistentBuffer&) = delete;
+
+    /// Makes room for `bytes`; returns true when the buffer was (re)created.
+    bool reserve(size_t bytes);
+    void* data() const { return mapped_; }
+    unsigned id() const { return id_; }
+    size_t capacity() const { return capacity_; }
+
+  private:
+    unsigned id_ = 0;
+    void* mapped_ = nullptr;
+    size_t capacity_ = 0;
+};
+
+/// Simulated strands on the GPU: vertices (xyz, radius), the patch index list
+/// (a patch per strand, `patchSize` indices each) and each patch's segment
+/// count (CPU side, for sorting), rebuilt only when the topology changes.
+struct StrandBuffers {
+    PersistentBuffer vertices;
+    unsigned indices = 0;
+    unsigned vao = 0;
+    int maxPatchVertices = 32;
+    int patchSize = 4;
+    std::vector<uint32_t> offsets;  ///< topology of the current index list
+    size_t indexCount = 0;
+    size_t segments = 0;
+    std::vector<uint32_t> list;     ///< the patch index list in strand order
+    std::vector<uint32_t> counts;   ///< segments per patch, strand order
+    std::vector<uint32_t> sortedList;
+
+    void create();
+    void destroy();
+    int chunkSegments = 0;          ///< most segments per patch asked for (0: as many as fit)
+    /// Uploads the vertices; rebuilds the patches when the topology or
+    /// `maxSegments` (segments per patch, 0 = as many as a patch holds) changed.
+    void upload(const StrandFrame& strands, int maxSegments = 0);
+    /// Reorders the patches back to front along `forward` (the camera's
+    /// viewing direction, from `eye`) by the depth of each patch's midpoint,
+    /// for blending with the over operator.
+    void sortBackToFront(const StrandFrame& strands, const Vec3f& eye, const Vec3f& forward);
+};
+
+/// The head mesh (positions + normals interleaved), its triangle list, and the
+/// triangles of generated-hair regions with their hair types.
+struct HeadBuffers {
+    PersistentBuffer vertices;
+    unsigned indices = 0;
+    unsigned furIndices = 0;
+    unsigned furTypes = 0;   ///< SSBO, one uint per region triangle
+    unsigned hairTypes = 0;  ///< RGBA32F texture, 2 rows, one column per hair type
+    unsigned vao = 0;
+    std::vector<uint32_t> triangles;  ///< flattened, for change detection
+    std::vector<uint8_t> types;       ///< per triangle hair type of the current fur list
+    std::vector<HairType> hairTypeRows;
+    size_t indexCount = 0;
+    size_t furIndexCount = 0;
+
+    void create();
+    void destroy();
+    void upload(const TriangleMesh& mesh, const std::vector<uint8_t>& triangleTypes,
+                const std::vector<HairType>& hairTypes);
+};
+
+/// The camera pass's multisampled target (opaque colour, WBOIT accumulation,
+/// revealage, min depth, depth buffer) and the resolved single-sample target.
+struct RenderTargets {
+    int width = 0, height = 0, samples = 0, supersample = 0;
+    unsigned msFbo = 0, opaque = 0, accum = 0, reveal = 0, minDepth = 0, depth = 0;
+    unsigned resolvedFbo = 0, resolvedColor = 0, resolvedDepth = 0;
+
+    void ensure(int w, int h, int samples, int supersample);
+    void destroy();
+};
+
+/// Shadow resources: the head's shadow map, the r32ui voxel grid, the summed
+/// R32F grid the shading samples, and an attachment-less framebuffer for
+/// voxelization.
+struct ShadowTargets {
+    int mapSize = 0, resolution = 0;
+    unsigned mapFbo = 0, map = 0;
+    unsigned voxelFbo = 0, voxels = 0, density = 0;
+    unsigned dummyDensity = 0, dummyMap = 0;  ///< bound when a shadow kind is off
+
+    void ensure(int mapSize, int resolution);
+    void destroy();
+};
+
+}  // namespace hp

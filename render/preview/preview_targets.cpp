@@ -1,0 +1,141 @@
+// Framebuffers and textures of the preview: the camera pass's multisampled
+// target, the resolved image, and the shadow map and voxel grids.
+#include "render/preview/preview_gpu.h"
+
+#include "core/errors.h"
+
+#include <epoxy/gl.h>
+
+namespace hp {
+
+namespace {
+
+GLuint makeTarget(int w, int h, int samples, GLenum format) {
+    GLuint tex = 0;
+    if (samples > 1) {
+        glCreateTextures(GL_TEXTURE_2D_MULTISAMPLE, 1, &tex);
+        glTextureStorage2DMultisample(tex, samples, format, w, h, GL_TRUE);
+    } else {
+        glCreateTextures(GL_TEXTURE_2D, 1, &tex);
+        glTextureStorage2D(tex, 1, format, w, h);
+        glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
+    return tex;
+}
+
+void checkComplete(GLuint fbo, const char* what) {
+    const GLenum status = glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE)
+        throw FrameError(cat("preview: the ", what, " framebuffer is incomplete (status 0x", std::hex, status, ")"));
+}
+
+void deleteTextures(std::initializer_list<unsigned*> list) {
+    for (unsigned* t : list) {
+        if (*t) glDeleteTextures(1, t);
+        *t = 0;
+    }
+}
+
+void deleteFramebuffers(std::initializer_list<unsigned*> list) {
+    for (unsigned* f : list) {
+        if (*f) glDeleteFramebuffers(1, f);
+        *f = 0;
+    }
+}
+
+}  // namespace
+
+void RenderTargets::ensure(int w, int h, int s, int ss) {
+    if (w == width && h == height && s == samples && ss == supersample && msFbo) return;
+    destroy();
+    width = w, height = h, samples = s, supersample = ss;
+    const int tw = w * ss, th = h * ss;
+    opaque = makeTarget(tw, th, s, GL_RGBA32F);  // sorted hair blends into it: half floats drift over many faint strands
+    accum = makeTarget(tw, th, s, GL_RGBA32F);
+    reveal = makeTarget(tw, th, s, GL_R32F);
+    minDepth = makeTarget(tw, th, s, GL_R32F);
+    depth = makeTarget(tw, th, s, GL_DEPTH_COMPONENT32F);
+    glCreateFramebuffers(1, &msFbo);
+    glNamedFramebufferTexture(msFbo, GL_COLOR_ATTACHMENT0, opaque, 0);
+    glNamedFramebufferTexture(msFbo, GL_COLOR_ATTACHMENT1, accum, 0);
+    glNamedFramebufferTexture(msFbo, GL_COLOR_ATTACHMENT2, reveal, 0);
+    glNamedFramebufferTexture(msFbo, GL_COLOR_ATTACHMENT3, minDepth, 0);
+    glNamedFramebufferTexture(msFbo, GL_DEPTH_ATTACHMENT, depth, 0);
+    checkComplete(msFbo, "multisampled camera");
+
+    resolvedColor = makeTarget(w, h, 1, GL_RGBA32F);
+    glTextureParameteri(resolvedColor, GL_TEXTURE_MIN_FILTER, GL_LINEAR);  // the viewer scales it
+    glTextureParameteri(resolvedColor, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    resolvedDepth = makeTarget(w, h, 1, GL_R32F);
+    glCreateFramebuffers(1, &resolvedFbo);
+    glNamedFramebufferTexture(resolvedFbo, GL_COLOR_ATTACHMENT0, resolvedColor, 0);
+    glNamedFramebufferTexture(resolvedFbo, GL_COLOR_ATTACHMENT1, resolvedDepth, 0);
+    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glNamedFramebufferDrawBuffers(resolvedFbo, 2, buffers);
+    checkComplete(resolvedFbo, "resolved");
+}
+
+void RenderTargets::destroy() {
+    deleteFramebuffers({&msFbo, &resolvedFbo});
+    deleteTextures({&opaque, &accum, &reveal, &minDepth, &depth, &resolvedColor, &resolvedDepth});
+    width = height = samples = supersample = 0;
+}
+
+void ShadowTargets::ensure(int size, int res) {
+    if (!dummyDensity) {
+        // Bound when a shadow kind is off, so every sampler always sees a complete texture.
+        const float zero = 0.f, one = 1.f;
+        glCreateTextures(GL_TEXTURE_3D, 1, &dummyDensity);
+        glTextureStorage3D(dummyDensity, 1, GL_R32F, 1, 1, 1);
+        glTextureSubImage3D(dummyDensity, 0, 0, 0, 0, 1, 1, 1, GL_RED, GL_FLOAT, &zero);
+        glCreateTextures(GL_TEXTURE_2D, 1, &dummyMap);
+        glTextureStorage2D(dummyMap, 1, GL_DEPTH_COMPONENT32F, 1, 1);
+        glTextureSubImage2D(dummyMap, 0, 0, 0, 1, 1, GL_DEPTH_COMPONENT, GL_FLOAT, &one);
+        glTextureParameteri(dummyMap, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    }
+    if (size != mapSize) {
+        deleteFramebuffers({&mapFbo});
+        deleteTextures({&map});
+        mapSize = size;
+        glCreateTextures(GL_TEXTURE_2D, 1, &map);
+        glTextureStorage2D(map, 1, GL_DEPTH_COMPONENT32F, size, size);
+        glTextureParameteri(map, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTextureParameteri(map, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTextureParameteri(map, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTextureParameteri(map, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        glTextureParameteri(map, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+        glTextureParameteri(map, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+        glCreateFramebuffers(1, &mapFbo);
+        glNamedFramebufferTexture(mapFbo, GL_DEPTH_ATTACHMENT, map, 0);
+        glNamedFramebufferDrawBuffer(mapFbo, GL_NONE);
+        checkComplete(mapFbo, "shadow map");
+    }
+    if (res != resolution) {
+        deleteFramebuffers({&voxelFbo});
+        deleteTextures({&voxels, &density});
+        resolution = res;
+        glCreateTextures(GL_TEXTURE_3D, 1, &voxels);
+        glTextureStorage3D(voxels, 1, GL_R32UI, res, res, res);
+        glCreateTextures(GL_TEXTURE_3D, 1, &density);
+        glTextureStorage3D(density, 1, GL_R32F, res, res, res);
+        glTextureParameteri(density, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTextureParameteri(density, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
+            glTextureParameteri(density, wrap, GL_CLAMP_TO_EDGE);
+        // Voxelization writes through image atomics only: a framebuffer with
+        // no attachments gives the rasterizer its res x res viewport.
+        glCreateFramebuffers(1, &voxelFbo);
+        glNamedFramebufferParameteri(voxelFbo, GL_FRAMEBUFFER_DEFAULT_WIDTH, res);
+        glNamedFramebufferParameteri(voxelFbo, GL_FRAMEBUFFER_DEFAULT_HEIGHT, res);
+        checkComplete(voxelFbo, "voxelization");
+    }
+}
+
+void ShadowTargets::destroy() {
+    deleteFramebuffers({&mapFbo, &voxelFbo});
+    deleteTextures({&map, &voxels, &density, &dummyDensity, &dummyMap});
+    mapSize = resolution = 0;
+}
+
+}  // namespace hp

@@ -1,0 +1,106 @@
+// @brief The Embree reference renderer: ray-traced frames of the strands and
+// the head, to compare the GL preview against.
+//
+// Two shading modes share one camera, light set and geometry:
+// - kajiya-kay: the preview's model, exactly kajiyaKay() of render/view/view.h
+//   with the View's HairMaterial, direct light only, with ray-traced shadows
+//   through semi-transparent hair (HairMaterial::transmittance per strand
+//   crossing, the same parameter the preview's voxel shadows derive from). Any difference
+//   to the preview is then visibility, shadows and anti-aliasing, not shading.
+// - physical: a path tracer with Chiang et al.'s hair BSDF (render/reference/hair_bsdf.h)
+//   and a Lambertian head; shadow rays see hair as opaque because light that
+//   passes through strands is carried by the BSDF's transmission lobes.
+//   Shadow rays of light samples with a small unshadowed contribution are
+//   traced by Russian roulette (ReferenceSettings::shadowRouletteThreshold):
+//   unbiased, and most of dark hair's shadow rays are skipped.
+//
+// Determinism: every random number is a hash of (seed, frame, pixel, sample,
+// dimension) (render/reference/sampling.h), pixels are independent, and samples are
+// summed in a fixed order, so an image is bit-identical for any thread count.
+#pragma once
+
+#include "render/reference/hair_bsdf.h"
+#include "render/image/image_io.h"
+#include "render/view/view.h"
+#include "sim/strands/head.h"
+#include "sim/strands/strand.h"
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+namespace hp {
+
+enum class ReferenceMode { KajiyaKay, Physical };
+
+/// "kajiya-kay" / "physical".
+const char* referenceModeName(ReferenceMode mode);
+
+struct ReferenceSettings {
+    ReferenceMode mode = ReferenceMode::KajiyaKay;
+    int samplesPerPixel = 16;    ///< stratified (Owen-scrambled Sobol') over the pixel, box filter
+    int bounces = 4;             ///< physical: indirect bounces after the first hit (0 = direct light only)
+    uint64_t seed = 1;
+    int frame = 0;               ///< part of the random sequence, so frames decorrelate
+    bool shadows = true;
+    HairFiberParams fiber;           ///< physical mode
+    /// physical: light samples whose unshadowed contribution is below this
+    /// fraction of the light's radiance (max over RGB of path throughput ×
+    /// BSDF, 1/sr) trace their shadow ray by Russian roulette (unbiased,
+    /// slightly noisier); 0 traces every shadow ray.
+    float shadowRouletteThreshold = 1.f / 32.f;
+    bool diffuseSpecularLayers = false;  ///< add diffuse.{R,G,B} and specular.{R,G,B}
+    bool strandIdLayer = false;          ///< add strand_id (stable id of the nearest strand, −1 for none)
+    int tileSize = 32;                   ///< pixels per tile side; tiles run in parallel (TBB)
+    /// Called after each finished tile with (tiles done, tiles); calls are
+    /// serialised, but may come from any thread.
+    std::function<void(size_t, size_t)> progress;
+};
+
+/// Measurements of one render.
+struct ReferenceStats {
+    double buildSeconds = 0.0;   ///< Embree scene construction
+    double renderSeconds = 0.0;  ///< tracing and shading
+    /// Process CPU time of the two phases (all threads): the work done, which
+    /// a busy shared machine inflates far less than wall time.
+    double buildCpuSeconds = 0.0;
+    double renderCpuSeconds = 0.0;
+    int64_t sceneBytes = 0;      ///< Embree memory held by the frame's scene (memory monitor)
+    int64_t peakBytes = 0;       ///< Embree peak over build and render
+    size_t strands = 0;
+    size_t segments = 0;
+    uint64_t rays = 0;           ///< camera, bounce and shadow rays
+};
+
+/// Channel names of the output image, in order: R G B A Z, then diffuse.R/G/B
+/// and specular.R/G/B if asked for, then strand_id. Colour is linear and
+/// premultiplied by A (coverage), plus the environment seen where nothing is
+/// hit (zero with the default black environment); Z is the view-space depth
+/// of the nearest sample, camera.farClip where nothing was hit.
+std::vector<std::string> referenceChannels(const ReferenceSettings& settings);
+
+/// Renders frames; keeps one Embree device alive across them. Each render
+/// builds the frame's scene and releases it before returning.
+class ReferenceRenderer {
+  public:
+    ReferenceRenderer();
+    ~ReferenceRenderer();
+    ReferenceRenderer(const ReferenceRenderer&) = delete;
+    ReferenceRenderer& operator=(const ReferenceRenderer&) = delete;
+
+    /// `strands` and `head` may be null (nothing of that kind). The image has
+    /// view.camera.width × height pixels. Throws FrameError for broken input
+    /// (NaN vertices, negative radii) or invalid settings.
+    Image render(const View& view, const StrandFrame* strands, const TriangleMesh* head,
+                 const ReferenceSettings& settings, ReferenceStats* stats = nullptr);
+
+    /// Bytes Embree holds between renders (should return to its idle value).
+    int64_t embreeBytesInUse() const;
+
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace hp

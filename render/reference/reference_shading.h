@@ -1,0 +1,36 @@
+// @brief Radiance of one camera sample for the reference renderer's two modes
+// (internal to render/reference/reference.cpp; see render/reference/reference.h for the models).
+#pragma once
+
+#include "render/reference/embree_scene.h"
+#include "render/reference/hair_bsdf.h"
+#include "render/reference/reference.h"
+#include "render/reference/sampling.h"
+
+namespace hp {
+
+/// Everything the shading of one frame reads; shared by all threads.
+struct ShadingContext {
+    const EmbreeScene& scene;
+    const View& view;
+    const ReferenceSettings& settings;
+    HairModel hair;
+};
+
+/// What one camera sample saw.
+struct SampleResult {
+    Vec3f radiance = Vec3f::Zero();
+    Vec3f diffuse = Vec3f::Zero();   ///< part of radiance (kajiya-kay: diffuse term; physical: all but R at the first hit)
+    Vec3f specular = Vec3f::Zero();  ///< kajiya-kay: specular term; physical: R lobe of direct light at the first hit
+    bool hit = false;
+    float depth = 0.f;               ///< view-space depth of the first hit
+    int64_t strandId = -1;           ///< stable id of the strand hit first (with the id layer only), −1 for head or nothing
+    uint32_t rays = 0;
+};
+
+/// Shades the camera ray (origin, unit dir) whose first hit is `hit`, with
+/// the context's mode; further random numbers come from `sampler`.
+SampleResult shadeSample(const ShadingContext& ctx, const Vec3f& origin, const Vec3f& dir, const SceneHit& hit,
+                         sampling::PixelSampler& sampler);
+
+}  // namespace hp

@@ -1,0 +1,121 @@
+#include "render/view/view.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hp {
+
+Mat4f lookAt(const Vec3f& eye, const Vec3f& target, const Vec3f& up) {
+    const Vec3f f = (target - eye).normalized();
+    const Vec3f s = f.cross(up).normalized();
+    const Vec3f u = s.cross(f);
+    Mat4f m = Mat4f::Identity();
+    m.block<1, 3>(0, 0) = s.transpose();
+    m.block<1, 3>(1, 0) = u.transpose();
+    m.block<1, 3>(2, 0) = -f.transpose();
+    m(0, 3) = -s.dot(eye);
+    m(1, 3) = -u.dot(eye);
+    m(2, 3) = f.dot(eye);
+    return m;
+}
+
+Mat4f Camera::view() const { return lookAt(position, target, up); }
+
+Mat4f Camera::projection() const {
+    const float t = 1.f / std::tan(0.5f * fovY * float(M_PI) / 180.f);
+    Mat4f m = Mat4f::Zero();
+    m(0, 0) = t / aspect();
+    m(1, 1) = t;
+    m(2, 2) = (farClip + nearClip) / (nearClip - farClip);
+    m(2, 3) = 2.f * farClip * nearClip / (nearClip - farClip);
+    m(3, 2) = -1.f;
+    return m;
+}
+
+CameraRays::CameraRays(const Camera& c)
+    : forward_((c.target - c.position).normalized()),
+      side_(forward_.cross(c.up).normalized()),
+      up_(side_.cross(forward_)),
+      tanHalf_(std::tan(0.5f * c.fovY * float(M_PI) / 180.f)),
+      aspect_(c.aspect()),
+      width_(float(c.width)),
+      height_(float(c.height)) {}
+
+Vec3f Camera::rayDirection(float x, float y) const { return CameraRays(*this).direction(x, y); }
+
+Vec3f Light::toLight(const Vec3f& p, Vec3f* radiance, float* distance) const {
+    if (type == LightType::Directional) {
+        if (radiance) *radiance = color * intensity;
+        if (distance) *distance = std::numeric_limits<float>::infinity();
+        return -direction.normalized();
+    }
+    const Vec3f d = position - p;
+    const float r2 = std::max(d.squaredNorm(), 1e-8f);
+    if (radiance) *radiance = color * (intensity / r2);
+    if (distance) *distance = std::sqrt(r2);
+    return d / std::sqrt(r2);
+}
+
+std::vector<Light> View::worldLights() const {
+    std::vector<Light> out = lights;
+    const Vec3f back = (camera.position - camera.target).normalized();
+    const Vec3f right = camera.up.cross(back).normalized();
+    const Vec3f up = back.cross(right);
+    for (Light& l : out) {
+        if (!l.cameraRelative) continue;
+        l.direction = l.direction.x() * right + l.direction.y() * up + l.direction.z() * back;
+        l.position = camera.target + l.position.x() * right + l.position.y() * up + l.position.z() * back;
+        l.cameraRelative = false;
+    }
+    return out;
+}
+
+std::vector<Light> threePointRig() {
+    auto light = [](Vec3f direction, Vec3f color, float intensity, bool shadows) {
+        Light l;
+        l.direction = direction;
+        l.color = color;
+        l.intensity = intensity;
+        l.castsShadows = shadows;
+        l.cameraRelative = true;
+        return l;
+    };
+    return {light({0.85f, -0.5f, -0.3f}, {1.f, 0.95f, 0.88f}, 1.6f, true),
+            light({-0.8f, -0.1f, -0.55f}, {0.85f, 0.9f, 1.f}, 0.25f, false),
+            light({-0.25f, -0.6f, 0.8f}, {1.f, 1.f, 1.f}, 1.f, false)};
+}
+
+Vec3f skinShade(const SurfaceMaterial& m, const Vec3f& n, const Vec3f& l, const Vec3f& v) {
+    const float c = n.dot(l);
+    const float w = std::max(m.wrap, 0.f);
+    Vec3f f = m.color * std::max(0.f, (c + w) / (1.f + w));
+    if (c > 0.f && m.specular > 0.f) f += Vec3f::Constant(m.specular * std::pow(std::max(0.f, n.dot((l + v).normalized())), m.shininess));
+    return f;
+}
+
+namespace {
+float sinBetween(const Vec3f& a, const Vec3f& b) {
+    const float c = std::clamp(a.dot(b), -1.f, 1.f);
+    return std::sqrt(std::max(0.f, 1.f - c * c));
+}
+Vec3f shifted(const Vec3f& t, const Vec3f& n, float shift) {
+    if (shift == 0.f) return t;
+    return (t + shift * n).normalized();
+}
+}  // namespace
+
+Vec3f kajiyaKay(const HairMaterial& m, const Vec3f& t, const Vec3f& n, const Vec3f& l, const Vec3f& v,
+                Vec3f* diffuseOut, Vec3f* specularOut) {
+    const Vec3f h = (l + v).normalized();
+    const Vec3f diffuse = m.kd * sinBetween(t, l) * m.color;
+    Vec3f specular = m.ks * std::pow(sinBetween(shifted(t, n, m.primaryShift), h), m.shininess) * m.specularColor;
+    if (m.twoLobes) {
+        specular += m.secondaryKs * std::pow(sinBetween(shifted(t, n, m.secondaryShift), h), m.secondaryShininess) *
+                    m.secondaryColor;
+    }
+    if (diffuseOut) *diffuseOut = diffuse;
+    if (specularOut) *specularOut = specular;
+    return diffuse + specular;
+}
+
+}  // namespace hp
