@@ -25,33 +25,6 @@ using namespace hp::test;
 
 namespace {
 
-/// frontView (camera at (0, 0, 1) looking at the origin) with a warm light
-/// of intensity 2 and a black environment.
-View testView(int width, int height, const Vec3f& lightDirection) {
-    View v = frontView(width, height, lightDirection);
-    v.lights[0].intensity = 2.f;
-    v.lights[0].color = Vec3f(1.f, 0.9f, 0.8f);
-    v.environment = Vec3f::Zero();
-    return v;
-}
-
-/// 3000 synthetic strands on their 0.1 m sphere head (16 x 32 facets), seen
-/// from (0, 0.05, 0.9) in testView's light from (-1, -1, -1).
-struct HairOnHead {
-    StrandFrame strands;
-    TriangleMesh head;
-    View view;
-};
-
-HairOnHead hairOnHead(int width, int height) {
-    SyntheticHairSettings hs;
-    hs.strands = 3000;
-    HairOnHead h{makeSyntheticHair(hs), makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32),
-                 testView(width, height, Vec3f(-1.f, -1.f, -1.f))};
-    h.view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
-    return h;
-}
-
 /// One straight strand from a to b with n vertices of constant radius.
 void addLine(StrandFrame& f, uint32_t id, const Vec3f& a, const Vec3f& b, int n, float radius) {
     std::vector<Vec3f> p(n);

@@ -7,10 +7,12 @@
 #include "pipeline/batch/path_template.h"
 #include "pipeline/stages/stages.h"
 #include "pipeline/scene/view_settings.h"
+#include "render/reference/adaptive_sampling.h"
 #include "render/reference/reference.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include <optional>
 
@@ -24,8 +26,31 @@ ReferenceSettings referenceSettings(const Scene& s, const ShotSettings& shot) {
     ReferenceSettings r;
     r.mode = s.text("reference.mode") == "physical" ? ReferenceMode::Physical : ReferenceMode::KajiyaKay;
     r.samplesPerPixel = int(s.integer("reference.samples"));
+    // Adaptive unless a fixed count is given; both at once is a contradiction.
+    r.noiseThreshold = float(s.number("reference.noise_threshold"));
+    if (s.given("reference.samples")) {
+        if (s.given("reference.noise_threshold") && r.noiseThreshold > 0.f)
+            s.fail("reference.noise_threshold",
+                   "asks for adaptive sampling, but reference.samples fixes the sample count: give one of them "
+                   "(or noise_threshold: 0)");
+        r.noiseThreshold = 0.f;
+    }
+    r.minSamples = int(s.integer("reference.min_samples"));
+    r.maxSamples = int(s.integer("reference.max_samples"));
+    if (r.noiseThreshold > 0.f) {
+        for (const char* key : {"reference.min_samples", "reference.max_samples"})
+            if (!isPowerOfTwo(uint32_t(s.integer(key))))
+                s.fail(key, cat(s.integer(key), " is not a power of two (sample counts double from pass to pass, "
+                                "which keeps the sampler's strata)"));
+        if (r.maxSamples < r.minSamples)
+            s.fail("reference.max_samples", cat(r.maxSamples, " is below reference.min_samples (", r.minSamples, ")"));
+    }
+    r.timeLimit = s.number("reference.time_limit");
+    r.filter.type = s.text("reference.filter.type") == "box" ? PixelFilterType::Box : PixelFilterType::Gaussian;
+    r.filter.radius = r.filter.type == PixelFilterType::Box ? 0.5f : float(s.number("reference.filter.radius"));
+    r.filter.sigma = float(s.number("reference.filter.sigma"));
     r.bounces = int(s.integer("reference.depth"));
-    r.seed = uint64_t(shot.seed);
+    r.seed = s.has("reference.seed") ? uint64_t(s.integer("reference.seed")) : uint64_t(shot.seed);
     r.shadows = s.flag("reference.shadows");
     r.shadowRouletteThreshold = float(s.number("reference.shadow_roulette"));
     r.diffuseSpecularLayers = s.flag("reference.layers.diffuse_specular");
@@ -37,6 +62,21 @@ ReferenceSettings referenceSettings(const Scene& s, const ShotSettings& shot) {
     f.ior = float(s.number("reference.physical.ior"));
     f.sigmaA = hairAbsorption(s);
     return r;
+}
+
+/// `value` with `digits` decimals.
+std::string fixed(double value, int digits) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.*f", digits, value);
+    return text;
+}
+
+/// "64 spp" or "spp 16..1024 (mean 212.4), 97.1% below noise 0.01".
+std::string samplesText(const ReferenceSettings& s, const ReferenceStats& st) {
+    if (!(s.noiseThreshold > 0.f)) return cat(s.samplesPerPixel, " spp");
+    return cat("spp ", st.minSamples, "..", st.maxSamples, " (mean ", fixed(st.meanSamples, 1), "), ",
+               fixed(100.0 * st.convergedFraction, 1), "% below noise ", s.noiseThreshold,
+               st.timeLimitReached ? " (time limit reached)" : "");
 }
 
 std::string checkedTemplate(const Scene& s, const std::string& key, bool required) {
@@ -118,11 +158,16 @@ class ReferenceStage final : public FrameStage {
                 logVerbose("reference: frame ", data.frame, " ", 10 * decile, "%");
             }
         };
+        settings.passDone = [&](int samples, double sampling) {
+            if (settings.noiseThreshold > 0.f)
+                logVerbose("reference: frame ", data.frame, " pass to ", samples, " spp, ", fixed(100.0 * sampling, 1),
+                           "% of pixels still sampling");
+        };
         ReferenceStats stats;
         const Image image = renderer_.render(view, data.strands, head, settings, &stats);
-        logVerbose("reference: frame ", data.frame, ": ", stats.strands, " strands, ", settings.samplesPerPixel,
-                   " spp, ", referenceModeName(settings.mode), ", build ", stats.buildSeconds, " s, render ",
-                   stats.renderSeconds, " s, Embree ", stats.sceneBytes / (1 << 20), " MiB");
+        logVerbose("reference: frame ", data.frame, ": ", stats.strands, " strands, ", referenceModeName(settings.mode),
+                   ", ", samplesText(settings, stats), ", build ", fixed(stats.buildSeconds, 2), " s, render ",
+                   fixed(stats.renderSeconds, 2), " s, Embree ", stats.sceneBytes / (1 << 20), " MiB");
 
         ImageWriteOptions options;
         options.metadata = {{"hairpipe:stage", "reference"},
@@ -130,7 +175,8 @@ class ReferenceStage final : public FrameStage {
                             {"hairpipe:frame", std::to_string(data.frame)},
                             {"hairpipe:seed", std::to_string(shot_.seed)},
                             {"hairpipe:mode", referenceModeName(settings.mode)},
-                            {"hairpipe:samples", std::to_string(settings.samplesPerPixel)},
+                            {"hairpipe:samples", samplesText(settings, stats)},
+                            {"hairpipe:sampler_seed", std::to_string(settings.seed)},
                             {"hairpipe:strands", std::to_string(stats.strands)}};
         std::vector<fs::path> paths;
         append(paths, sequence, data.frame);

@@ -74,7 +74,7 @@ void writeImage(const std::string& path, const Image& image, const ImageWriteOpt
             format = OIIO::TypeDesc::HALF;
             // Depth and integer-like layers keep full precision.
             for (const std::string& c : image.channels) {
-                const bool precise = c == "Z" || c.find("id") != std::string::npos;
+                const bool precise = c == "Z" || c == "samples" || c.find("id") != std::string::npos;
                 channelFormats.push_back(precise ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::HALF);
             }
         }

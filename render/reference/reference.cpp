@@ -2,6 +2,7 @@
 
 #include "core/errors.h"
 #include "render/reference/embree_scene.h"
+#include "render/reference/adaptive_sampling.h"
 #include "render/reference/reference_shading.h"
 
 #include <pmmintrin.h>
@@ -11,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <ctime>
 #include <limits>
@@ -23,7 +25,7 @@ const char* referenceModeName(ReferenceMode mode) {
 }
 
 std::vector<std::string> referenceChannels(const ReferenceSettings& s) {
-    std::vector<std::string> c{"R", "G", "B", "A", "Z"};
+    std::vector<std::string> c{"R", "G", "B", "A", "Z", "samples", "error"};
     if (s.diffuseSpecularLayers)
         for (const char* n : {"diffuse.R", "diffuse.G", "diffuse.B", "specular.R", "specular.G", "specular.B"})
             c.push_back(n);
@@ -51,6 +53,16 @@ void checkSettings(const View& view, const ReferenceSettings& s) {
     if (view.camera.width <= 0 || view.camera.height <= 0)
         throw FrameError(cat("reference: image size ", view.camera.width, "x", view.camera.height, " is empty"));
     if (s.samplesPerPixel < 1) throw FrameError(cat("reference: ", s.samplesPerPixel, " samples per pixel"));
+    if (s.noiseThreshold < 0.f || !std::isfinite(s.noiseThreshold))
+        throw FrameError(cat("reference: noise threshold ", s.noiseThreshold));
+    if (s.noiseThreshold > 0.f) {
+        if (s.minSamples < 1 || !isPowerOfTwo(uint32_t(s.minSamples)) || s.maxSamples < s.minSamples ||
+            !isPowerOfTwo(uint32_t(s.maxSamples)))
+            throw FrameError(cat("reference: adaptive sample counts ", s.minSamples, "..", s.maxSamples,
+                                 " must be powers of two with min <= max"));
+    }
+    if (!(s.filter.radius > 0.f) || (s.filter.type == PixelFilterType::Gaussian && !(s.filter.sigma > 0.f)))
+        throw FrameError(cat("reference: pixel filter radius ", s.filter.radius, ", sigma ", s.filter.sigma));
     if (s.bounces < 0) throw FrameError(cat("reference: ", s.bounces, " bounces"));
     if (s.tileSize < 1) throw FrameError(cat("reference: tile size ", s.tileSize));
     const float t = view.hair.transmittance;
@@ -72,49 +84,99 @@ class FlushDenormals {
     unsigned saved_;
 };
 
-/// Renders the pixels of one tile into `image`.
-uint64_t renderTile(const ShadingContext& ctx, Image& image, int x0, int y0, int x1, int y1) {
+/// What a pixel has gathered so far: sums of its samples in a fixed order.
+struct PixelState {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Vector3d firstHalf = Eigen::Vector3d::Zero();  ///< sum of the first n/2 samples
+    uint32_t n = 0;
+    uint32_t covered = 0;
+    float depth = 0.f;
+    float error = std::numeric_limits<float>::infinity();
+};
+
+/// The image being sampled: per-pixel sums, the optional layers' sums and
+/// which pixels still sample.
+struct Film {
+    int width, height;
+    std::vector<PixelState> pixels;
+    std::vector<Eigen::Vector3d> diffuse, specular;  ///< with the diffuse/specular layers
+    std::vector<int64_t> ids;                        ///< with the id layer
+    std::vector<uint8_t> active;
+
+    Film(int w, int h, const ReferenceSettings& s, float farClip)
+        : width(w), height(h), pixels(size_t(w) * size_t(h)), active(pixels.size(), 1) {
+        for (PixelState& p : pixels) p.depth = farClip;
+        if (s.diffuseSpecularLayers)
+            diffuse.assign(pixels.size(), Eigen::Vector3d::Zero()), specular = diffuse;
+        if (s.strandIdLayer) ids.assign(pixels.size(), -1);
+    }
+};
+
+/// Takes each active pixel of one tile from its sample count up to `target`
+/// samples (indices n .. target−1 of its sequence). The first half's sum is
+/// kept at index target/2, which is where the previous pass stopped.
+uint64_t sampleTile(const ShadingContext& ctx, Film& film, int x0, int y0, int x1, int y1, uint32_t target) {
     const ReferenceSettings& s = ctx.settings;
     const Camera& cam = ctx.view.camera;
-    const int nc = image.channelCount();
-    const bool layers = s.diffuseSpecularLayers;
-    const int idChannel = s.strandIdLayer ? nc - 1 : -1;
-    const float inv = 1.f / float(s.samplesPerPixel);
+    const bool layers = !film.diffuse.empty(), ids = !film.ids.empty();
     const FlushDenormals flush;
     const CameraRays camera(cam);
     uint64_t rays = 0;
     for (int y = y0; y < y1; ++y) {
         for (int x = x0; x < x1; ++x) {
+            const size_t k = size_t(y) * size_t(film.width) + size_t(x);
+            if (!film.active[k]) continue;
+            PixelState& px = film.pixels[k];
             sampling::PixelSampler sampler(s.seed, s.frame, x, y);
-            Eigen::Vector3d rgb = Eigen::Vector3d::Zero(), dif = rgb, spec = rgb;
-            int covered = 0;
-            float depth = cam.farClip;
-            int64_t id = -1;
-            for (int i = 0; i < s.samplesPerPixel; ++i) {
-                sampler.start(uint32_t(i));
-                const Vec2f u = sampler.next2D();
-                const Vec3f dir = camera.direction(float(x) + u.x(), float(y) + u.y());
+            for (uint32_t i = px.n; i < target; ++i) {
+                if (i == target / 2) px.firstHalf = px.sum;
+                sampler.start(i);
+                const Vec2f offset = sampleFilterOffset(s.filter, sampler.next2D());
+                const Vec3f dir = camera.direction(float(x) + 0.5f + offset.x(), float(y) + 0.5f + offset.y());
                 const SceneHit hit = ctx.scene.intersect(cam.position, dir, 0.f, std::numeric_limits<float>::infinity());
                 const SampleResult r = shadeSample(ctx, cam.position, dir, hit, sampler);
                 rays += r.rays;
-                rgb += r.radiance.cast<double>();
-                if (layers) dif += r.diffuse.cast<double>(), spec += r.specular.cast<double>();
+                px.sum += r.radiance.cast<double>();
+                if (layers) film.diffuse[k] += r.diffuse.cast<double>(), film.specular[k] += r.specular.cast<double>();
                 if (r.hit) {
-                    ++covered;
+                    ++px.covered;
                     // The nearest sample decides depth and id (no filtering of ids).
-                    if (r.depth < depth) depth = r.depth, id = r.strandId;
+                    if (r.depth < px.depth) {
+                        px.depth = r.depth;
+                        if (ids) film.ids[k] = r.strandId;
+                    }
                 }
             }
-            float* px = &image.at(x, y, 0);
-            for (int c = 0; c < 3; ++c) px[c] = float(rgb[c]) * inv;
-            px[3] = float(covered) * inv;
-            px[4] = depth;
-            if (layers)
-                for (int c = 0; c < 3; ++c) px[5 + c] = float(dif[c]) * inv, px[8 + c] = float(spec[c]) * inv;
-            if (idChannel >= 0) px[idChannel] = float(id);
+            if (px.n < target) {
+                px.n = target;
+                px.error = pixelError(px.sum / double(target), px.firstHalf / double(target / 2 ? target / 2 : 1));
+            }
         }
     }
     return rays;
+}
+
+/// The film's means as the output image (channels of referenceChannels).
+Image resolve(const Film& film, const ReferenceSettings& s) {
+    Image image(film.width, film.height, referenceChannels(s));
+    const int idChannel = s.strandIdLayer ? image.channelCount() - 1 : -1;
+    for (int y = 0; y < film.height; ++y)
+        for (int x = 0; x < film.width; ++x) {
+            const size_t k = size_t(y) * size_t(film.width) + size_t(x);
+            const PixelState& p = film.pixels[k];
+            const double inv = p.n ? 1.0 / double(p.n) : 0.0;
+            float* px = &image.at(x, y, 0);
+            for (int c = 0; c < 3; ++c) px[c] = float(p.sum[c] * inv);
+            px[3] = float(double(p.covered) * inv);
+            px[4] = p.depth;
+            px[5] = float(p.n);
+            px[6] = std::isfinite(p.error) ? p.error : 0.f;
+            if (!film.diffuse.empty())
+                for (int c = 0; c < 3; ++c)
+                    px[7 + c] = float(film.diffuse[k][c] * inv), px[10 + c] = float(film.specular[k][c] * inv);
+            if (idChannel >= 0) px[idChannel] = float(film.ids[k]);
+        }
+    return image;
 }
 
 }  // namespace
@@ -141,24 +203,64 @@ Image ReferenceRenderer::render(const View& shotView, const StrandFrame* strands
     const auto t1 = Clock::now();
     const std::clock_t c1 = std::clock();
     const ShadingContext ctx{scene, view, settings, HairModel(settings.fiber)};
-    Image image(view.camera.width, view.camera.height, referenceChannels(settings));
+    Film film(view.camera.width, view.camera.height, settings, view.camera.farClip);
     const int ts = settings.tileSize;
-    const int tilesX = (image.width + ts - 1) / ts, tilesY = (image.height + ts - 1) / ts;
+    const int tilesX = (film.width + ts - 1) / ts, tilesY = (film.height + ts - 1) / ts;
     const size_t tiles = size_t(tilesX) * size_t(tilesY);
-    std::atomic<size_t> done{0};
+    const bool adaptive = settings.noiseThreshold > 0.f;
+    const uint32_t last = uint32_t(adaptive ? settings.maxSamples : settings.samplesPerPixel);
     std::atomic<uint64_t> rays{0};
+    std::atomic<bool> outOfTime{false};
     std::mutex progressMutex;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t t = range.begin(); t != range.end(); ++t) {
-            const int tx = int(t % size_t(tilesX)), ty = int(t / size_t(tilesX));
-            const int x0 = tx * ts, y0 = ty * ts;
-            rays += renderTile(ctx, image, x0, y0, std::min(x0 + ts, image.width), std::min(y0 + ts, image.height));
-            if (settings.progress) {
-                std::lock_guard<std::mutex> lock(progressMutex);
-                settings.progress(++done, tiles);
+    // Passes: every active pixel goes to `target` samples; between passes the
+    // pixels whose error is below the threshold stop (with their neighbours
+    // dilated back in), and the target doubles, so counts stay powers of two.
+    const uint32_t first = adaptive ? uint32_t(settings.minSamples) : last;
+    for (uint32_t target = first;; target *= 2) {
+        std::atomic<size_t> done{0};
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& range) {
+            for (size_t t = range.begin(); t != range.end(); ++t) {
+                // The first pass always completes: every pixel gets its minimum.
+                if (target > first && settings.timeLimit > 0.0 && secondsSince(t0) > settings.timeLimit)
+                    outOfTime = true;
+                if (outOfTime) return;
+                const int tx = int(t % size_t(tilesX)), ty = int(t / size_t(tilesX));
+                const int x0 = tx * ts, y0 = ty * ts;
+                rays += sampleTile(ctx, film, x0, y0, std::min(x0 + ts, film.width), std::min(y0 + ts, film.height),
+                                   target);
+                if (settings.progress) {
+                    std::lock_guard<std::mutex> lock(progressMutex);
+                    settings.progress(++done, tiles);
+                }
             }
+        });
+        ++st.passes;
+        size_t sampling = 0;
+        if (adaptive) {
+            for (size_t k = 0; k < film.pixels.size(); ++k)
+                film.active[k] = film.active[k] && !(film.pixels[k].error < settings.noiseThreshold);
+            dilateActive(film.active, film.width, film.height);
+            for (uint8_t a : film.active) sampling += a;
         }
-    });
+        if (settings.passDone) settings.passDone(int(target), double(sampling) / double(film.pixels.size()));
+        if (!adaptive || sampling == 0 || outOfTime || target >= last) break;
+    }
+    st.timeLimitReached = outOfTime;
+    st.minSamples = std::numeric_limits<int>::max();
+    double samples = 0.0, error = 0.0;
+    size_t converged = 0;
+    for (const PixelState& p : film.pixels) {
+        st.minSamples = std::min(st.minSamples, int(p.n));
+        st.maxSamples = std::max(st.maxSamples, int(p.n));
+        samples += p.n;
+        if (std::isfinite(p.error)) error += p.error;
+        converged += p.error < settings.noiseThreshold;
+    }
+    const double pixels = double(film.pixels.size());
+    st.meanSamples = samples / pixels;
+    st.meanError = error / pixels;
+    st.convergedFraction = double(converged) / pixels;
+    Image image = resolve(film, settings);
     st.renderSeconds = secondsSince(t1);
     st.renderCpuSeconds = cpuSecondsSince(c1);
     st.rays = rays.load();

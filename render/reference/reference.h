@@ -14,13 +14,21 @@
 //   traced by Russian roulette (ReferenceSettings::shadowRouletteThreshold):
 //   unbiased, and most of dark hair's shadow rays are skipped.
 //
+// Sampling: each pixel is the mean of its own samples, placed by filter
+// importance sampling (render/reference/pixel_filter.h). With a noise
+// threshold, pixels sample in passes that double their count until their
+// error estimate is below it (render/reference/adaptive_sampling.h).
+//
 // Determinism: every random number is a hash of (seed, frame, pixel, sample,
-// dimension) (render/reference/sampling.h), pixels are independent, and samples are
-// summed in a fixed order, so an image is bit-identical for any thread count.
+// dimension) (render/reference/sampling.h), pixels are independent, samples are
+// summed in a fixed order, and adaptive sampling decides between passes, so
+// an image is bit-identical for any thread count (unless a time limit stops
+// it: where the clock stops depends on the machine).
 #pragma once
 
-#include "render/reference/hair_bsdf.h"
 #include "render/image/image_io.h"
+#include "render/reference/hair_bsdf.h"
+#include "render/reference/pixel_filter.h"
 #include "render/view/view.h"
 #include "sim/strands/head.h"
 #include "sim/strands/strand.h"
@@ -39,7 +47,19 @@ const char* referenceModeName(ReferenceMode mode);
 
 struct ReferenceSettings {
     ReferenceMode mode = ReferenceMode::KajiyaKay;
-    int samplesPerPixel = 16;    ///< stratified (Owen-scrambled Sobol') over the pixel, box filter
+    /// Fixed sample count of every pixel when noiseThreshold is 0.
+    int samplesPerPixel = 16;
+    /// Adaptive sampling (Cycles' estimate, adaptive_sampling.h): a pixel
+    /// stops when its error estimate falls below this; 0 = off (every pixel
+    /// takes samplesPerPixel).
+    float noiseThreshold = 0.f;
+    int minSamples = 16;         ///< adaptive: first pass (a power of two)
+    int maxSamples = 1024;       ///< adaptive: no pixel goes past this (a power of two)
+    /// Seconds from the start of render() after which no further pass or
+    /// tile starts (0 = none). Pixels keep the samples they have; the image
+    /// then depends on the machine's speed.
+    double timeLimit = 0.0;
+    PixelFilter filter;          ///< Gaussian σ 0.5 px, radius 1.5 px (pbrt-v4's default)
     int bounces = 4;             ///< physical: indirect bounces after the first hit (0 = direct light only)
     uint64_t seed = 1;
     int frame = 0;               ///< part of the random sequence, so frames decorrelate
@@ -53,9 +73,12 @@ struct ReferenceSettings {
     bool diffuseSpecularLayers = false;  ///< add diffuse.{R,G,B} and specular.{R,G,B}
     bool strandIdLayer = false;          ///< add strand_id (stable id of the nearest strand, −1 for none)
     int tileSize = 32;                   ///< pixels per tile side; tiles run in parallel (TBB)
-    /// Called after each finished tile with (tiles done, tiles); calls are
-    /// serialised, but may come from any thread.
+    /// Called after each finished tile of a pass with (tiles done, tiles);
+    /// calls are serialised, but may come from any thread.
     std::function<void(size_t, size_t)> progress;
+    /// Called after each pass with (samples per pixel reached, fraction of
+    /// pixels still sampling), from the calling thread.
+    std::function<void(int, double)> passDone;
 };
 
 /// Measurements of one render.
@@ -71,10 +94,19 @@ struct ReferenceStats {
     size_t strands = 0;
     size_t segments = 0;
     uint64_t rays = 0;           ///< camera, bounce and shadow rays
+    int passes = 0;              ///< sampling passes (1 without adaptive sampling)
+    int minSamples = 0;          ///< fewest samples a pixel took
+    int maxSamples = 0;          ///< most samples a pixel took
+    double meanSamples = 0.0;    ///< samples per pixel, averaged over the image
+    double convergedFraction = 0.0;  ///< pixels whose error ended below the threshold
+    double meanError = 0.0;      ///< the error layer averaged over the image
+    bool timeLimitReached = false;
 };
 
-/// Channel names of the output image, in order: R G B A Z, then diffuse.R/G/B
-/// and specular.R/G/B if asked for, then strand_id. Colour is linear and
+/// Channel names of the output image, in order: R G B A Z, samples (the
+/// pixel's sample count), error (its final error estimate,
+/// adaptive_sampling.h pixelError), then diffuse.R/G/B and specular.R/G/B
+/// if asked for, then strand_id. Colour is linear and
 /// premultiplied by A (coverage), plus the environment seen where nothing is
 /// hit (zero with the default black environment); Z is the view-space depth
 /// of the nearest sample, camera.farClip where nothing was hit.

@@ -12,6 +12,15 @@
 //                   [--width 1920] [--height 1080] [--spp 16] [--bounces 4]
 //                   [--repeat 1] [--threads 2] [--out DIR] [--no-head] [--no-shadows]
 //                   [--melanin 1.3] [--shadow-roulette 0.03125 (0: off)] [--seed 1]
+//                   [--noise-threshold T (adaptive; 0: --spp fixed)] [--min-samples 16]
+//                   [--max-samples 1024] [--time-limit S] [--filter gaussian|box]
+//                   [--seeds A,B]
+//
+// B-converge (docs/benchmarks.md): with --seeds A,B every render is made with
+// both sampler seeds and the two images are compared on the hair mask (FLIP,
+// SSIM: render/compare/compare.h), the noise figure that needs no
+// higher-sample image; the time column is then one render's.
+#include "render/compare/compare.h"
 #include "render/reference/reference.h"
 #include "sim/strands/head.h"
 #include "sim/strands/synthetic.h"
@@ -61,6 +70,11 @@ int main(int argc, char** argv) {
     float melanin = 1.3f;
     float shadowRoulette = ReferenceSettings{}.shadowRouletteThreshold;
     uint64_t seed = 1;
+    std::vector<std::string> seeds;
+    float noiseThreshold = 0.f;
+    int minSamples = 16, maxSamples = 1024;
+    double timeLimit = 0.0;
+    PixelFilterType filter = PixelFilterType::Gaussian;
     std::string out;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -85,6 +99,12 @@ int main(int argc, char** argv) {
         else if (a == "--melanin") melanin = std::stof(next());
         else if (a == "--shadow-roulette") shadowRoulette = std::stof(next());
         else if (a == "--seed") seed = std::stoull(next());
+        else if (a == "--seeds") seeds = split(next());
+        else if (a == "--noise-threshold") noiseThreshold = std::stof(next());
+        else if (a == "--min-samples") minSamples = std::stoi(next());
+        else if (a == "--max-samples") maxSamples = std::stoi(next());
+        else if (a == "--time-limit") timeLimit = std::stod(next());
+        else if (a == "--filter") filter = next() == "box" ? PixelFilterType::Box : PixelFilterType::Gaussian;
         else {
             std::fprintf(stderr, "unknown option %s (see the comment at the top of bench_reference.cpp)\n", a.c_str());
             return 1;
@@ -97,10 +117,18 @@ int main(int argc, char** argv) {
     view.lights[0].direction.normalize();
     const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 32, 64);
 
-    std::printf("# bench_reference: %dx%d, %d spp, %d bounces (physical), %d threads, head %s, shadow roulette %g, synthetic hair\n",
-                width, height, spp, bounces, threads, withHead ? "on" : "off", shadowRoulette);
-    std::printf("%-8s %-11s %8s %9s %9s %9s %8s %8s %8s %10s %10s %9s\n", "strands", "mode", "build_s", "render_s",
-                "frame_s", "spread_s", "bcpu_s", "rcpu_s", "rays/spl", "embree_MB", "emb_peakMB", "rss_MB");
+    std::printf("# bench_reference: %dx%d, %s, %d bounces (physical), %d threads, head %s, shadow roulette %g, "
+                "%s filter, synthetic hair\n",
+                width, height,
+                noiseThreshold > 0.f ? ("noise threshold " + std::to_string(noiseThreshold) + ", spp " +
+                                        std::to_string(minSamples) + ".." + std::to_string(maxSamples))
+                                           .c_str()
+                                     : (std::to_string(spp) + " spp").c_str(),
+                bounces, threads, withHead ? "on" : "off", shadowRoulette, pixelFilterName(filter));
+    std::printf("%-8s %-11s %8s %9s %9s %9s %8s %8s %8s %10s %10s %9s %8s %8s %7s %7s\n", "strands", "mode", "build_s",
+                "render_s", "frame_s", "spread_s", "bcpu_s", "rcpu_s", "rays/spl", "embree_MB", "emb_peakMB", "rss_MB",
+                "spp_mean", "spp_max", "flip2", "ssim2");
+    if (seeds.empty()) seeds.push_back(std::to_string(seed));
     ReferenceRenderer renderer;
     for (const std::string& count : strandCounts) {
         SyntheticHairSettings hs;
@@ -112,29 +140,47 @@ int main(int argc, char** argv) {
             s.mode = modeName == "physical" ? ReferenceMode::Physical : ReferenceMode::KajiyaKay;
             s.samplesPerPixel = spp;
             s.bounces = bounces;
-            s.seed = seed;
             s.frame = 1;
+            s.noiseThreshold = noiseThreshold;
+            s.minSamples = minSamples;
+            s.maxSamples = maxSamples;
+            s.timeLimit = timeLimit;
+            s.filter.type = filter;
+            if (filter == PixelFilterType::Box) s.filter.radius = 0.5f;
             s.shadows = shadows;
             s.fiber.sigmaA = hairAbsorptionFromMelanin(melanin, 0.f);
             s.shadowRouletteThreshold = shadowRoulette;
             std::vector<double> frame, build, render, bcpu, rcpu;
             ReferenceStats st;
-            Image image;
-            for (int r = 0; r < repeat; ++r) {
-                image = renderer.render(view, &strands, withHead ? &head : nullptr, s, &st);
-                bcpu.push_back(st.buildCpuSeconds);
-                rcpu.push_back(st.renderCpuSeconds);
-                build.push_back(st.buildSeconds);
-                render.push_back(st.renderSeconds);
-                frame.push_back(st.buildSeconds + st.renderSeconds);
+            std::vector<Image> images;
+            for (const std::string& seedText : seeds) {
+                s.seed = std::stoull(seedText);
+                Image image;
+                for (int r = 0; r < repeat; ++r) {
+                    image = renderer.render(view, &strands, withHead ? &head : nullptr, s, &st);
+                    bcpu.push_back(st.buildCpuSeconds);
+                    rcpu.push_back(st.renderCpuSeconds);
+                    build.push_back(st.buildSeconds);
+                    render.push_back(st.renderSeconds);
+                    frame.push_back(st.buildSeconds + st.renderSeconds);
+                }
+                images.push_back(std::move(image));
             }
+            double flip2 = -1.0, ssim2 = -1.0;
+            if (images.size() >= 2) {
+                CompareSettings cs;
+                cs.mask = MaskMode::Hair;
+                const FrameMetrics m = compareImages(images[0], images[1], cs).metrics;
+                flip2 = m.flip, ssim2 = m.ssim;
+            }
+            const Image& image = images.front();
             const double spread = *std::max_element(frame.begin(), frame.end()) -
                                   *std::min_element(frame.begin(), frame.end());
-            std::printf("%-8s %-11s %8.2f %9.2f %9.2f %9.2f %8.2f %8.2f %8.2f %10.1f %10.1f %9.0f\n", count.c_str(),
-                        modeName.c_str(), median(build), median(render), median(frame), spread, median(bcpu),
-                        median(rcpu),
-                        double(st.rays) / (double(width) * height * spp), double(st.sceneBytes) / (1 << 20),
-                        double(st.peakBytes) / (1 << 20), peakRssMiB());
+            std::printf("%-8s %-11s %8.2f %9.2f %9.2f %9.2f %8.2f %8.2f %8.2f %10.1f %10.1f %9.0f %8.1f %8d %7.4f %7.4f\n",
+                        count.c_str(), modeName.c_str(), median(build), median(render), median(frame), spread,
+                        median(bcpu), median(rcpu), double(st.rays) / (double(width) * height * st.meanSamples),
+                        double(st.sceneBytes) / (1 << 20), double(st.peakBytes) / (1 << 20), peakRssMiB(),
+                        st.meanSamples, st.maxSamples, flip2, ssim2);
             std::fflush(stdout);
             if (!out.empty()) {
                 std::filesystem::create_directories(out);
