@@ -405,3 +405,41 @@ TEST(Skin, ReflectsAtMostWhatItReceivesAndTheAlbedoWhenDiffuse) {
         }
     }
 }
+
+TEST(Lights, ShadowRouletteOnlyWhereAShadowRayIsTraced) {
+    // Shadow-ray roulette (ReferenceSettings::shadowRouletteThreshold) trades
+    // noise for skipped shadow rays; a light sample that traces no shadow
+    // ray (a first-hit light, or shadows off) must not pay that noise: its
+    // image may not depend on the threshold. With shadow rays it does.
+    SyntheticHairSettings hs;
+    hs.strands = 600;
+    const StrandFrame strands = makeSyntheticHair(hs);
+    const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
+    View view;
+    view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
+    view.camera.width = 40;
+    view.camera.height = 30;
+    view.environment = Vec3f::Zero();
+    view.lights = {Light{}};
+    view.lights[0].direction = Vec3f(-1.f, -1.f, -1.f);
+    view.lights[0].castsShadows = false;
+    ReferenceSettings s;
+    s.mode = ReferenceMode::Physical;
+    s.samplesPerPixel = 4;
+    s.bounces = 1;
+    ReferenceRenderer renderer;
+    auto differs = [&](ReferenceSettings a) {
+        a.shadowRouletteThreshold = 0.f;
+        const Image exact = renderer.render(view, &strands, &head, a);
+        a.shadowRouletteThreshold = 10.f;
+        const Image roulette = renderer.render(view, &strands, &head, a);
+        return exact.pixels != roulette.pixels;
+    };
+    s.unshadowedLights = UnshadowedLights::FirstHit;
+    EXPECT_FALSE(differs(s)) << "first-hit light";
+    s.unshadowedLights = UnshadowedLights::Shadowed;
+    s.shadows = false;
+    EXPECT_FALSE(differs(s)) << "shadows off";
+    s.shadows = true;
+    EXPECT_TRUE(differs(s)) << "shadowed light";
+}

@@ -176,7 +176,7 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
             Vec3f li = ls.radiance;
             if (!light.delta()) li *= (firstHit || !bsdfSampling ? 1.f : powerHeuristic(ls.pdf, pdfB)) / ls.pdf;
             Vec3f c = beta.cwiseProduct(f).cwiseProduct(li);
-            if (!firstHit) {
+            if (!firstHit && s.shadows) {  // roulette only where a shadow ray would be traced
                 const float w = shadowRoulette(c.maxCoeff() / light.scale(origin), s.shadowRouletteThreshold, u);
                 if (w <= 0.f) continue;
                 li *= w * visibility(ctx, origin, ls.wi, ls.distance, 0.f, start, &r.rays);
