@@ -141,6 +141,8 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
         const Vec3f wo = -d;
         Vec3f origin = p;
         RayStart start;
+        const bool onHead = hit.kind == SceneHit::Kind::Head;
+        Vec3f headNg = Vec3f::Zero();
         std::optional<HairBsdf> hairBsdf;
         VertexBsdf bsdf(ctx.view.head, Vec3f::UnitZ(), wo);
         if (hit.kind == SceneHit::Kind::Hair) {
@@ -155,6 +157,7 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
             if (ng.dot(wo) < 0.f) ng = -ng;
             if (n.dot(ng) < 0.f) n = -n;
             origin = p + surfaceOffset(p) * ng;
+            headNg = ng;
             bsdf = VertexBsdf(ctx.view.head, n, wo);
             start = kFromHead;
         }
@@ -219,13 +222,27 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
         }
         o = origin;
         d = bs.wi;
-        ++r.rays;
-        hit = ctx.scene.intersect(o, d, 0.f, kInf, start);
-        const bool escaped = hit.kind == SceneHit::Kind::None;
+        // The path goes on with the head opaque: a bounce off the skin must
+        // not see hair through the neck. A direction into the head's surface
+        // (the wrap lobe past the terminator) ends it.
+        const bool intoHead = onHead && !(d.dot(headNg) > 0.f);
+        SceneHit next;
+        if (!intoHead) {
+            ++r.rays;
+            next = ctx.scene.intersect(o, d, 0.f, kInf, onHead ? RayStart{} : start);
+        }
         if (bsdfSampling || skyBsdfSampling) {
-            // The lights and sky this ray reaches (without shadows, through the scene).
+            // The lights and sky this ray reaches, seen as the light samples'
+            // shadow rays see them (hair blocks; from the head, the head does
+            // not), so that both estimates of each light agree for MIS.
+            float tLight = next.kind == SceneHit::Kind::None ? kInf : next.t;
+            if (onHead && (intoHead || next.kind == SceneHit::Kind::Head)) {
+                ++r.rays;
+                const SceneHit hair = ctx.scene.intersect(o, d, 0.f, kInf, kFromHead);
+                tLight = hair.kind == SceneHit::Kind::None ? kInf : hair.t;
+            }
+            if (!s.shadows) tLight = kInf;
             Vec3f found = Vec3f::Zero();
-            const float tLight = escaped || !s.shadows ? kInf : hit.t;
             for (const SampledLight& light : ctx.lights) {
                 if (firstHitLight(light) || !bsdfSampling) continue;
                 Vec3f le;
@@ -233,7 +250,7 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
                 if (light.hit(o, d, tLight, &le, &pdfL))
                     found += le * (lightSampling ? powerHeuristic(bs.pdf, pdfL) : 1.f);
             }
-            if (env.active() && skyBsdfSampling && (escaped || !s.shadows))
+            if (env.active() && skyBsdfSampling && std::isinf(tLight))
                 found += env.radiance(d) * (skyLightSampling ? powerHeuristic(bs.pdf, env.pdf(d)) : 1.f);
             if (found.maxCoeff() > 0.f) {
                 r.radiance += beta.cwiseProduct(found);
@@ -247,7 +264,8 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
                 }
             }
         }
-        if (escaped || last) break;
+        hit = next;
+        if (intoHead || hit.kind == SceneHit::Kind::None || last) break;
     }
     r.diffuse = r.radiance - r.specular;
     return r;
