@@ -443,3 +443,29 @@ TEST(Lights, ShadowRouletteOnlyWhereAShadowRayIsTraced) {
     s.shadows = true;
     EXPECT_TRUE(differs(s)) << "shadowed light";
 }
+
+TEST(Lights, HeadCastsNoShadowOnItselfForAnyStrategy) {
+    // The head casts no shadow on itself (RayStart::throughHead): a part of
+    // the head between a head point and a light must be ignored alike by the
+    // light samples' shadow rays and by the BSDF rays' search for the light,
+    // or light, BSDF and MIS estimates would disagree. A second head square
+    // hangs between the plane and the disk, covering most of it.
+    PlaneShot shot = planeShot();
+    const uint32_t base = uint32_t(shot.plane.positions.size());
+    const float e = 0.25f, z = 0.25f;
+    for (const Vec3f& c : {Vec3f(-e, -e, z), Vec3f(e, -e, z), Vec3f(e, e, z), Vec3f(-e, e, z)}) shot.plane.positions.push_back(c);
+    shot.plane.triangles.push_back({base, base + 1, base + 2});
+    shot.plane.triangles.push_back({base, base + 2, base + 3});
+    shot.plane.computeNormals();
+    shot.view.camera.position = Vec3f(0.f, 0.f, 0.1f);  // under the occluder, looking down at the plane
+    shot.view.camera.target = Vec3f::Zero();
+    Light disk;
+    disk.type = LightType::Disk;
+    disk.position = Vec3f(0.f, 0.f, 0.5f);
+    disk.direction = Vec3f(0.f, 0.f, -1.f);
+    disk.size = Vec2f(0.6f, 0.6f);
+    disk.intensity = 1.5f;
+    shot.view.lights = {disk};
+    const double R = 0.3, h = 0.5, L = 1.5 / (kPi * R * R);
+    expectAllStrategiesAgree(shot, L * R * R / (R * R + h * h), "disk over a head that covers it");
+}
