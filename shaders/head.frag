@@ -24,9 +24,15 @@ void main() {
         vec3 radiance;
         vec3 l = toLight(i, vWorld, radiance);
         float c = dot(n, l);
-        // skinShade (render/view/view.cpp): wrapped diffuse plus a Blinn-Phong sheen.
-        vec3 f = uHeadColor.rgb * max(0.0, (c + w) / (1.0 + w));
-        if (c > 0.0 && uHeadSkin.y > 0.0) f += vec3(uHeadSkin.y * pow(max(0.0, dot(n, normalize(l + v))), uHeadSkin.z));
+        // skinShade (render/view/view.cpp): energy-conserving wrapped Lambert
+        // plus a normalised Blinn-Phong sheen, (1 - ks) + ks <= 1.
+        float ks = clamp(uHeadSkin.y, 0.0, 1.0);
+        vec3 f = uHeadColor.rgb * ((1.0 - ks) * max(0.0, c + w) / (3.14159265 * (1.0 + w) * (1.0 + w)));
+        if (c > 0.0 && ks > 0.0) {
+            float s = uHeadSkin.z;
+            float norm = (s + 2.0) * (s + 4.0) / (8.0 * 3.14159265 * (exp2(-0.5 * s) + s));
+            f += vec3(ks * norm * pow(max(0.0, dot(n, normalize(l + v))), s) * c);
+        }
         if (max(f.r, max(f.g, f.b)) > 0.0) color += f * radiance * hairOnlyVisibility(i, vWorld);
     }
     oColor = vec4(color, 1.0);

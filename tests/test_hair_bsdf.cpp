@@ -85,6 +85,45 @@ TEST(HairBsdf, WhiteFurnaceConservesEnergy) {
     std::printf("largest furnace deviation %.4f\n", worst);
 }
 
+TEST(HairBsdf, WhiteFurnaceByQuadratureLosesAtMostOnePercent) {
+    // The white furnace of Chiang et al. 2016 (§6), by deterministic
+    // quadrature instead of sampling: σa = 0, so ∫ S(wo, wi) dω_i must be 1
+    // for every wo and every offset h. Midpoint rule in θi (dω = cos θi dθi
+    // dφi) and φi, fine enough for β = 0.1 (Mp's width in θ is √v ≈ 0.08 rad,
+    // Np's logistic scale 0.07 rad; the nodes are 0.5° apart).
+    constexpr int nTheta = 360, nPhi = 720;
+    float worst = 0.f;
+    for (float betaM : {0.1f, 0.3f, 0.6f, 0.9f}) {
+        for (float betaN : {0.1f, 0.3f, 0.6f, 0.9f}) {
+            HairFiberParams p;
+            p.sigmaA = Vec3f::Zero();
+            p.longitudinalRoughness = betaM;
+            p.azimuthalRoughness = betaN;
+            const HairModel model(p);
+            for (float thetaO : {-60.f, 0.f, 70.f}) {
+                const Vec3f wo = direction(thetaO, 0.4f);
+                for (float h : {-0.6f, 0.9f}) {
+                    const HairBsdf bsdf(model, h);
+                    double sum = 0.0;
+                    for (int j = 0; j < nTheta; ++j) {
+                        const float thetaI = kPi * ((float(j) + 0.5f) / float(nTheta) - 0.5f);
+                        const double w = std::cos(thetaI) * (double(kPi) / nTheta) * (2.0 * kPi / nPhi);
+                        for (int i = 0; i < nPhi; ++i) {
+                            const float phi = 2.f * kPi * (float(i) + 0.5f) / float(nPhi);
+                            const Vec3f wi(std::sin(thetaI), std::cos(thetaI) * std::cos(phi), std::cos(thetaI) * std::sin(phi));
+                            sum += bsdf.eval(wo, wi).x() * w;
+                        }
+                    }
+                    worst = std::max(worst, float(std::abs(sum - 1.0)));
+                    EXPECT_NEAR(sum, 1.0, 0.01) << "beta_m " << betaM << " beta_n " << betaN << " theta_o " << thetaO
+                                                << " h " << h;
+                }
+            }
+        }
+    }
+    std::printf("largest quadrature furnace deviation %.5f\n", worst);
+}
+
 TEST(HairBsdf, SampledWhiteFurnaceConservesEnergy) {
     // Same integral through sample(): each weight S/pdf, averaged.
     for (float betaM : {0.2f, 0.4f, 0.8f}) {

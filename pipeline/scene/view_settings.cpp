@@ -2,6 +2,7 @@
 #include "pipeline/scene/key_fields.h"
 
 #include "core/errors.h"
+#include "render/reference/environment_light.h"
 #include "render/reference/hair_bsdf.h"
 
 namespace hp {
@@ -28,18 +29,34 @@ View makeView(const Scene& s) {
     for (size_t i = 0; i < s.count("render.lights"); ++i) {
         const std::string k = cat("render.lights[", i, "].");
         Light l;
-        l.type = s.text(k + "type") == "point" ? LightType::Point : LightType::Directional;
+        const std::string& type = s.text(k + "type");
+        l.type = type == "point" ? LightType::Point
+                 : type == "quad" ? LightType::Quad
+                 : type == "disk" ? LightType::Disk
+                                  : LightType::Directional;
         l.direction = s.vec3f(k + "direction");
         l.position = s.vec3f(k + "position");
+        l.angle = float(s.number(k + "angle"));
+        l.size = Vec2f(float(s.number(k + "width")), float(s.number(k + "height")));
+        l.up = s.vec3f(k + "up");
         l.color = s.vec3f(k + "color");
         l.intensity = float(s.number(k + "intensity"));
         l.castsShadows = s.flag(k + "shadows");
         l.cameraRelative = s.text(k + "space") == "camera";
-        if (l.type == LightType::Directional && l.direction.norm() < 1e-6f)
-            s.fail(k + "direction", "a directional light needs a non-zero direction");
+        if (l.type != LightType::Point && l.direction.norm() < 1e-6f)
+            s.fail(k + "direction", cat("a ", type, " light needs a non-zero direction"));
         v.lights.push_back(l);
     }
     v.environment = s.vec3f("render.environment");
+    const std::filesystem::path map = s.file("render.environment_map");
+    if (!map.empty()) {
+        try {
+            v.environmentMap = loadEnvironmentMap(map.string(), float(s.number("render.environment_intensity")),
+                                                  float(s.number("render.environment_rotation")));
+        } catch (const Error& e) {
+            s.fail("render.environment_map", e.what());
+        }
+    }
 
     HairMaterial& h = v.hair;
     h.color = s.number("render.hair.melanin") >= 0 ? hairColorFromAbsorption(hairAbsorption(s), hairRoughness(s))

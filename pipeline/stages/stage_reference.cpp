@@ -53,6 +53,8 @@ ReferenceSettings referenceSettings(const Scene& s, const ShotSettings& shot) {
     r.seed = s.has("reference.seed") ? uint64_t(s.integer("reference.seed")) : uint64_t(shot.seed);
     r.shadows = s.flag("reference.shadows");
     r.shadowRouletteThreshold = float(s.number("reference.shadow_roulette"));
+    r.unshadowedLights = s.text("reference.physical.unshadowed_lights") == "first-hit" ? UnshadowedLights::FirstHit
+                                                                                        : UnshadowedLights::Shadowed;
     r.diffuseSpecularLayers = s.flag("reference.layers.diffuse_specular");
     r.strandIdLayer = s.flag("reference.layers.strand_id");
     HairFiberParams& f = r.fiber;

@@ -368,8 +368,9 @@ struct PreviewRenderer::Impl {
         p.use();
         glProgramUniform1i(p.id(), p.uniform("uSamples"), targets.samples);
         glProgramUniform1i(p.id(), p.uniform("uSupersample"), targets.supersample);
-        glProgramUniform3f(p.id(), p.uniform("uEnvironment"), view.environment.x(), view.environment.y(),
-                           view.environment.z());
+        // An environment map shows as its mean (render.environment_map).
+        const Vec3f env = view.meanEnvironment();
+        glProgramUniform3f(p.id(), p.uniform("uEnvironment"), env.x(), env.y(), env.z());
         glBindTextureUnit(0, targets.opaque);
         glBindTextureUnit(1, targets.accum);
         glBindTextureUnit(2, targets.reveal);

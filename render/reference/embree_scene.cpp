@@ -89,7 +89,10 @@ void skipOwnSurface(const RTCFilterFunctionNArguments* args) {
     const auto* q = reinterpret_cast<const IntersectQuery*>(args->context);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
-        if (RTCHitN_geomID(args->hit, args->N, i) != q->scene->hairGeom) continue;
+        if (RTCHitN_geomID(args->hit, args->N, i) != q->scene->hairGeom) {
+            if (q->start.throughHead) args->valid[i] = 0;  // as shadow rays: a ray from the head ignores it
+            continue;
+        }
         if (ownSurface(*q->scene, q->start, RTCHitN_primID(args->hit, args->N, i))) args->valid[i] = 0;
     }
 }
@@ -277,7 +280,7 @@ SceneHit EmbreeScene::intersect(const Vec3f& o, const Vec3f& d, float tnear, flo
     rtcInitIntersectContext(&q.context);
     q.scene = impl_.get();
     q.start = start;
-    if (start.strand != kNoStrand) q.context.filter = skipOwnSurface;
+    if (start.strand != kNoStrand || start.throughHead) q.context.filter = skipOwnSurface;
 
     RTCRayHit rh = embree::rayHit(o, d, tnear, tfar);
     rtcIntersect1(impl_->scene, &q.context, &rh);

@@ -67,7 +67,9 @@ struct SceneHit {
 struct RayStart {
     uint32_t strand = kNoStrand;  ///< starting strand, kNoStrand for camera rays and the head
     uint32_t segment = 0;
-    /// Shadow rays leaving the head pass through it: the head casts no shadow
+    /// Rays leaving the head (shadow rays, and the physical mode's search
+    /// for lights along a bounce, which must agree with them for multiple
+    /// importance sampling) pass through it: the head casts no shadow
     /// on itself. A low-poly head's flat triangles would otherwise cut its
     /// smooth shading into a staircase along the terminator (the "shadow
     /// terminator" problem); its own shading (n·l) darkens the far side.

@@ -106,6 +106,8 @@ class HairBsdf {
     /// Scattering kernel S(wo, wi) (1/sr); `lobes`, if given, receives the
     /// four lobes' parts (R, TT, TRT, residual) that sum to the result.
     Vec3f eval(const Vec3f& wo, const Vec3f& wi, Vec3f* lobes = nullptr) const;
+    /// eval() and pdf() in one pass (what multiple importance sampling needs).
+    Vec3f eval(const Vec3f& wo, const Vec3f& wi, Vec3f* lobes, float* pdf) const { return evaluate(wo, wi, lobes, pdf); }
     /// Solid-angle density of sample() producing wi.
     float pdf(const Vec3f& wo, const Vec3f& wi) const;
     /// Picks a lobe by its attenuation (u0.x), samples Np (u0.y) and Mp (u1).

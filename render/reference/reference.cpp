@@ -202,7 +202,9 @@ Image ReferenceRenderer::render(const View& shotView, const StrandFrame* strands
 
     const auto t1 = Clock::now();
     const std::clock_t c1 = std::clock();
-    const ShadingContext ctx{scene, view, settings, HairModel(settings.fiber)};
+    std::vector<SampledLight> lights(view.lights.begin(), view.lights.end());
+    const ShadingContext ctx{scene, view, settings, HairModel(settings.fiber), std::move(lights),
+                             EnvironmentLight(view.environment, view.environmentMap)};
     Film film(view.camera.width, view.camera.height, settings, view.camera.farClip);
     const int ts = settings.tileSize;
     const int tilesX = (film.width + ts - 1) / ts, tilesY = (film.height + ts - 1) / ts;

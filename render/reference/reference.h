@@ -8,11 +8,16 @@
 //   crossing, the same parameter the preview's voxel shadows derive from). Any difference
 //   to the preview is then visibility, shadows and anti-aliasing, not shading.
 // - physical: a path tracer with Chiang et al.'s hair BSDF (render/reference/hair_bsdf.h)
-//   and a Lambertian head; shadow rays see hair as opaque because light that
+//   and the head's energy-conserving skinShade (render/view/view.h); shadow rays see hair as opaque because light that
 //   passes through strands is carried by the BSDF's transmission lobes.
 //   Shadow rays of light samples with a small unshadowed contribution are
 //   traced by Russian roulette (ReferenceSettings::shadowRouletteThreshold):
-//   unbiased, and most of dark hair's shadow rays are skipped.
+//   unbiased, and most of dark hair's shadow rays are skipped. Every light
+//   casts shadows (ReferenceSettings::unshadowedLights); lights with size
+//   (render/reference/light_sampling.h) and the environment
+//   (render/reference/environment_light.h) are sampled both ways and combined
+//   by multiple importance sampling; paths end by Russian roulette from the
+//   second bounce on.
 //
 // Sampling: each pixel is the mean of its own samples, placed by filter
 // importance sampling (render/reference/pixel_filter.h). With a noise
@@ -42,6 +47,19 @@ namespace hp {
 
 enum class ReferenceMode { KajiyaKay, Physical };
 
+/// Physical mode: what a light with Light::castsShadows == false does.
+/// - Shadowed (default, unbiased): the flag is a preview convenience and is
+///   ignored; every light casts shadows and lights every bounce.
+/// - FirstHit (biased): such a light lights only the camera-visible hit,
+///   unshadowed, and never a point reached after a bounce (so it cannot add
+///   its energy twice or light deep TT / skin paths); it is light-sampled only.
+enum class UnshadowedLights { Shadowed, FirstHit };
+
+/// Physical mode: how direct light from lights with size and the environment
+/// is estimated. Mis (default) combines light and BSDF sampling with the
+/// power heuristic; the other two exist to test that all three agree.
+enum class LightStrategy { Mis, LightOnly, BsdfOnly };
+
 /// "kajiya-kay" / "physical".
 const char* referenceModeName(ReferenceMode mode);
 
@@ -65,6 +83,8 @@ struct ReferenceSettings {
     int frame = 0;               ///< part of the random sequence, so frames decorrelate
     bool shadows = true;
     HairFiberParams fiber;           ///< physical mode
+    UnshadowedLights unshadowedLights = UnshadowedLights::Shadowed;
+    LightStrategy lightStrategy = LightStrategy::Mis;
     /// physical: light samples whose unshadowed contribution is below this
     /// fraction of the light's radiance (max over RGB of path throughput ×
     /// BSDF, 1/sr) trace their shadow ray by Russian roulette (unbiased,

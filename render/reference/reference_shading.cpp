@@ -1,52 +1,17 @@
 #include "render/reference/reference_shading.h"
 
+#include "render/reference/vertex_bsdf.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace hp {
 
 namespace {
 
-constexpr float kInvPi = float(1.0 / M_PI);
 constexpr float kInf = std::numeric_limits<float>::infinity();
-
-/// Offset off the head's surface for rays leaving it: far above float error
-/// at head scale, far below a hair radius.
-/// Shadow rays from the head see hair only (RayStart::throughHead says why).
-const RayStart kFromHead{kNoStrand, 0, true};
-
-float surfaceOffset(const Vec3f& p) { return 4e-6f * (1.f + p.cwiseAbs().maxCoeff()); }
-
-/// Local frame of a fibre hit: x along the tangent, z the viewer's direction
-/// projected into the normal plane, y = z × x (render/reference/hair_bsdf.h).
-struct FiberFrame {
-    Vec3f x, y, z;
-    Vec3f toLocal(const Vec3f& w) const { return {w.dot(x), w.dot(y), w.dot(z)}; }
-    Vec3f toWorld(const Vec3f& w) const { return w.x() * x + w.y() * y + w.z() * z; }
-};
-
-FiberFrame fiberFrame(const Vec3f& tangent, const Vec3f& wo) {
-    FiberFrame f;
-    f.x = tangent;
-    Vec3f perp = wo - wo.dot(tangent) * tangent;
-    if (perp.squaredNorm() < 1e-12f) {
-        Vec3f b2;
-        sampling::orthonormalBasis(tangent, &perp, &b2);
-    }
-    f.z = perp.normalized();
-    f.y = f.z.cross(f.x);
-    return f;
-}
-
-/// h = sin γo: the hit's offset across the fibre, from the tube's surface
-/// normal projected into the normal plane (y component; see hair_bsdf.h).
-float fiberOffset(const FiberFrame& f, const Vec3f& ng) {
-    Vec3f n = ng - ng.dot(f.x) * f.x;
-    const float len = n.norm();
-    if (len < 1e-6f) return 0.f;
-    return std::clamp(n.dot(f.y) / len, -1.f, 1.f);
-}
 
 /// Fraction of the light toward direction l (distance `distance`) that
 /// reaches p: 1 without shadows.
@@ -59,21 +24,28 @@ float visibility(const ShadingContext& ctx, const Vec3f& p, const Vec3f& l, floa
 }
 
 /// Shadow-ray Russian roulette of the physical mode: a light sample whose
-/// unshadowed contribution β·S·L is small next to the light's own radiance L
-/// (max over RGB of β·S below `threshold`, in 1/sr) traces its shadow ray only
-/// with probability q = max(β·S)/threshold and, when traced, counts 1/q
-/// times. E[visibility · [traced] / q] = E[visibility], so the estimate stays
+/// unshadowed contribution C is small next to the light's own scale E (the
+/// irradiance a delta light of its intensity gives; max over RGB of C / E
+/// below `threshold`, in 1/sr) traces its shadow ray only with probability
+/// q = max(C/E)/threshold and, when traced, counts 1/q times.
+/// E[visibility · [traced] / q] = E[visibility], so the estimate stays
 /// unbiased; the extra noise is at most of the order of the threshold times
 /// the small contributions themselves. Dark hair makes most light samples
 /// small (its BSDF lobes are narrow and absorbing): at brown hair and the
-/// default threshold about 80% of the shadow rays are skipped.
+/// default threshold about 80% of the shadow rays are skipped. Only samples
+/// that would trace a shadow ray take part.
 /// Returns the weight 1/q, or 0 when the shadow ray is skipped.
-float shadowRoulette(const Vec3f& throughput, float threshold, float u) {
-    const float c = throughput.maxCoeff();
+float shadowRoulette(float c, float threshold, float u) {
     if (!(c > 0.f)) return 0.f;
     if (!(threshold > 0.f) || c >= threshold) return 1.f;
     const float q = c / threshold;
     return u < q ? 1.f / q : 0.f;
+}
+
+/// Veach's power heuristic (β = 2) for the technique of density a against b.
+float powerHeuristic(float a, float b) {
+    const float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0.f ? a2 / (a2 + b2) : 0.f;
 }
 
 /// Light leaving `light` toward p, with shadowing. `start` lets the shadow
@@ -89,12 +61,15 @@ Vec3f incident(const ShadingContext& ctx, const Light& light, const Vec3f& p, fl
 
 // ------------------------------------------------------------ kajiya-kay --
 
+/// The preview's picture: lights as the preview approximates them
+/// (Light::toLight), castsShadows honoured, the environment as its mean.
 SampleResult shadeKajiyaKay(const ShadingContext& ctx, const Vec3f& o, const Vec3f& d, const SceneHit& hit) {
     SampleResult r;
     const View& view = ctx.view;
     const float T = view.hair.transmittance;
     const Vec3f p = o + hit.t * d;
     const Vec3f v = -d;
+    const Vec3f ambient = view.meanEnvironment();
     Vec3f l;
     if (hit.kind == SceneHit::Kind::Hair) {
         const CurvePoint cp = ctx.scene.curvePoint(hit.segment, hit.u);
@@ -111,14 +86,14 @@ SampleResult shadeKajiyaKay(const ShadingContext& ctx, const Vec3f& o, const Vec
             r.specular += specular.cwiseProduct(radiance);
         }
         // A constant environment lights hair as an ambient diffuse term.
-        r.diffuse += view.environment.cwiseProduct(view.hair.color) * view.hair.kd;
+        r.diffuse += ambient.cwiseProduct(view.hair.color) * view.hair.kd;
     } else {
         Vec3f n = ctx.scene.headShadingNormal(hit.triangle, hit.b1, hit.b2);
         Vec3f ng = hit.ng;
         if (ng.dot(v) < 0.f) ng = -ng;
         if (n.dot(ng) < 0.f) n = -n;
         const Vec3f q = p + surfaceOffset(p) * ng;
-        r.diffuse = view.head.color.cwiseProduct(Vec3f::Constant(view.head.ambient) + view.environment);
+        r.diffuse = view.head.color.cwiseProduct(Vec3f::Constant(view.head.ambient) + ambient);
         for (const Light& light : view.lights) {
             Vec3f radiance;
             l = light.toLight(q, &radiance, nullptr);
@@ -133,99 +108,164 @@ SampleResult shadeKajiyaKay(const ShadingContext& ctx, const Vec3f& o, const Vec
 
 // -------------------------------------------------------------- physical --
 
+/// One path of the physical mode. At each vertex: next-event estimation of
+/// every light and of the environment (light sampling), then one BSDF
+/// sample that continues the path and, where it meets a light with size or
+/// escapes to the environment, adds their radiance. Both estimates of the
+/// same light are weighted by the power heuristic (Veach and Guibas 1995),
+/// so together they count it once; delta lights are light-sampled only.
 SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit hit,
                            sampling::PixelSampler& sampler) {
     SampleResult r;
-    const View& view = ctx.view;
+    const ReferenceSettings& s = ctx.settings;
+    const EnvironmentLight& env = ctx.environment;
+    const bool firstHitOnly = s.unshadowedLights == UnshadowedLights::FirstHit;
+    const bool lightSampling = s.lightStrategy != LightStrategy::BsdfOnly;
+    const bool bsdfSampling = s.lightStrategy != LightStrategy::LightOnly;
+    // A constant sky is gathered by BSDF sampling alone: light-sampling it
+    // (nearly uniform directions) cost a shadow ray per vertex for 3% less
+    // noise on the default shot, a loss at equal time. A map is sampled
+    // both ways.
+    const bool skyLightSampling = lightSampling && env.hasMap();
+    const bool skyBsdfSampling = bsdfSampling || !env.hasMap();
+    // Lights that only the first hit sees (first-hit option) are light-sampled only.
+    auto firstHitLight = [&](const SampledLight& l) { return firstHitOnly && !l.light().castsShadows; };
+    // Is there anything a BSDF ray past the last bounce could still find?
+    bool hittable = false;
+    for (const SampledLight& l : ctx.lights) hittable = hittable || (!l.delta() && !firstHitLight(l));
+    hittable = (hittable && bsdfSampling) || (env.active() && skyBsdfSampling);
     Vec3f beta = Vec3f::Ones();
-    Vec3f l;
-    // Past the last bounce one more BSDF-sampled ray still gathers the
-    // environment (its direct light), when there is one.
-    const bool environment = view.environment.maxCoeff() > 0.f;
     for (int bounce = 0;; ++bounce) {
-        const bool last = bounce >= ctx.settings.bounces;
+        const bool last = bounce >= s.bounces;
         const Vec3f p = o + hit.t * d;
         const Vec3f wo = -d;
-        Vec3f nextDir;
+        Vec3f origin = p;
         RayStart start;
-        Vec3f nextOrigin = p;
+        const bool onHead = hit.kind == SceneHit::Kind::Head;
+        Vec3f headNg = Vec3f::Zero();
+        std::optional<HairBsdf> hairBsdf;
+        VertexBsdf bsdf(ctx.view.head, Vec3f::UnitZ(), wo);
         if (hit.kind == SceneHit::Kind::Hair) {
             const CurvePoint cp = ctx.scene.curvePoint(hit.segment, hit.u);
             const FiberFrame frame = fiberFrame(cp.tangent, wo);
-            const HairBsdf bsdf(ctx.hair, fiberOffset(frame, hit.ng));
-            const Vec3f woL = frame.toLocal(wo);
+            hairBsdf.emplace(ctx.hair, fiberOffset(frame, hit.ng));
+            bsdf = VertexBsdf(*hairBsdf, frame, wo);
             start = RayStart{hit.strand, hit.segment};
-            for (const Light& light : view.lights) {
-                const float u = sampler.nextSide();
-                Vec3f radiance;
-                float distance;
-                l = light.toLight(p, &radiance, &distance);
-                if (radiance.maxCoeff() <= 0.f) continue;
-                Vec3f lobes[HairModel::kLobes];
-                const Vec3f f = bsdf.eval(woL, frame.toLocal(l), lobes);
-                const float weight = shadowRoulette(beta.cwiseProduct(f), ctx.settings.shadowRouletteThreshold, u);
-                if (weight <= 0.f) continue;
-                if (light.castsShadows) radiance *= visibility(ctx, p, l, distance, 0.f, start, &r.rays);
-                radiance *= weight;
-                r.radiance += beta.cwiseProduct(f).cwiseProduct(radiance);
-                if (bounce == 0) r.specular += lobes[0].cwiseProduct(radiance);
-            }
-            if (last && !environment) break;
-            const Vec2f u0 = sampler.next2D(), u1 = sampler.next2D();
-            const HairSample s = bsdf.sample(woL, u0, u1);
-            if (!s.valid) break;
-            beta = beta.cwiseProduct(s.weight);
-            nextDir = frame.toWorld(s.wi).normalized();
         } else {
             Vec3f n = ctx.scene.headShadingNormal(hit.triangle, hit.b1, hit.b2);
             Vec3f ng = hit.ng;
             if (ng.dot(wo) < 0.f) ng = -ng;
             if (n.dot(ng) < 0.f) n = -n;
-            nextOrigin = p + surfaceOffset(p) * ng;
-            const Vec3f albedo = view.head.color;
-            for (const Light& light : view.lights) {
-                const float u = sampler.nextSide();
-                Vec3f radiance;
-                float distance;
-                l = light.toLight(nextOrigin, &radiance, &distance);
-                if (radiance.maxCoeff() <= 0.f) continue;
-                // The head's material with the cosine, as S is for hair; over π
-                // for a Lambert part that conserves energy (render/view/view.h).
-                const Vec3f f = skinShade(view.head, n, l, wo) * kInvPi;
-                if (f.maxCoeff() <= 0.f) continue;
-                const float weight = shadowRoulette(beta.cwiseProduct(f), ctx.settings.shadowRouletteThreshold, u);
-                if (weight <= 0.f) continue;
-                if (light.castsShadows) radiance *= visibility(ctx, nextOrigin, l, distance, 0.f, kFromHead, &r.rays);
-                radiance *= weight;
-                r.radiance += beta.cwiseProduct(f).cwiseProduct(radiance);
-            }
-            if (last && !environment) break;
-            Vec3f b1, b2;
-            sampling::orthonormalBasis(n, &b1, &b2);
-            const Vec3f w = sampling::cosineHemisphere(sampler.next2D());
-            nextDir = (w.x() * b1 + w.y() * b2 + w.z() * n).normalized();
-            if (nextDir.dot(ng) <= 0.f) break;
-            beta = beta.cwiseProduct(albedo);  // (albedo/π · cos) / (cos/π)
+            origin = p + surfaceOffset(p) * ng;
+            headNg = ng;
+            bsdf = VertexBsdf(ctx.view.head, n, wo);
+            start = kFromHead;
         }
-        // Russian roulette: continue with probability max(β) (≤ 1) and
-        // reweight, which is unbiased and stops the many paths that dark
-        // hair has already absorbed.
-        if (!last) {
+
+        // Light sampling: one sample per light, then the environment.
+        for (const SampledLight& light : ctx.lights) {
+            const float u = sampler.nextSide();
+            const Vec2f ul = sampler.next2D();
+            const bool firstHit = firstHitLight(light);
+            if (firstHit && bounce > 0) continue;  // never after a bounce
+            if (!light.delta() && !lightSampling && !firstHit) continue;
+            const LightSample ls = light.sample(origin, ul);
+            if (!ls.valid) continue;
+            float pdfB = 0.f;
+            Vec3f spec;
+            const Vec3f f = bsdf.eval(ls.wi, &pdfB, &spec);
+            if (!(f.maxCoeff() > 0.f)) continue;
+            // Delta lights give irradiance; lights with size radiance / pdf.
+            Vec3f li = ls.radiance;
+            if (!light.delta()) li *= (firstHit || !bsdfSampling ? 1.f : powerHeuristic(ls.pdf, pdfB)) / ls.pdf;
+            Vec3f c = beta.cwiseProduct(f).cwiseProduct(li);
+            if (!firstHit && s.shadows) {  // roulette only where a shadow ray would be traced
+                const float w = shadowRoulette(c.maxCoeff() / light.scale(origin), s.shadowRouletteThreshold, u);
+                if (w <= 0.f) continue;
+                li *= w * visibility(ctx, origin, ls.wi, ls.distance, 0.f, start, &r.rays);
+                c = beta.cwiseProduct(f).cwiseProduct(li);
+            }
+            r.radiance += c;
+            if (bounce == 0) r.specular += spec.cwiseProduct(li);
+        }
+        if (env.active()) {
+            const Vec2f ue = sampler.next2D();
+            const LightSample ls = skyLightSampling ? env.sample(ue) : LightSample{};
+            float pdfB = 0.f;
+            Vec3f spec;
+            const Vec3f f = ls.valid ? bsdf.eval(ls.wi, &pdfB, &spec) : Vec3f::Zero();
+            if (f.maxCoeff() > 0.f) {
+                Vec3f li = ls.radiance * ((skyBsdfSampling ? powerHeuristic(ls.pdf, pdfB) : 1.f) / ls.pdf);
+                li *= visibility(ctx, origin, ls.wi, kInf, 0.f, start, &r.rays);
+                r.radiance += beta.cwiseProduct(f).cwiseProduct(li);
+                if (bounce == 0) r.specular += spec.cwiseProduct(li);
+            }
+        }
+        if (last && !hittable) break;
+
+        // BSDF sampling: the path's next direction.
+        const Vec2f u0 = sampler.next2D(), u1 = sampler.next2D();
+        const VertexSample bs = bsdf.sample(u0, u1);
+        if (!bs.valid) break;
+        beta = beta.cwiseProduct(bs.weight);
+        // Russian roulette from the second bounce on (as pbrt-v4: the first
+        // bounces carry most of the picture and cost little): continue with
+        // probability max(β) (≤ 1) and reweight, which is unbiased and stops
+        // the many paths that dark hair has already absorbed.
+        if (!last && bounce >= 1) {
             const float survive = std::min(1.f, beta.maxCoeff());
+            const float ur = sampler.next1D();
             if (survive < 1.f) {
-                if (!(sampler.next1D() < survive)) break;
+                if (!(ur < survive)) break;
                 beta /= survive;
             }
         }
-        o = nextOrigin;
-        d = nextDir;
-        ++r.rays;
-        hit = ctx.scene.intersect(o, d, 0.f, kInf, start);
-        if (hit.kind == SceneHit::Kind::None) {
-            r.radiance += beta.cwiseProduct(view.environment);
-            break;
+        o = origin;
+        d = bs.wi;
+        // The path goes on with the head opaque: a bounce off the skin must
+        // not see hair through the neck. A direction into the head's surface
+        // (the wrap lobe past the terminator) ends it.
+        const bool intoHead = onHead && !(d.dot(headNg) > 0.f);
+        SceneHit next;
+        if (!intoHead) {
+            ++r.rays;
+            next = ctx.scene.intersect(o, d, 0.f, kInf, onHead ? RayStart{} : start);
         }
-        if (last) break;
+        if (bsdfSampling || skyBsdfSampling) {
+            // The lights and sky this ray reaches, seen as the light samples'
+            // shadow rays see them (hair blocks; from the head, the head does
+            // not), so that both estimates of each light agree for MIS.
+            float tLight = next.kind == SceneHit::Kind::None ? kInf : next.t;
+            if (onHead && (intoHead || next.kind == SceneHit::Kind::Head)) {
+                ++r.rays;
+                const SceneHit hair = ctx.scene.intersect(o, d, 0.f, kInf, kFromHead);
+                tLight = hair.kind == SceneHit::Kind::None ? kInf : hair.t;
+            }
+            if (!s.shadows) tLight = kInf;
+            Vec3f found = Vec3f::Zero();
+            for (const SampledLight& light : ctx.lights) {
+                if (firstHitLight(light) || !bsdfSampling) continue;
+                Vec3f le;
+                float pdfL;
+                if (light.hit(o, d, tLight, &le, &pdfL))
+                    found += le * (lightSampling ? powerHeuristic(bs.pdf, pdfL) : 1.f);
+            }
+            if (env.active() && skyBsdfSampling && std::isinf(tLight))
+                found += env.radiance(d) * (skyLightSampling ? powerHeuristic(bs.pdf, env.pdf(d)) : 1.f);
+            if (found.maxCoeff() > 0.f) {
+                r.radiance += beta.cwiseProduct(found);
+                if (bounce == 0 && s.diffuseSpecularLayers) {
+                    // The R lobe's share of what this direction brought.
+                    float pdfB;
+                    Vec3f spec;
+                    const Vec3f f = bsdf.eval(d, &pdfB, &spec);
+                    for (int c = 0; c < 3; ++c)
+                        if (f[c] > 0.f) r.specular[c] += beta[c] * found[c] * spec[c] / f[c];
+                }
+            }
+        }
+        hit = next;
+        if (intoHead || hit.kind == SceneHit::Kind::None || last) break;
     }
     r.diffuse = r.radiance - r.specular;
     return r;
@@ -237,7 +277,9 @@ SampleResult shadeSample(const ShadingContext& ctx, const Vec3f& origin, const V
                          sampling::PixelSampler& sampler) {
     SampleResult r;
     if (hit.kind == SceneHit::Kind::None) {
-        r.radiance = r.diffuse = ctx.view.environment;
+        // The sky seen: the map itself in physical mode, its mean in the preview's.
+        r.radiance = r.diffuse = ctx.settings.mode == ReferenceMode::Physical ? ctx.environment.radiance(dir)
+                                                                                : ctx.view.meanEnvironment();
         r.rays = 1;
         return r;
     }

@@ -3,7 +3,9 @@
 #pragma once
 
 #include "render/reference/embree_scene.h"
+#include "render/reference/environment_light.h"
 #include "render/reference/hair_bsdf.h"
+#include "render/reference/light_sampling.h"
 #include "render/reference/reference.h"
 #include "render/reference/sampling.h"
 
@@ -15,6 +17,8 @@ struct ShadingContext {
     const View& view;
     const ReferenceSettings& settings;
     HairModel hair;
+    std::vector<SampledLight> lights;  ///< view.lights in world space, prepared for sampling
+    EnvironmentLight environment;      ///< view.environment plus view.environmentMap
 };
 
 /// What one camera sample saw.

@@ -49,6 +49,7 @@ Vec3f Light::toLight(const Vec3f& p, Vec3f* radiance, float* distance) const {
         if (distance) *distance = std::numeric_limits<float>::infinity();
         return -direction.normalized();
     }
+    // Point, and quad/disk as a point of the same intensity at the centre.
     const Vec3f d = position - p;
     const float r2 = std::max(d.squaredNorm(), 1e-8f);
     if (radiance) *radiance = color * (intensity / r2);
@@ -64,6 +65,7 @@ std::vector<Light> View::worldLights() const {
     for (Light& l : out) {
         if (!l.cameraRelative) continue;
         l.direction = l.direction.x() * right + l.direction.y() * up + l.direction.z() * back;
+        l.up = l.up.x() * right + l.up.y() * up + l.up.z() * back;
         l.position = camera.target + l.position.x() * right + l.position.y() * up + l.position.z() * back;
         l.cameraRelative = false;
     }
@@ -86,10 +88,20 @@ std::vector<Light> threePointRig() {
 }
 
 Vec3f skinShade(const SurfaceMaterial& m, const Vec3f& n, const Vec3f& l, const Vec3f& v) {
+    constexpr float kInvPi = float(1.0 / M_PI);
     const float c = n.dot(l);
     const float w = std::max(m.wrap, 0.f);
-    Vec3f f = m.color * std::max(0.f, (c + w) / (1.f + w));
-    if (c > 0.f && m.specular > 0.f) f += Vec3f::Constant(m.specular * std::pow(std::max(0.f, n.dot((l + v).normalized())), m.shininess));
+    const float ks = std::clamp(m.specular, 0.f, 1.f);
+    Vec3f f = m.color * ((1.f - ks) * std::max(0.f, c + w) * kInvPi / ((1.f + w) * (1.f + w)));
+    if (c > 0.f && ks > 0.f) {
+        const float s = m.shininess;
+        const float nh = std::max(0.f, n.dot((l + v).normalized()));
+        // Exact normalisation of Blinn-Phong with the cosine (Giesen 2009),
+        // (s + 2)(s + 4) / (8π (2^(−s/2) + s)): reflects exactly 1 seen head
+        // on and less elsewhere; (s + 8)/(8π) overshoots it by up to 5%.
+        const float norm = (s + 2.f) * (s + 4.f) * (0.125f * kInvPi) / (std::exp2(-0.5f * s) + s);
+        f += Vec3f::Constant(ks * norm * std::pow(nh, s) * c);
+    }
     return f;
 }
 

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -58,25 +59,64 @@ class CameraRays {
     float width_, height_;
 };
 
-enum class LightType { Directional, Point };
+/// Directional: a distant light (the sun), a delta direction or, with an
+/// angle, a cone of directions. Point: a delta point. Quad and disk: one-sided
+/// area lights at `position`, emitting toward `direction`.
+enum class LightType { Directional, Point, Quad, Disk };
 
 struct Light {
     LightType type = LightType::Directional;
-    Vec3f direction{-1.f, -1.f, -1.f};  ///< directional: the way the light travels (normalised on use)
-    Vec3f position{0.f, 1.f, 1.f};      ///< point lights
+    Vec3f direction{-1.f, -1.f, -1.f};  ///< directional: the way the light travels; quad/disk: the way it faces (normalised on use)
+    Vec3f position{0.f, 1.f, 1.f};      ///< point lights and the centre of quad/disk lights
     Vec3f color{1.f, 1.f, 1.f};
-    float intensity = 3.f;              ///< radiance scale (directional) or power/(4π) (point)
+    /// What `intensity` means, chosen so that a light's size never changes
+    /// how bright it is:
+    /// - directional: irradiance on a surface facing it (delta or with angle:
+    ///   a cone of half-angle α has radiance intensity / (π sin²α));
+    /// - point: radiant intensity (irradiance intensity / r² at distance r);
+    /// - quad/disk: radiant intensity along the normal (radiance = intensity /
+    ///   area, a Lambertian emitter: far away it is a point light of the same
+    ///   intensity in front of it, times the cosine off its normal).
+    float intensity = 3.f;
+    float angle = 0.f;            ///< directional: angular diameter in degrees (0 = a delta direction)
+    Vec2f size{0.1f, 0.1f};       ///< quad: width × height (m); disk: diameter = size.x()
+    /// Quad: the edge of height size.y() lies in the plane of `up` and the
+    /// normal (its width is horizontal for up = +y).
+    Vec3f up{0.f, 1.f, 0.f};
     /// Whether the light is blocked by hair and head. The preview shadows one
     /// light (PreviewShadowSettings::light); the rig's fill and rim lights are
-    /// unshadowed in both renderers, so the two stay the same picture.
+    /// unshadowed in the preview and the Kajiya-Kay reference, so the two stay
+    /// the same picture. The physical reference shadows every light unless
+    /// ReferenceSettings::unshadowedLights says otherwise.
     bool castsShadows = true;
-    /// Direction and position are given in the camera's frame (x right, y up,
-    /// z toward the viewer; positions relative to the camera target), so a
+    /// Direction, up and position are given in the camera's frame (x right, y
+    /// up, z toward the viewer; positions relative to the camera target), so a
     /// rig follows any camera. View::worldLights() resolves them.
     bool cameraRelative = false;
 
-    /// Unit vector from `p` toward the light, and the light's radiance at `p`.
+    bool isDelta() const { return type == LightType::Point || (type == LightType::Directional && !(angle > 0.f)); }
+    /// Unit vector from `p` toward the light, and the light's radiance at `p`
+    /// (irradiance factor: multiply by a BRDF × cosine). Lights with size are
+    /// approximated the way the preview draws them: a directional light with
+    /// an angle as its delta direction, quad and disk as a point light of the
+    /// same intensity at their centre (the physical reference samples their
+    /// true shape, render/reference/light_sampling.h).
     Vec3f toLight(const Vec3f& p, Vec3f* radiance, float* distance) const;
+};
+
+/// An HDR lat-long environment image (equirectangular: column u is the
+/// azimuth φ = 2π u − π, φ = 0 looking down −z and φ = π/2 toward +x; row v
+/// the polar angle θ = π v from +y at the top row), scaled and turned about
+/// +y. Read by loadEnvironmentMap (render/reference/environment_light.h).
+struct EnvironmentMap {
+    std::string path;                                 ///< the file, for messages
+    int width = 0, height = 0;
+    std::shared_ptr<const std::vector<float>> rgb;    ///< width × height × 3 linear radiance, top row first
+    float intensity = 1.f;
+    float rotationDegrees = 0.f;                      ///< about +y: the map turns by this angle (right-handed)
+    Vec3f mean = Vec3f::Zero();                       ///< intensity × the solid-angle mean radiance
+
+    bool empty() const { return !rgb || width <= 0 || height <= 0; }
 };
 
 /// Kajiya-Kay hair material. The preview's GLSL (shaders/) mirrors kajiyaKay().
@@ -105,17 +145,29 @@ struct HairMaterial {
 struct SurfaceMaterial {
     Vec3f color{0.75f, 0.6f, 0.5f};
     float ambient = 0.05f;
-    /// Light wrapping past the terminator, (n·l + w) / (1 + w): the soft
-    /// falloff light scattered under skin gives (0 = Lambert).
+    /// Light wrapping past the terminator, max(0, n·l + w), normalised: the
+    /// soft falloff light scattered under skin gives (0 = Lambert).
     float wrap = 0.f;
-    float specular = 0.f;    ///< Blinn-Phong weight of the oily sheen (untinted)
+    float specular = 0.f;    ///< share ks of the normalised Blinn-Phong sheen (untinted); the diffuse keeps 1 − ks
     float shininess = 30.f;  ///< its exponent
 };
 
-/// Reflected radiance factor of the head material for unit normal n, light
-/// direction l and view direction v, without the ambient term: albedo ·
-/// max(0, (n·l + w)/(1 + w)) + specular · (n·h)^shininess · [n·l > 0].
-/// Multiply by the light's radiance. shaders/head.frag mirrors it.
+/// The head material's BRDF times the cosine, f(l, v)·cos, for unit normal n,
+/// light direction l and view direction v, without the ambient term; multiply
+/// by the light's irradiance (delta light) or radiance (over a solid angle).
+/// Energy-conserving, so a path tracer can use it as it is:
+///   (1 − ks) · albedo · max(0, n·l + w) / (π (1 + w)²)         wrapped Lambert
+///   + ks · N(s) · (n·h)^s · max(0, n·l)                        normalised Blinn-Phong
+///   N(s) = (s + 2)(s + 4) / (8π (2^(−s/2) + s))
+/// with w the wrap, ks the specular weight, s the shininess, h = (l + v)/|l + v|.
+/// The wrapped Lambert integrates to albedo over the directions n·l > −w
+/// (∫ (c + w) dω = π (1 + w)²); N(s) makes the sheen reflect exactly 1 seen
+/// head on and less at other angles (Giesen 2009, "Derivation of Phong and
+/// Blinn-Phong BRDF normalization factors"; the popular (s + 8)/(8π) of
+/// Akenine-Möller, Haines and Hoffman, "Real-Time Rendering", 3rd ed. 2008,
+/// approximates it from above, by up to 5%), so the reflected fraction never
+/// exceeds (1 − ks)·albedo + ks ≤ 1.
+/// shaders/head.frag mirrors it.
 Vec3f skinShade(const SurfaceMaterial& m, const Vec3f& n, const Vec3f& l, const Vec3f& v);
 
 /// Everything a renderer needs about the shot besides geometry.
@@ -123,11 +175,15 @@ struct View {
     Camera camera;
     std::vector<Light> lights{Light{}};
     Vec3f environment{0.f, 0.f, 0.f};  ///< constant environment radiance (black by default)
+    EnvironmentMap environmentMap;     ///< added to `environment` where it has an image
     HairMaterial hair;
     SurfaceMaterial head;
 
     /// The lights in world space: camera-relative ones turned by the camera.
     std::vector<Light> worldLights() const;
+    /// The environment as one constant: the colour plus the map's mean (what
+    /// the preview and the Kajiya-Kay reference use).
+    Vec3f meanEnvironment() const { return environment + environmentMap.mean; }
 };
 
 /// The default three-point rig (camera-relative, so it follows the camera):
