@@ -125,14 +125,14 @@ TEST(CurlyWet, HangingDryCurlStretchesWithoutPreload) {
         }
         s.bendSmoothing = CurlyWetSettings{}.bendSmoothing;
 
-        // The seed's springs on the same real hair's weight hold the curl:
+        // Kim 2023's springs on the same real hair's weight hold the curl:
         // the check above can fail.
         CurlyWetSettings seed = CurlyWetSettings::seedSprings();
         seed.preload = false;
         seed.particles = particles;
         seed.massPerLength = float(mu);
         const Hang held = hangOneCurl(seed);
-        std::printf("  the seed's springs: pitch %.2f -> %.2f mm\n", 1e3f * held.rest.y(), 1e3f * held.hung.y());
+        std::printf("  Kim 2023's springs: pitch %.2f -> %.2f mm\n", 1e3f * held.rest.y(), 1e3f * held.hung.y());
         EXPECT_LT(held.hung.y() / held.rest.y() - 1.0, 0.1 * expected);
     }
 }
