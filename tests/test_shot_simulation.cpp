@@ -9,6 +9,7 @@
 #include <tbb/global_control.h>
 
 #include <cstring>
+#include <limits>
 
 using namespace hp;
 namespace fs = std::filesystem;
@@ -38,6 +39,7 @@ TEST(ShotSimulation, DefaultClipKeepsLengthsRootsAndClearance) {
     ASSERT_EQ(sim.followerCount(), 600u);
     const float segment = float(scene.number("hair.guides.length") / scene.integer("hair.guides.segments"));
     double worstLength = 0, deepest = 0, worstRoot = 0;
+    float extent = 0.f;  // largest coordinate magnitude of a guide vertex
     for (int frame = 2; frame <= 84; frame += 2) {
         const StrandFrame& f = sim.advanceTo(frame);
         ASSERT_NO_THROW(f.validate());
@@ -49,12 +51,18 @@ TEST(ShotSimulation, DefaultClipKeepsLengthsRootsAndClearance) {
             for (uint32_t v = f.first(s) + 1; v < f.first(s) + f.vertexCount(s); ++v) {
                 const float len = (f.positions[v] - f.positions[v - 1]).norm();
                 worstLength = std::max(worstLength, double(std::abs(len / segment - 1.f)));
+                extent = std::max(extent, f.positions[v].cwiseAbs().maxCoeff());
                 deepest = std::max(deepest, double(-exact.signedDistance(f.positions[v])));
             }
             worstRoot = std::max(worstRoot, double(exact.signedDistance(f.positions[f.first(s)])));
         }
     }
-    EXPECT_LE(worstLength, 0.001) << "segment length error over the clip (issue 4: <= 0.1%)";
+    // The rod places every vertex at its rest length (the goal was 0.1%):
+    // what is left is float rounding, a couple of ulps of the coordinates
+    // (up to `extent`) over a segment. Measured 2.0e-6; the bound is ~1e-5.
+    RecordProperty("worst_length_error_e9", int(worstLength * 1e9));
+    EXPECT_LE(worstLength, 2.0 * std::numeric_limits<float>::epsilon() * extent / segment)
+        << "segment length error over the clip";
     EXPECT_LE(deepest, 0.001) << "deepest guide vertex inside the head over the default clip (goal: none deeper than 1 mm)";
     EXPECT_LE(worstRoot, 1e-5 * 0.3) << "roots ride the deformed surface";
 }
