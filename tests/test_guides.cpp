@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 using namespace hp;
@@ -265,14 +266,19 @@ TEST(Guides, StableOverTenThousandStepsWithATeleport) {
     };
     HeadPose pose = poseAt(0);
     solver.initialize(sphereRootFrames(dirs, 0.1f, pose), pose);
-    double peak = 0;
+    double peak = 0, worstLength = 0;
     int resets = 0;
+    // Lengths are exact up to float rounding: a couple of ulps of the
+    // coordinates (up to |offset| + R + L = 2.35 m after the cut) over a
+    // segment, 5e-5 (measured 2.5e-5; the bound was 1e-3).
+    const double lengthBound = 2.0 * std::numeric_limits<float>::epsilon() * (2.0 + 0.1 + s.length) / (s.length / s.segments);
     for (int k = 1; k <= 10000; ++k) {
         if (k == 5000) offset.translation() = Vec3f(2.f, 0.5f, -1.f);  // a scene cut
         pose = poseAt(k);
         const StepStats& st = solver.step(sphereRootFrames(dirs, 0.1f, pose), pose);
         ASSERT_EQ(st.nanCount, 0u) << "step " << k;
-        ASSERT_LE(st.maxLengthError, 1e-3) << "step " << k;
+        ASSERT_LE(st.maxLengthError, lengthBound) << "step " << k;
+        worstLength = std::max(worstLength, st.maxLengthError);
         ASSERT_LE(st.maxPenetration, 1e-3) << "step " << k << " pinned " << st.pinnedCount;
         if (st.reset) {
             ++resets;
@@ -283,6 +289,7 @@ TEST(Guides, StableOverTenThousandStepsWithATeleport) {
     }
     EXPECT_EQ(resets, 1);
     RecordProperty("peak_uj", int(peak * 1e6));
+    RecordProperty("worst_length_error_e9", int(worstLength * 1e9));
     // Bounded: never more than the guides (the rod's μ = N·ρ·πr²) could take
     // from the head and gravity: turning rigidly at 180°/s out to R + L, plus
     // every guide falling from straight up to straight down (its centre by
