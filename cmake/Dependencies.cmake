@@ -1,6 +1,6 @@
 # Every third-party library comes from Debian 12 packages (see README,
-# "Dependencies"); nothing is vendored or downloaded. Facts behind the
-# workarounds below are in ../shared/STACK.md of the development workspace.
+# "Dependencies"); nothing is vendored or downloaded. Each workaround below
+# says the fact behind it beside it.
 find_package(PkgConfig REQUIRED)
 find_package(ZLIB REQUIRED)
 

@@ -1,11 +1,11 @@
-// The test oracle for Kajiya-Kay shading, written from seed 004's equations
+// The test oracle for Kajiya-Kay shading, written from the equations of Dehlin and Styngberg 2017
 // and not from render/view/view.cpp, so the renderers' shading is checked against
 // the paper rather than against itself:
 //   diffuse  = kd · sin(t, l) · colour
 //   specular = ks · sin(t', h)^α · specular colour,  h = (l + v)/|l + v|,
 // where sin(a, b) = |a × b| for unit vectors, and t' is the tangent tilted
 // along the view-facing normal n by the lobe's shift (Scheuermann's two-lobe
-// variant: t' = (t + shift·n)/|t + shift·n|; shift 0 is the seed's single
+// variant: t' = (t + shift·n)/|t + shift·n|; shift 0 is Dehlin and Styngberg 2017's single
 // lobe). A second lobe, when on, adds its own ks, exponent, shift and colour.
 #pragma once
 

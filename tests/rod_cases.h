@@ -138,10 +138,12 @@ struct Cantilever {
     std::vector<Vec3f> positions;  ///< final state, for determinism checks
 };
 
-/// A strand clamped horizontally (5 copies, groups of 2 so threads share
-/// the work), settled with drag for 6 s; its tip against the elastica.
-inline Cantilever cantilever(double beta, int threads) {
+/// A strand of `segments` segments clamped horizontally (5 copies, groups
+/// of 2 so threads share the work), settled with drag for 6 s; its tip
+/// against the elastica.
+inline Cantilever cantilever(double beta, int threads, int segments = 23) {
     GuideSettings s = rodSettings(0.f, 4.f, false);
+    s.segments = segments;
     s.youngsModulus = youngsFor(s, beta);
     s.threads = threads;
     s.strandsPerWorld = 2;

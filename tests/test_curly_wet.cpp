@@ -80,7 +80,7 @@ TEST(CurlyWet, RestShapeIsCurlyAndHoldsStill) {
 }
 
 TEST(CurlyWet, CurlRadiusAndPitchSurviveABouncingHead) {
-    // The seed's springs, set explicitly (hair.curly.*_stiffness given):
+    // Kim 2023's springs, set explicitly (hair.curly.*_stiffness given):
     // they hold curls against a 1.8 g bounce. The material's, like real
     // ringlets, stretch; test_curly_hang.cpp checks their stiffness against
     // the coil spring's.
@@ -232,7 +232,7 @@ TEST(CurlyWet, AdhesionHoldsWetHairOnTheHeadAndLetsDryHairGo) {
 }
 
 TEST(CurlyWet, StableUnderFastRotationWithCohesion) {
-    // Seed Fig. 5-6: wet curly hair with cohesion on a head spinning fast.
+    // Kim 2023 Fig. 5-6: wet curly hair with cohesion on a head spinning fast.
     CurlyWetSettings s;
     s.saturation = 1.f;
     CurlyWetSolver solver(s);
@@ -399,7 +399,7 @@ hair:
     EXPECT_EQ(s.particles, 16);
     EXPECT_FLOAT_EQ(s.curlRadius, 0.006f);
     EXPECT_FLOAT_EQ(s.curlPitch, 0.02f);
-    EXPECT_FLOAT_EQ(s.bendStiffness, 12.f);  // given: the seed's spring model
+    EXPECT_FLOAT_EQ(s.bendStiffness, 12.f);  // given: Kim 2023's spring model
     EXPECT_EQ(s.iterations, 5);
     // Not given: from hair.material and hair.radius.root, as for the rod.
     EXPECT_LT(s.coreStiffness, 0.f);
@@ -417,7 +417,7 @@ hair:
     EXPECT_FLOAT_EQ(s.saturationRoot, 0.3f);
     EXPECT_FALSE(s.cohesion);
     EXPECT_FLOAT_EQ(s.adhesionWeight, 2000.f);
-    // The seed's constants are the defaults.
+    // Kim 2023's constants are the defaults.
     EXPECT_FLOAT_EQ(s.cohesionTightness, 0.85f);
     EXPECT_FLOAT_EQ(s.globalStiffness, 0.999995f);
     EXPECT_FLOAT_EQ(s.wetStiffness, 0.9999f);

@@ -51,7 +51,9 @@ class LocalSlurm {
     }
     bool started() const { return !conf_.empty(); }
     /// slurm-local's exit 3: the host cannot run slurmd (a cgroup plugin
-    /// that does not initialise even with the plugins that need none).
+    /// that does not initialise even with the plugins that need none, or a
+    /// host name Slurm had to resolve and could not), with the cause in
+    /// output(). slurm-local gives up within SLURM_LOCAL_WAIT (30 s).
     bool hostCannot() const { return hostCannot_; }
     const std::string& output() const { return output_; }
     std::string logs() const { return readFile(state_ / "log/slurmctld.log") + readFile(state_ / "log/slurmd.log"); }

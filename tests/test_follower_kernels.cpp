@@ -15,7 +15,7 @@ using namespace hp;
 // Kernels
 
 TEST(FollowerKernels, FixedOffsetIsZeroAtRootAndTipAndOneInTheMiddle) {
-    // The seed: 23 segments, qs = 23 / 2 = 11 in integer arithmetic = (23 - 1) / 2.
+    // Gomes 2024: 23 segments, qs = 23 / 2 = 11 in integer arithmetic = (23 - 1) / 2.
     EXPECT_EQ(follower::fixedOffsetCurve(0, 23), 0.f);
     EXPECT_EQ(follower::fixedOffsetCurve(22, 23), 0.f);  // y = 2 qs, the tip segment
     EXPECT_EQ(follower::fixedOffsetCurve(11, 23), 1.f);

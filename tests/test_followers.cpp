@@ -479,7 +479,7 @@ TEST(Followers, InPlaceAppendEqualsSeparateOutput) {
 
 TEST(Followers, CollisionLeavesNoVertexInsideTheHead) {
     // Guides lie over the head and differ a lot between neighbours at the
-    // crown, so interpolated followers cut into the head (the seed's Fig. 5.4).
+    // crown, so interpolated followers cut into the head (Gomes 2024's Fig. 5.4).
     const hp::test::SphereScene scene(94, 2000, 0.7);
     const FollowerGroom& groom = scene.groom;
     const StrandFrame& guides = scene.guides;

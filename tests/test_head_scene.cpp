@@ -215,7 +215,7 @@ TEST(Scalp, SelectionModesOnTheDefaultHead) {
     s.mask = dir / "missing.png";
     EXPECT_THROW(selectScalp(rig, rest, s), AssetError);
 
-    // A region: the seed's partial sphere, here the upper hemisphere about the skull centre.
+    // A region: Gomes 2024's partial sphere, here the upper hemisphere about the skull centre.
     s.method = ScalpMethod::Region;
     s.center = Vec3f(0, 0.015f, -0.01f);
     s.axis = Vec3f::UnitY();

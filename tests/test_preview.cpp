@@ -315,7 +315,7 @@ std::vector<float> cpuVoxelize(const std::vector<std::pair<Vec3f, Vec3f>>& lines
 }
 
 /// The summed voxel grid the GPU shades with equals a CPU voxelization summed
-/// along the same light rays: transmittance alpha^C per voxel, for the seed's
+/// along the same light rays: transmittance alpha^C per voxel, for Dehlin and Styngberg 2017's
 /// three voxelization modes.
 // With preview.shadow.weight: crossings (the default) the additive grid holds
 // expected strand crossings of a light ray: summed over the grid and times a
@@ -384,7 +384,7 @@ TEST(Preview, VoxelTransmittanceMatchesCpuVoxelization) {
                                std::pair{VoxelMode::Additive, VoxelSplat::Trilinear}}) {
         PreviewSettings s;
         s.shadow.resolution = res;
-        s.shadow.weight = VoxelWeight::Fragments;  // the seed's count, which cpuVoxelize mirrors
+        s.shadow.weight = VoxelWeight::Fragments;  // Dehlin and Styngberg 2017's count, which cpuVoxelize mirrors
         s.shadow.alpha = alpha;
         s.shadow.mode = mode;
         s.shadow.splat = splat;

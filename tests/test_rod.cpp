@@ -5,17 +5,42 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 using namespace hp;
 using namespace hp::rodcases;
 
-TEST(Rod, HeavyElasticaTipMatchesShootingWithinTwoPercentOfLength) {
+namespace {
+
+/// The lengths are exact up to float rounding: the last pass places each
+/// vertex at its rest length from the previous one, in coordinates of size
+/// up to L, so a segment of L/n can be off by a couple of ulps of L:
+/// 2·ε·n (5.5e-6 for 23 segments; measured ≤ 1.5e-6).
+double lengthBound(int segments) { return 2.0 * std::numeric_limits<float>::epsilon() * segments; }
+
+}  // namespace
+
+TEST(Rod, HeavyElasticaTipMatchesShootingToTheChainsDiscretisation) {
+    // The 23-segment chain against the continuous elastica: a second-order
+    // discretisation's error is of the order (l/L)² = 1/23² = 1.9e-3 of L
+    // (measured: 1.0e-4 at β = 0.5 up to 2.1e-3 at β = 128); the bound is
+    // 1.5 times that scale. Where the error is largest (β ≥ 32) it is
+    // discretisation: 46 segments more than halve it (measured 0.46, 0.35;
+    // second order would give 0.25, a wrong stiffness ~1).
+    const double scale = 1.0 / (23.0 * 23.0);
     for (double beta : {0.5, 2.0, 8.0, 32.0, 128.0}) {
         const Cantilever one = cantilever(beta, 1), two = cantilever(beta, 2);
         RecordProperty("tip_error_beta_" + std::to_string(beta), std::to_string(one.error));
-        EXPECT_LE(one.error, 0.02f) << "β = " << beta;
-        EXPECT_LE(one.maxStretch, 1e-3) << "β = " << beta;
+        EXPECT_LE(one.error, 1.5 * scale) << "β = " << beta;
+        EXPECT_LE(one.maxStretch, lengthBound(23)) << "β = " << beta;
         EXPECT_LT(one.kineticEnergy, 1e-9) << "not at rest, β = " << beta;
         EXPECT_EQ(one.positions, two.positions) << "1 and 2 threads differ, β = " << beta;
+        if (beta >= 32) {
+            const Cantilever fine = cantilever(beta, 1, 46);
+            RecordProperty("tip_error_46_beta_" + std::to_string(beta), std::to_string(fine.error));
+            EXPECT_LT(fine.error, 0.6 * one.error) << "β = " << beta << ": refining does not converge";
+        }
     }
 }
 
@@ -23,16 +48,27 @@ TEST(Rod, HangingChainFirstModePeriodMatchesBessel) {
     const Pendulum p = pendulum();
     RecordProperty("pendulum_period_error", std::to_string(p.error));
     ASSERT_GE(p.crossings, 6u) << "the tip should swing through the vertical";
+    // Measured 2.87% (the 23-link chain and its integrator against the
+    // continuous chain); the bound was already this close.
     EXPECT_LE(p.error, 0.03) << "period " << p.period << " s, chain " << p.reference << " s";
-    EXPECT_LE(p.maxStretch, 1e-3);
+    EXPECT_LE(p.maxStretch, lengthBound(23));
 }
 
 TEST(Rod, ReleasedFromHorizontalNeverGainsEnergyAndComesToRestWithDrag) {
     const Energy e = energy();
-    RecordProperty("energy_drift", std::to_string(e.drift));
-    EXPECT_LE(e.drift, 0.01);
-    EXPECT_LT(e.dampedKinetic, 1e-6);
-    EXPECT_LE(e.maxStretch, 1e-3);
+    RecordProperty("energy_drift_e9", std::to_string(e.drift * 1e9));
+    RecordProperty("damped_kinetic_e12", std::to_string(e.dampedKinetic * 1e12));
+    // Without drag the total energy never rises above its start (measured:
+    // not at all; XPBD's implicit step only dissipates). The bound is the
+    // float resolution of the positions it is computed from, ~10 ε.
+    EXPECT_LE(e.drift, 1e-6);
+    // With drag c = 1/s the energy in play, at most the μgL²/2 a limp strand
+    // releases from horizontal, decays at least as e^(-c·t) (v *= e^(-c·h)
+    // each step; the integrator and bending only take more): after 5 s,
+    // 1.3e-6 J. Measured 1.6e-8 J.
+    const double released = material(rodSettings(3.8e9f, 1.f, false)).massPerLength() * kG * kLength * kLength / 2;
+    EXPECT_LT(e.dampedKinetic, released * std::exp(-1.0 * 5.0));
+    EXPECT_LE(e.maxStretch, lengthBound(23));
 }
 
 TEST(Rod, PreloadHoldsTheGroomAndWithoutItHairHangs) {
@@ -51,7 +87,7 @@ TEST(Rod, PreloadHoldsTheGroomAndWithoutItHairHangs) {
     for (size_t i = 0; i < x.size(); ++i) moved = std::max(moved, (f.positions[i] - x[i]).norm());
     RecordProperty("preload_motion_um", std::to_string(moved * 1e6f));
     EXPECT_LE(moved, 1e-3f) << "the pre-loaded groom moved " << moved * 1000 << " mm in 1 s";
-    EXPECT_LE(held.worst.maxLengthError, 1e-3);
+    EXPECT_LE(held.worst.maxLengthError, lengthBound(s.segments));
 
     s.preload = false;
     Strand hangs(s, x);

@@ -83,7 +83,7 @@ TEST(Roots, FibonacciGivesTheExactCountOnTheScalpOnly) {
 
 TEST(Roots, FibonacciOnASphereMatchesTheSeedLattice) {
     // On a sphere about its centre the projection is radial, so root i is
-    // the seed's Fibonacci cap point i (the lattice size may differ by one
+    // Gomes 2024's Fibonacci cap point i (the lattice size may differ by one
     // where a point falls exactly on the scalp's edge: Δ ≤ 2i/n²).
     const SphereScalp s;
     RootSettings rs;

@@ -110,6 +110,25 @@ TEST(Scene, SetOverridesAreTypedAndValidated) {
     EXPECT_NE(malformed.detail().find("key.path=value"), std::string::npos);
 }
 
+TEST(Scene, EmptySetValueIsTheEmptyStringForTextKeys) {
+    // "--set reference.png=" turns the PNG off (the key's doc: empty writes
+    // none); before, YAML read the empty value as null, "has no value".
+    const Scene s = Scene::parse("reference: {png: out.png}\n", "shot.yaml", ".", {"reference.png=", "cache.usd= "});
+    EXPECT_EQ(s.text("reference.png"), "");
+    EXPECT_TRUE(s.given("reference.png"));
+    EXPECT_EQ(s.where("reference.png").file, "--set reference.png=");
+    EXPECT_EQ(s.text("cache.usd"), "") << "blanks only are empty too";
+    EXPECT_EQ(Scene::parse("", "shot.yaml", ".", {"reference.png=\"\""}).text("reference.png"), "")
+        << "the quoted spelling still works";
+    // A file key without a file is "none" unless the key is required.
+    EXPECT_TRUE(Scene::parse("", "shot.yaml", ".", {"hair.groom.file="}).file("hair.groom.file").empty());
+    // Keys that are not text still need a value.
+    for (const char* set : {"fps=", "render.camera.width=", "render.exposure=", "simulation.preload="}) {
+        const SceneError e = parseError("", {set});
+        EXPECT_NE(e.detail().find("has no value"), std::string::npos) << set << ": " << e.what();
+    }
+}
+
 TEST(Scene, FileKeysMustExist) {
     test::TempDir dir;
     test::writeFile(dir / "scene.yaml", "output:\n  directory: out\n");
@@ -142,9 +161,38 @@ TEST(Schema, EveryKeyIsDocumented) {
     }
 }
 
-TEST(Schema, DefaultsAreValid) {
-    // Every default must pass its own validation (an empty scene uses them all).
-    EXPECT_NO_THROW(Scene::parse("", "empty.yaml", "."));
+TEST(Schema, DefaultsAreValidAndFillAnEmptyScene) {
+    // Every default must pass its own validation (an empty scene uses them
+    // all), and every key of an empty scene must read back as its schema
+    // default, marked as not given: the same value a --set of the default's
+    // text gives (keys inside list items are checked by SceneLists).
+    const Scene empty = Scene::parse("", "empty.yaml", ".");
+    size_t checked = 0;
+    for (const KeySpec& k : Schema::scene().keys()) {
+        if (k.type == KeyType::List || k.path.find("[]") != std::string::npos) continue;
+        SCOPED_TRACE(k.path + " (default '" + k.defaultYaml + "')");
+        if (k.defaultYaml.empty()) {
+            EXPECT_FALSE(empty.has(k.path)) << "a key without default is absent";
+            continue;
+        }
+        ASSERT_TRUE(empty.has(k.path));
+        EXPECT_FALSE(empty.given(k.path));
+        const Scene set = Scene::parse("", "set.yaml", ".", {k.path + "=" + k.defaultYaml});
+        ASSERT_TRUE(set.given(k.path));
+        switch (k.type) {
+        case KeyType::Bool: EXPECT_EQ(empty.flag(k.path), set.flag(k.path)); break;
+        case KeyType::Int: EXPECT_EQ(empty.integer(k.path), set.integer(k.path)); break;
+        case KeyType::Float: EXPECT_EQ(empty.number(k.path), set.number(k.path)); break;
+        case KeyType::String:
+        case KeyType::Enum: EXPECT_EQ(empty.text(k.path), set.text(k.path)); break;
+        case KeyType::Vec3: EXPECT_EQ(empty.vec3(k.path), set.vec3(k.path)); break;
+        case KeyType::FrameRange: EXPECT_EQ(empty.frames(k.path), set.frames(k.path)); break;
+        case KeyType::Curve: EXPECT_EQ(empty.curve(k.path).keys, set.curve(k.path).keys); break;
+        default: continue;  // files resolve against different folders in a file and on the command line
+        }
+        ++checked;
+    }
+    EXPECT_GT(checked, 100u) << "the schema's keys were walked";
 }
 
 TEST(Schema, ReferencePageIsUpToDate) {

@@ -9,6 +9,7 @@
 #include <tbb/global_control.h>
 
 #include <cstring>
+#include <limits>
 
 using namespace hp;
 namespace fs = std::filesystem;
@@ -38,6 +39,7 @@ TEST(ShotSimulation, DefaultClipKeepsLengthsRootsAndClearance) {
     ASSERT_EQ(sim.followerCount(), 600u);
     const float segment = float(scene.number("hair.guides.length") / scene.integer("hair.guides.segments"));
     double worstLength = 0, deepest = 0, worstRoot = 0;
+    float extent = 0.f;  // largest coordinate magnitude of a guide vertex
     for (int frame = 2; frame <= 84; frame += 2) {
         const StrandFrame& f = sim.advanceTo(frame);
         ASSERT_NO_THROW(f.validate());
@@ -49,33 +51,103 @@ TEST(ShotSimulation, DefaultClipKeepsLengthsRootsAndClearance) {
             for (uint32_t v = f.first(s) + 1; v < f.first(s) + f.vertexCount(s); ++v) {
                 const float len = (f.positions[v] - f.positions[v - 1]).norm();
                 worstLength = std::max(worstLength, double(std::abs(len / segment - 1.f)));
+                extent = std::max(extent, f.positions[v].cwiseAbs().maxCoeff());
                 deepest = std::max(deepest, double(-exact.signedDistance(f.positions[v])));
             }
             worstRoot = std::max(worstRoot, double(exact.signedDistance(f.positions[f.first(s)])));
         }
     }
-    EXPECT_LE(worstLength, 0.001) << "segment length error over the clip (issue 4: <= 0.1%)";
+    // The rod places every vertex at its rest length (the goal was 0.1%):
+    // what is left is float rounding, a couple of ulps of the coordinates
+    // (up to `extent`) over a segment. Measured 2.0e-6; the bound is ~1e-5.
+    RecordProperty("worst_length_error_e9", int(worstLength * 1e9));
+    EXPECT_LE(worstLength, 2.0 * std::numeric_limits<float>::epsilon() * extent / segment)
+        << "segment length error over the clip";
     EXPECT_LE(deepest, 0.001) << "deepest guide vertex inside the head over the default clip (goal: none deeper than 1 mm)";
     EXPECT_LE(worstRoot, 1e-5 * 0.3) << "roots ride the deformed surface";
 }
 
-TEST(ShotSimulation, HairHangsAndMovesWithTheHead) {
-    const Scene scene = smallDefaultScene();
+namespace {
+
+/// Guide vertices of `f` in the head's rest frame (the pose's rigid part undone).
+std::vector<Vec3f> guidesInHeadFrame(const StrandFrame& f, const HeadPose& pose) {
+    const Eigen::Isometry3f toHead = pose.transform.inverse();
+    std::vector<Vec3f> out;
+    for (size_t s = 0; s < f.guideCount; ++s)
+        for (uint32_t v = f.first(s); v < f.first(s) + f.vertexCount(s); ++v) out.push_back(toHead * f.positions[v]);
+    return out;
+}
+
+float largestDistance(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b) {
+    float d = 0.f;
+    for (size_t i = 0; i < a.size(); ++i) d = std::max(d, (a[i] - b[i]).norm());
+    return d;
+}
+
+}  // namespace
+
+TEST(ShotSimulation, HairHangsUnderGravityAndSwingsWithTheHead) {
+    const Scene scene = smallDefaultScene({"frames=1-120"});
+    const float length = float(scene.number("hair.guides.length"));
+    // Hangs: the settled, pre-loaded groom is an equilibrium under gravity.
+    // On a head held still (clip_speed 0) it stays where it is; without the
+    // pre-load the same groom sags, so the test can tell the two apart.
+    auto drift = [&](const char* preload) {
+        ShotSimulation still(smallDefaultScene({"head.clip_speed=0", std::string("simulation.preload=") + preload}),
+                             24.0, 1);
+        const std::vector<Vec3f> at1 = guidesInHeadFrame(still.advanceTo(1), still.pose());
+        return largestDistance(at1, guidesInHeadFrame(still.advanceTo(24), still.pose()));
+    };
+    const float held = drift("true"), sagged = drift("false");
+    RecordProperty("still_head_drift_um", int(held * 1e6f));
+    RecordProperty("no_preload_sag_um", int(sagged * 1e6f));
+    // Held: less than the clearance the solver keeps from the head
+    // (hair.guides.collision_radius, 1 mm; measured 0.30 mm). Sagged: the
+    // unbalanced weight bends the groom by centimetres (measured 55 mm).
+    const float clearance = float(scene.number("hair.guides.collision_radius"));
+    EXPECT_LT(held, clearance) << "pre-loaded hair on a still head, 1 s";
+    EXPECT_GT(sagged, 10.f * clearance) << "without the pre-load the groom sags under gravity";
+    // And it hangs: the guides' tips are, on average, more than half their
+    // length below their roots (measured 0.71 L; a groom standing up or
+    // lying flat would be at ≤ 0).
     ShotSimulation sim(scene, 24.0, 1);
-    const StrandFrame first = sim.advanceTo(1);
-    // The combed groom holds still at the first frame (pre-loaded springs).
-    const StrandFrame second = sim.advanceTo(2);
-    double moved = 0;
-    for (size_t v = 0; v < first.positions.size(); ++v)
-        moved = std::max(moved, double((first.positions[v] - second.positions[v]).norm()));
-    // The clip starts nodding at once, so the hair moves, but by millimetres, not a collapse.
-    EXPECT_LT(moved, 0.02) << "largest vertex motion in the first frame";
-    // During the clip the strands move with the head.
-    double maxSpeed = 0;
-    for (int frame = 3; frame <= 84; ++frame)
-        for (const Vec3f& v : sim.advanceTo(frame).velocities) maxSpeed = std::max(maxSpeed, double(v.norm()));
-    EXPECT_GT(maxSpeed, 0.2) << "strands move with the head";
-    EXPECT_LT(maxSpeed, 20.0) << "no explosion";
+    const StrandFrame& first = sim.advanceTo(1);
+    const Vec3f down = Vec3f(scene.vec3f("simulation.gravity")).normalized();
+    double meanDrop = 0;
+    for (size_t s = 0; s < first.guideCount; ++s) {
+        const Vec3f rootToTip = first.positions[first.first(s) + first.vertexCount(s) - 1] - first.positions[first.first(s)];
+        meanDrop += rootToTip.dot(down) / double(first.guideCount);
+    }
+    RecordProperty("mean_tip_drop_mm", int(meanDrop * 1e3));
+    EXPECT_GT(meanDrop, 0.5 * length) << "the tips hang below the roots";
+
+    // Swings with the head: in the head's frame the hair lags behind the
+    // nods, shakes and the turn (a rigid copy of the head would not move
+    // there at all): the fast turn (375°/s) sweeps the tips by more than
+    // half their length (measured 1.4 L). The clip holds still from 2.85 s
+    // (frame 70) on, and the drag (3/s on velocity) damps a free swing as
+    // e^(-3t/2): at frame 120, 2.1 s later, e^-3.1 ≈ 4.5% of its speed is
+    // left; hair still sliding off the head and shoulders adds to that
+    // (measured 6.8%), so the bound is 10%.
+    const std::vector<Vec3f> rest = guidesInHeadFrame(first, sim.pose());
+    float swing = 0.f, peakSpeed = 0.f;
+    auto guideSpeed = [](const StrandFrame& f) {
+        float v = 0.f;
+        for (uint32_t i = 0; i < f.offsets[f.guideCount]; ++i) v = std::max(v, f.velocities[i].norm());
+        return v;
+    };
+    for (int frame = 2; frame <= 70; ++frame) {
+        const StrandFrame& f = sim.advanceTo(frame);
+        peakSpeed = std::max(peakSpeed, guideSpeed(f));
+        swing = std::max(swing, largestDistance(rest, guidesInHeadFrame(f, sim.pose())));
+    }
+    const float endSpeed = guideSpeed(sim.advanceTo(120));
+    RecordProperty("swing_mm", int(swing * 1e3f));
+    RecordProperty("peak_speed_mm_s", int(peakSpeed * 1e3f));
+    RecordProperty("end_speed_mm_s", int(endSpeed * 1e3f));
+    EXPECT_GT(swing, 0.5f * length) << "the hair swings relative to the head";
+    EXPECT_LT(swing, 2.f * length) << "within its own reach, no explosion";
+    EXPECT_LT(endSpeed, 0.1f * peakSpeed) << "and comes to rest once the head holds still";
 }
 
 TEST(ShotSimulation, IdenticalForOneAndTwoThreads) {

@@ -7,6 +7,7 @@
 #include "sim/strands/fibonacci.h"
 #include "sim/strands/sphere_roots.h"
 #include "sim/guides/guides.h"
+#include "sim/guides/rod_kernels.h"
 
 #include <gtest/gtest.h>
 
@@ -53,10 +54,23 @@ TEST(SimGuards, LongViolentRunStaysBoundedAndFinite) {
     HeadPose pose = shaken(0.0);
     solver.initialize(roots(dirs, pose), pose);
     // A strand swung rigidly with the head moves at most
-    // ω·(r + L) + v_head = 18.8·0.35 + 1.9 ≈ 8.5 m/s; allow 3× that.
-    const float speedBound = 3.f * 8.5f;
-    const double mass = double(dirs.size()) * s.massPerLength * s.length;
-    const double energyBound = 0.5 * mass * speedBound * speedBound;
+    // ω·(r + L) + v_head = 18.8·0.35 + 1.9 ≈ 8.5 m/s. A whip's tip outruns
+    // the rigid swing (measured: 10.7 m/s, 1.26×); 2× is a blow-up.
+    const float speedBound = 2.f * 8.5f;
+    // Energy: the guides' kinetic energy if they swung rigidly with the head
+    // at its peak rates, Σ ∫ ½μ(ω·r + v_head)² dr over r ∈ [R, R + L], with
+    // the rod's own μ = N·ρ·πr² (sim/guides/rod_kernels.h), not the rope's
+    // simulation.mass_per_length (0.005 kg/m, 7.7× the rod's μ). Measured
+    // peak: 0.57 of it (14.5 mJ of 25.7 mJ): the strands do not all swing at
+    // the head's peak rates at once.
+    rod::Material m;
+    m.youngs = s.youngsModulus;
+    m.density = s.density;
+    m.radius = s.rootRadius;
+    m.hairsPerGuide = s.hairsPerGuide;
+    const double mu = m.massPerLength(), omega = 2 * M_PI * 3 * 1.0, vHead = 2 * M_PI * 6 * 0.05;
+    const auto cube = [&](double r) { return std::pow(omega * r + vHead, 3) / (3 * omega); };
+    const double rigidEnergy = double(dirs.size()) * 0.5 * mu * (cube(kRadius + s.length) - cube(kRadius));
     double peakEnergy = 0;
     float peakSpeed = 0;
     StrandFrame f;
@@ -76,8 +90,9 @@ TEST(SimGuards, LongViolentRunStaysBoundedAndFinite) {
     RecordProperty("peak_speed_mm_per_s", int(peakSpeed * 1000));
     RecordProperty("peak_energy_uj", int(peakEnergy * 1e6));
     EXPECT_LT(peakSpeed, speedBound);
-    EXPECT_LT(peakEnergy, energyBound);
-    EXPECT_GT(peakEnergy, 1e-4) << "the shaking moved the hair";
+    RecordProperty("peak_energy_over_rigid_e3", int(1000 * peakEnergy / rigidEnergy));
+    EXPECT_LT(peakEnergy, rigidEnergy) << "rigid swing: " << rigidEnergy << " J";
+    EXPECT_GT(peakEnergy, 0.1 * rigidEnergy) << "the shaking moved the hair";
 }
 
 TEST(SimGuards, VelocityClampHoldsSpeedsToTheLimit) {

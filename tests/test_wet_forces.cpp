@@ -29,7 +29,7 @@ float angleDeg(const Vec3f& a, const Vec3f& b) {
     return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.f / kPi;
 }
 
-// ---- IIR smoothing (seed eq. 2-3) ----------------------------------------------
+// ---- IIR smoothing (Kim 2023 eq. 2-3) ----------------------------------------------
 
 TEST(CurlyKernels, BetaFromSmoothingLength) {
     EXPECT_FLOAT_EQ(smoothingBeta(0.01f, 0.f), 1.f);
@@ -47,7 +47,7 @@ TEST(CurlyKernels, BetaOneReproducesTheInput) {
 }
 
 TEST(CurlyKernels, FirstSmoothedEdgeIsTheFirstEdgeAndLinesPassUnchanged) {
-    // d_0 = λ_1 - λ_0 for any β (the seed's initialisation), and the filter's
+    // d_0 = λ_1 - λ_0 for any β (Kim 2023's initialisation), and the filter's
     // gain at zero frequency is 1: a straight, evenly sampled line is a fixed point.
     std::vector<Vec3f> line(30), d(29);
     for (size_t i = 0; i < line.size(); ++i) line[i] = Vec3f(0.1f, 0.2f, -0.3f) + float(i) * Vec3f(0.003f, 0.01f, 0.f);
@@ -113,7 +113,7 @@ TEST(CurlyKernels, TransportedFramesAreRotationsThatFollowTheCurve) {
     for (size_t i = 0; i < F.size(); ++i) EXPECT_LT((Fq[i] - Q * F[i]).norm(), 1e-4f) << i;
 }
 
-// ---- Springs (seed eq. 1, 4, 5) -------------------------------------------------
+// ---- Springs (Kim 2023 eq. 1, 4, 5) -------------------------------------------------
 
 Mat3f numericJacobian(const std::function<Vec3f(const Vec3f&)>& f, const Vec3f& x) {
     Mat3f J;
@@ -311,7 +311,7 @@ TEST(CurlyKernels, HelixPointsAndFitRecoverRadiusAndPitch) {
     EXPECT_EQ(fitHelix(line.data(), line.size()).samples, 0u);
 }
 
-// ---- Wet effects (seed §2-5) -------------------------------------------------------
+// ---- Wet effects (Kim 2023 §2-5) -------------------------------------------------------
 
 TEST(WetForces, SaturationProfile) {
     EXPECT_FLOAT_EQ(saturationAt(0.5f, 1.f, 1.f, 0.3f), 0.5f);

@@ -6,7 +6,7 @@
 //   make_head OUT.glb [--rings N] [--sectors N] [--key-rate HZ]
 //   make_head OUT.glb --body             the shoulders under that head, with its
 //                                        neck and clips (scenes/assets/body.glb)
-//   make_head OUT.glb --sphere RADIUS    a static UV sphere, the seed's and
+//   make_head OUT.glb --sphere RADIUS    a static UV sphere, Gomes 2024's and
 //                                        the benchmarks' head (scenes/assets/sphere.glb)
 #include "core/errors.h"
 #include "pipeline/head/default_head.h"

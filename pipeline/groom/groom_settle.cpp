@@ -129,9 +129,14 @@ bool readSettledGroom(const fs::path& file, uint64_t key, SettledGroom& g) {
     return true;
 }
 
+double settleEnergy(const GuideSettings& settings, size_t guides, double restSpeed) {
+    const double mass = double(guides) * settings.guideMassPerLength() * double(settings.length);
+    return 0.5 * mass * restSpeed * restSpeed;
+}
+
 SettledGroom settleGroom(const GuideSettings& settings, const std::vector<SurfaceFrame>& roots, const HeadPose& pose,
                          const std::vector<std::vector<Vec3f>>* groom, double seconds, float stiffness,
-                         const SettleCache& cache, const std::string& sceneKeys) {
+                         double restSpeed, const SettleCache& cache, const std::string& sceneKeys) {
     const uint64_t key = settleKey(settings, roots, pose, groom, seconds, sceneKeys);
     SettledGroom g;
     if (!cache.file.empty() && cache.reuse && readSettledGroom(cache.file, key, g) && g.strands.size() == roots.size()) {
@@ -149,6 +154,7 @@ SettledGroom settleGroom(const GuideSettings& settings, const std::vector<Surfac
     solver.initialize(roots, pose, groom);
     HeadPose still = pose;  // the first frame's pose, held still
     const double start = solver.time();
+    const double atRest = settleEnergy(settings, roots.size(), restSpeed);
     // Converged only after a few steps: the first step starts from rest.
     constexpr int kMinSteps = 10;
     int steps = 0;
@@ -160,7 +166,7 @@ SettledGroom settleGroom(const GuideSettings& settings, const std::vector<Surfac
             throw FrameError(cat("settling the groom diverged after ", solver.time() - start, " s (", st.nanCount,
                                  " non-finite values); try a smaller simulation.time_step or hair.groom.settle: 0"));
         g.kineticEnergy = st.kineticEnergy;
-        if (steps >= kMinSteps && st.kineticEnergy < kSettledEnergy) {
+        if (steps >= kMinSteps && st.kineticEnergy < atRest) {
             g.converged = true;
             break;
         }
@@ -172,7 +178,7 @@ SettledGroom settleGroom(const GuideSettings& settings, const std::vector<Surfac
     for (size_t i = 0; i < g.strands.size(); ++i)
         g.strands[i].assign(frame.positions.begin() + frame.first(i), frame.positions.begin() + frame.first(i) + frame.vertexCount(i));
     logInfo("groom: settled for ", g.seconds, " s: ",
-            g.converged ? cat("at rest (kinetic energy ", g.kineticEnergy, " J < ", kSettledEnergy, " J)")
+            g.converged ? cat("at rest (kinetic energy ", g.kineticEnergy, " J < ", atRest, " J)")
                         : cat("time ran out (hair.groom.settle), kinetic energy still ", g.kineticEnergy, " J"));
     if (!cache.file.empty()) {
         fs::create_directories(cache.file.parent_path());

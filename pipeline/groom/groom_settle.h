@@ -2,8 +2,11 @@
 // without gravity (a bell of straight or combed strands). Before the first
 // frame it is simulated on the first frame's pose held still, with gravity
 // and head collisions, through the public GuideSolver interface (so any
-// formulation the scene configures), until its kinetic energy is below
-// kSettledEnergy or the time runs out. The shape it comes to rest in becomes
+// formulation the scene configures), until it is at rest or the time runs
+// out. At rest: the guides' RMS speed sqrt(2·E_kin/M) is below
+// hair.groom.settle_speed, i.e. E_kin < ½·M·v² with M = guides·μ·L their
+// mass (settleEnergy), a criterion that does not change with the groom's
+// size or hairs_per_guide. The shape it comes to rest in becomes
 // the rest shape the shot's solver is initialised with (its pre-load then
 // makes it the equilibrium), so hair lies on the head from frame 1.
 //
@@ -35,14 +38,17 @@
 
 namespace hp {
 
-inline constexpr double kSettledEnergy = 1e-6;  ///< J: below this the groom is at rest
 inline constexpr float kSettleDamping = 10.f;   ///< 1/s, at least, while settling
+
+/// The kinetic energy below which `guides` guides of `settings` are at
+/// rest: ½·M·v², M = guides·μ·L, v = `restSpeed` (RMS), J.
+double settleEnergy(const GuideSettings& settings, size_t guides, double restSpeed);
 
 struct SettledGroom {
     std::vector<std::vector<Vec3f>> strands;  ///< world space at the pose's time
     double seconds = 0.0;        ///< simulated
     double kineticEnergy = 0.0;  ///< J, at the end
-    bool converged = false;      ///< kinetic energy fell below kSettledEnergy (else the time ran out)
+    bool converged = false;      ///< kinetic energy fell below settleEnergy (else the time ran out)
     bool fromCache = false;
 };
 
@@ -60,12 +66,13 @@ uint64_t settleKey(const GuideSettings& settings, const std::vector<SurfaceFrame
 std::string settleSceneKeys(const Scene& scene);
 
 /// @brief Settles `groom` (null: straight along the root normals) on `pose`
-/// for at most `seconds`, springs scaled by `stiffness`, or reads it from `cache` when the key matches.
+/// for at most `seconds` or until at rest (RMS speed below `restSpeed`, m/s), springs scaled by
+/// `stiffness`, or reads it from `cache` when the key matches.
 /// Throws FrameError when the simulation diverges, IoError when the cache
 /// cannot be written.
 SettledGroom settleGroom(const GuideSettings& settings, const std::vector<SurfaceFrame>& roots, const HeadPose& pose,
                          const std::vector<std::vector<Vec3f>>* groom, double seconds, float stiffness,
-                         const SettleCache& cache, const std::string& sceneKeys);
+                         double restSpeed, const SettleCache& cache, const std::string& sceneKeys);
 
 /// Writes / reads the cache file (readSettledGroom: false when it is absent,
 /// of another key or version, or corrupt).

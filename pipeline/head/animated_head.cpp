@@ -14,14 +14,6 @@ namespace {
 /// rigid motion, and a few thousand points average a deforming surface well.
 constexpr size_t kMaxFitVertices = 4096;
 
-/// How far the colliders beside the head measure exactly (beyond: this, a
-/// lower bound). Hair needs exact distances only near contact; the head's
-/// own grid is exact only 6 mm out (head.collider.exterior_band). A mesh
-/// query gathers the triangles within this range of a vertex: 1 cm instead
-/// of 5 cut the default shot's frame from 670 to 170 ms (128 without the
-/// body) and left every strand bit for bit the same.
-constexpr float kWorldRange = 0.01f;
-
 std::vector<uint32_t> thinned(std::vector<uint32_t> v) {
     if (v.size() <= kMaxFitVertices) return v;
     std::vector<uint32_t> out;
@@ -175,7 +167,7 @@ HeadPose AnimatedHead::sample(double time) const {
             if (c.visible && !c.shape.triangles.empty()) addScenery(pose.scenery, c.shape, poses.back(), skins[i]);
         }
         pose.collider =
-            std::make_shared<CompositeCollider>(std::move(pose.collider), world_->posed(poses, kWorldRange, std::move(skins)));
+            std::make_shared<CompositeCollider>(std::move(pose.collider), world_->posed(poses, settings_.collidersBand, std::move(skins)));
     }
     return pose;
 }

@@ -51,6 +51,9 @@ struct HeadAnimationSettings {
     /// Colliders beside the head; the pose's collider joins them to the
     /// head's (CompositeCollider). Empty: the head's collider alone.
     std::vector<ExtraCollider> colliders;
+    /// How far the colliders beside the head measure exactly (beyond: a
+    /// lower bound), m (head.collider.colliders_band).
+    float collidersBand = 0.01f;
 };
 
 /// @brief A posed, animated head. sample() is thread-safe and deterministic.

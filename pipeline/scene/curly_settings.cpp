@@ -59,7 +59,7 @@ CurlyWetSettings curlyWetSettings(const Scene& scene) {
         {"hair.material.hairs_per_guide", &rod::Material::hairsPerGuide},
         {"hair.radius.root", &rod::Material::radius},
     });
-    // Mass and springs the scene gives are the seed's model; the others
+    // Mass and springs the scene gives are Kim 2023's model; the others
     // follow from the material (CurlyWetSettings::resolved).
     auto given = [&](const char* key) { return scene.given(key) ? float(scene.number(key)) : kFromMaterial; };
     s.massPerLength = given("hair.curly.mass_per_length");

@@ -39,7 +39,7 @@ PreviewSettings makePreviewSettings(const Scene& s) {
     if (sh.mode == VoxelMode::Binary && sh.splat == VoxelSplat::Trilinear)
         s.fail("preview.shadow.splat",
                "trilinear splatting spreads fractions of a fragment, which only adds up with voxel_mode: additive "
-               "(seed 004 compares nearest/binary, nearest/additive and trilinear/additive)");
+               "(Dehlin and Styngberg 2017 compare nearest/binary, nearest/additive and trilinear/additive)");
     sh.weight = s.text("preview.shadow.weight") == "fragments" ? VoxelWeight::Fragments : VoxelWeight::Crossings;
 
     GeneratedHairSettings& g = p.generated;

@@ -107,6 +107,14 @@ class SceneLoader {
             throw SceneError({origin.file}, key, "value is not valid YAML: " + e.msg);
         }
         const std::string norm = normalizeKeyPath(key);
+        // "key=" with nothing after it: YAML reads that as null ("has no
+        // value"), but on a command line it means the empty string, which a
+        // text key takes (--set reference.png= writes no PNG). Keys of other
+        // types still report that they have no value.
+        if (const KeySpec* spec = schema_.find(norm);
+            spec && (spec->type == KeyType::String || spec->type == KeyType::File) &&
+            text.find_first_not_of(" \t", eq + 1) == std::string::npos)
+            value = YAML::Node(std::string());
         if (!schema_.find(norm) && schema_.isSection(norm)) {
             if (!value.IsMap()) throw SceneError({origin.file}, key, "is a section: set one of its keys");
             walkMap(value, key, origin);

@@ -265,7 +265,8 @@ void ShotSimulation::initializeGuides(const GuideSettings& settings, const Impor
     }
     if (!imported && settle > 0) {
         SettledGroom s = settleGroom(settings, guideFrames_, pose_, shaped ? &strands : nullptr, settle,
-                                     float(scene_.number("hair.groom.settle_stiffness")), settleCache,
+                                     float(scene_.number("hair.groom.settle_stiffness")),
+                                     scene_.number("hair.groom.settle_speed"), settleCache,
                                      settleSceneKeys(scene_));
         strands = std::move(s.strands);
         shaped = true;

@@ -5,7 +5,7 @@
 // Time: the shot starts at the scene's first frame (frames.front() / fps),
 // whatever subset of frames a run asks for. Guides step at a fixed step: the
 // largest one not above the model's time step (simulation.time_step, 0.02 s
-// as in seed 000) that divides the frame interval, so every frame is a step's
+// as in Gomes 2024) that divides the frame interval, so every frame is a step's
 // end (0.02 s itself at 25 or 50 fps; three steps of 13.9 ms at 24 fps).
 // Writing a frame between two steps instead would interpolate each root
 // along the chord of its arc, off the turning scalp. The solvers' damping

@@ -112,8 +112,10 @@ std::unique_ptr<EglState> tryCandidate(const Candidate& c, std::string& why) {
     const char* ext = eglQueryString(display, EGL_EXTENSIONS);
     const bool surfaceless = hasExtension(ext, "EGL_KHR_surfaceless_context");
 
-    // Surfaceless platforms list configs only for pbuffers (see STACK.md); the
-    // colour format does not matter since all rendering goes to FBOs.
+    // Surfaceless platforms list configs only for pbuffers (Mesa's surfaceless
+    // EGL returns no config unless EGL_SURFACE_TYPE asks for EGL_PBUFFER_BIT;
+    // EGL_NO_CONFIG_KHR is the other way); the colour format does not matter
+    // since all rendering goes to FBOs.
     const EGLint configAttribs[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
     EGLConfig config = nullptr;
     EGLint configs = 0;

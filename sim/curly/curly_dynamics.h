@@ -1,5 +1,5 @@
-// One linearly implicit step of a curly strand (seed 001 / Iben et al.):
-// all of the seed's forces on one strand, assembled into a block-tridiagonal
+// One linearly implicit step of a curly strand (Kim 2023 / Iben et al. 2013):
+// all of Kim 2023's forces on one strand, assembled into a block-tridiagonal
 // system and solved for the velocity change. Plain C++ and Eigen, no physics
 // world: the solver (sim/curly/curly_world.cpp) hands the result to Bullet as node
 // forces, and Bullet integrates and solves the inextensible links.
@@ -51,7 +51,7 @@ struct MaterialSprings {
     float kc = 0;             ///< core spring, N/m
 };
 
-/// The seed's spring model made physical: μ, kb and kc of a guide whose rest
+/// Kim 2023's spring model made physical: μ, kb and kc of a guide whose rest
 /// shape is a curl of radius R and pitch P (advance per turn), sampled by
 /// inextensible edges of length l, from the wisp's material (rod::Material:
 /// the same keys, μ = Nρπr², EI = NEπr⁴/4 and GJ = NGπr⁴/2, as the rod).
@@ -68,7 +68,7 @@ struct MaterialSprings {
 /// along the axis grows by l cos α·Δα = F cos²α/kb. Equal compliance:
 ///   kb = cos²α / c_l.
 /// The coil's whole axial stiffness is then in kb, so kc = 0 (a core spring
-/// would add kc cos²α per edge on top of it; set it to get the seed's stiffer
+/// would add kc cos²α per edge on top of it; set it to get Kim 2023's stiffer
 /// curls). A curl no wider than an edge is not resolved by the edges and c_l
 /// vanishes with R: kb is capped by a straight rod's, the discrete joint
 /// stiffness EI/l (the rod formulation's) felt at the edge's end,
@@ -81,8 +81,8 @@ struct MaterialSprings {
 /// them, so it is set by the step, h²·ks/m = 10⁴ for a particle of mass
 /// m = μ·l (`mass`, when ≥ 0, is the μ to use instead of the material's):
 /// ks = 10⁴·m/h². (Measured: a pre-loaded hanging curl with the material's
-/// kb loses its equilibrium within a second at h²·ks/m ≈ 4·10⁴, which is the
-/// seed's 5000 N/m on 0.005 kg/m and 24 particles; at 10⁴ it holds, and the
+/// kb loses its equilibrium within a second at h²·ks/m ≈ 4·10⁴, which is
+/// Kim 2023's 5000 N/m on 0.005 kg/m and 24 particles; at 10⁴ it holds, and the
 /// hanging extension does not change between ks = 30 and 300 N/m.)
 MaterialSprings materialSprings(const rod::Material& material, float curlRadius, float curlPitch, float edgeLength,
                                 float mass, float step);

@@ -1,4 +1,4 @@
-// Kernels of the curly strand model (seed 001, after Iben et al. 2013,
+// Kernels of the curly strand model (Kim 2023, after Iben et al. 2013,
 // "Artistic simulation of curly hair"): pure functions on plain vectors, each
 // with its governing equation, testable without a physics world (after
 // PositionBasedDynamics). sim/curly/curly_dynamics.h assembles them into one
@@ -22,13 +22,13 @@ namespace hp::curly {
 using Mat3f = Eigen::Matrix3f;
 using Quatf = Eigen::Quaternionf;
 
-// ---- Smoothing (Iben et al. §4; seed eq. 2-3) -------------------------------
+// ---- Smoothing (Iben et al. §4; Kim 2023 eq. 2-3) -------------------------------
 
 /// The filter coefficient β = min(1, 1 - exp(-l/α)) for edges of length l and
 /// smoothing length α (m). α ≤ 0 means no smoothing (β = 1).
 float smoothingBeta(float edgeLength, float alpha);
 
-/// The IIR smoothing filter of the seed's eq. (2), one output per edge:
+/// The IIR smoothing filter of Kim 2023's eq. (2), one output per edge:
 ///   d_i = 2(1-β) d_{i-1} - (1-β)² d_{i-2} + β² (λ_{i+1} - λ_i),
 /// started with d_{-1} = d_{-2} = λ_1 - λ_0 (so d_0 = λ_1 - λ_0). A critically
 /// damped second-order low-pass whose gain at zero frequency is 1: β = 1
@@ -41,7 +41,7 @@ void smoothEdges(const Vec3f* lambda, size_t n, float beta, Vec3f* d, const Vec3
 
 /// Where the bending frames' smoothed curve starts: the root's hair
 /// direction R·ŷ (the follicle normal, the axis a curl is grown along) times
-/// the first edge's length, instead of the seed's first edge λ_1 - λ_0. The
+/// the first edge's length, instead of Kim 2023's first edge λ_1 - λ_0. The
 /// first edge of a curl runs around the coil (58° off its axis at the
 /// default curl), and the frames are transported from it to every edge, so
 /// when a load tilted that edge every bending target turned with it: a
@@ -66,7 +66,7 @@ void smoothedCurve(const Vec3f* lambda, size_t n, float beta, Vec3f* out);
 /// to the strand: Iben et al.'s bending targets t_i = F_i t̄_i.
 void transportFrames(const Vec3f* d, size_t edges, const Mat3f& rootFrame, Mat3f* frames);
 
-// ---- Springs (seed eq. 1, 4, 5) ---------------------------------------------
+// ---- Springs (Kim 2023 eq. 1, 4, 5) ---------------------------------------------
 
 /// A spring between particles a = i and b = i + 1. `force` acts on a; b gets
 /// -force. `K` = ∂force/∂e and `C` = ∂force/∂Δv (symmetric, positive
@@ -105,22 +105,22 @@ PairForce coreSpring(const Vec3f& b, float restLength, const Vec3f& nu, float kc
 /// overwritten; the solution is left in `rhs`.
 void solveBlockTridiagonal(Mat3f* diag, const Mat3f* upper, Vec3f* rhs, size_t n);
 
-// ---- Limits (Selle et al. 2008, as the seed's §1.1; strain: see placeParticle) --
+// ---- Limits (Selle et al. 2008, as Kim 2023's §1.1; strain: see placeParticle) --
 
 /// Velocity limiting, root to tip: where |v_{i+1} - v_i| > vmax the child's
 /// velocity is pulled back to v_i + vmax·Δv̂. Returns how many were limited.
 size_t limitRelativeVelocity(Vec3f* v, size_t n, float maxRelative);
 
 /// A per-step factor f given at the reference step h_ref, applied over a step
-/// h: f^(h/h_ref). Applying it n times with h/n gives the same decay, so the
-/// seed's per-step constants (ξ, ζ) do not depend on the step size.
+/// h: f^(h/h_ref). Applying it n times with h/n gives the same decay, so
+/// Kim 2023's per-step constants (ξ, ζ) do not depend on the step size.
 float perStepFactor(float factor, float h, float hRef);
 
 // ---- The obstacle (head) -----------------------------------------------------
 
 /// The head during one Bullet step and what a contact did to one particle:
 /// the same query, contact and projection out of the signed distance
-/// (Bridson et al.'s collision handling, which the seed uses) as the rope
+/// (Bridson et al.'s collision handling, which Kim 2023 uses) as the rope
 /// guides' (sim/solver/head_contact.h).
 using ObstacleQuery = strand::HeadQuery;
 using strand::Contact;
@@ -144,7 +144,7 @@ inline Contact placeParticle(const Vec3f& parent, Vec3f& child, float length, co
 /// (strand::contactFriction).
 using strand::contactFriction;
 
-// ---- Helices (seed eq. 6) and measuring them ----------------------------------
+// ---- Helices (Kim 2023 eq. 6) and measuring them ----------------------------------
 
 /// Points of the helix (r cos t, r sin t, c t), c = pitch / 2π, sampled at equal
 /// arc lengths `segment` from t = 0 and shifted so the first point is the

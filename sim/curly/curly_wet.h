@@ -1,21 +1,21 @@
-// Curly and wet guide strands (seed 001: Kim 2023 on Iben et al. 2013), the
+// Curly and wet guide strands (Kim 2023 on Iben et al. 2013), the
 // second strand model beside the rigid-chain guides (sim/guides/guides.h), with the
 // same shape of interface so the same driver can run either.
 //
-// A guide is a chain of particles (default 24) joined by the seed's stretch,
+// A guide is a chain of particles (default 24) joined by Kim 2023's stretch,
 // bending and core springs; wet hair adds curl exaggeration, cohesion between
 // strands, adhesion to the head and saturation-dependent stiffness, all
 // driven by a per-particle saturation σ that the pipeline animates per step
 // (setSaturation). Arrangement (details in sim/curly/curly_world.cpp):
-// - the seed's forces are assembled per strand into one linearly implicit
+// - Kim 2023's forces are assembled per strand into one linearly implicit
 //   (backward Euler) step (sim/curly/curly_dynamics.h), stable at 0.02 s;
 // - Bullet does the dynamics: each guide is a btSoftBody rope in a
 //   btSoftRigidDynamicsWorld; the implicit step's result enters as node forces
 //   (addForce), Bullet integrates gravity and those forces and solves the
 //   inextensible links;
 // - head contact is the projection out of the head's signed distance with
-//   Coulomb friction after each Bullet step (Bridson et al., as the seed);
-// - strain and root-to-tip velocity limiting (Selle et al.) and the seed's
+//   Coulomb friction after each Bullet step (Bridson et al., as Kim 2023);
+// - strain and root-to-tip velocity limiting (Selle et al.) and Kim 2023's
 //   velocity scales ξ, ζ follow.
 // Strands are split into fixed groups, one Bullet world each, advanced in
 // parallel with TBB; cohesion reads the previous step's positions of all
@@ -44,7 +44,7 @@ inline constexpr float kFromMaterial = -1.f;
 
 /// Everything the curly/wet solver needs (the step, scene cuts, render radii
 /// and partition: StepSettings). Units: metres, seconds, kg, degrees for
-/// angles. Defaults are the seed's values where it gives one.
+/// angles. Defaults are Kim 2023's values where it gives one.
 struct CurlyWetSettings : StepSettings {
     // Shape of a guide. Rest shape: a helix along the root normal (unless a
     // groom is given to initialize), so a curly guide is curly at rest.
@@ -57,11 +57,11 @@ struct CurlyWetSettings : StepSettings {
     // Time stepping (the step and substeps: StepSettings).
     int iterations = 8;             ///< Bullet link (inextensibility) iterations per Bullet step
 
-    // Material and springs (seed eq. 1, 4, 5). Mass and the stretch, bending
+    // Material and springs (Kim 2023 eq. 1, 4, 5). Mass and the stretch, bending
     // and core springs follow from `material` (the rod formulation's fibre
     // and wisp), the curl and the step where they are kFromMaterial (the
     // default): curly::materialSprings, sim/curly/curly_dynamics.h; so does
-    // helixWeight (5 kb). A value ≥ 0 is used as given (the seed's:
+    // helixWeight (5 kb). A value ≥ 0 is used as given (Kim 2023's:
     // 0.005 kg/m, ks = 5000, kb = kc = 20 N/m, w_h = 100 N/m).
     rod::Material material;         ///< E, G, ρ, fibre radius, hairs per guide
     float massPerLength = kFromMaterial; ///< kg/m (a guide stands for a clump of hairs)
@@ -88,15 +88,15 @@ struct CurlyWetSettings : StepSettings {
     float helixPitch = 0.f;         ///< wet helix advance per turn (2π p of eq. 6), m; 0: the curl pitch
     float helixWeight = kFromMaterial; ///< w_h of eq. (9), N/m; kFromMaterial: 5 kb (a wet helix unlike the rest curl wins)
     bool cohesion = true;           ///< cohesion between wet strands (eq. 10)
-    float cohesionTightness = 0.85f;///< λ (seed: 0.85)
+    float cohesionTightness = 0.85f;///< λ (Kim 2023: 0.85)
     float cohesionRadius = 0.01f;   ///< kernel radius of the neighbour average, m
     float cohesionStiffness = 1e4f; ///< pull toward the cohesive position, per unit mass, 1/s²
     bool adhesion = true;           ///< adhesion to the head (eq. 11-12)
-    float adhesionWeight = 1300.f;  ///< ν (seed: 1300)
+    float adhesionWeight = 1300.f;  ///< ν (Kim 2023: 1300)
     float adhesionRadius = 0.005f;  ///< h of A(r): the shell outside the head where wet hair is held, m
-    float globalStiffness = 0.999995f; ///< ξ, velocity scale per reference step (seed: 0.999995)
-    float wetStiffness = 0.9999f;   ///< γ0, ζ at σ = 1 (seed: 0.9999)
-    float dryStiffness = 1.0f;      ///< γ1, ζ at σ = 0 (seed: 1.0)
+    float globalStiffness = 0.999995f; ///< ξ, velocity scale per reference step (Kim 2023: 0.999995)
+    float wetStiffness = 0.9999f;   ///< γ0, ζ at σ = 1 (Kim 2023: 0.9999)
+    float dryStiffness = 1.0f;      ///< γ1, ζ at σ = 0 (Kim 2023: 1.0)
     float stiffnessStep = 1e-4f;    ///< reference step of ξ and ζ, s: v ← v(ξζ)^(h/this)
 
 
@@ -106,7 +106,7 @@ struct CurlyWetSettings : StepSettings {
     /// These settings with the material's mass and springs in place of every
     /// kFromMaterial (what the solver runs with: CurlyWetSolver::settings()).
     CurlyWetSettings resolved() const;
-    /// The seed's mass and spring constants (0.005 kg/m, ks = 5000, kb = kc = 20 N/m)
+    /// Kim 2023's mass and spring constants (0.005 kg/m, ks = 5000, kb = kc = 20 N/m)
     /// instead of the material's.
     static CurlyWetSettings seedSprings();
 };

@@ -1,8 +1,8 @@
 // The curly guides' Bullet side: one btSoftRigidDynamicsWorld per group of
-// guides, each guide a btSoftBody rope whose nodes are the seed's particles.
+// guides, each guide a btSoftBody rope whose nodes are Kim 2023's particles.
 //
 // Division of labour per Bullet step h:
-//  1. Kernels (sim/curly/curly_dynamics.h), per strand: the seed's stretch, bending
+//  1. Kernels (sim/curly/curly_dynamics.h), per strand: Kim 2023's stretch, bending
 //     and core springs and the wet forces (curl exaggeration, cohesion toward
 //     the previous step's cohesive positions, adhesion to the head) assembled
 //     into one linearly implicit step, giving each particle's Δv. It enters
@@ -15,19 +15,20 @@
 //  3. Kernels, root to tip: strain limiting (Selle et al.), projection out
 //     of the head's signed distance keeping the collision radius clear, then
 //     velocities from positions, Coulomb friction against the moving head,
-//     root-to-tip velocity limiting, and the seed's velocity scales ξ and ζ_i
+//     root-to-tip velocity limiting, and Kim 2023's velocity scales ξ and ζ_i
 //     (step-size independent).
 //
-// Why this arrangement: the seed's springs are force-based, and a curl needs
+// Why this arrangement: Kim 2023's springs are force-based, and a curl needs
 // stiff ones — as explicit forces at 0.02 s they blow up (h²k/m ≈ 150 for the
 // bending springs; explicit needs < 4), so they go through an implicit step,
 // which Bullet's soft-body solver does not offer for such springs (its links
 // and bending links are position constraints without targets that turn with
 // the strand); Bullet keeps what it does well here, integration and
 // inextensibility. Head contact goes through the signed distance
-// (as the rigid-chain guides do, and as the seed's adhesion needs anyway)
-// rather than Bullet's soft-rigid sparse SDF, whose cell size and per-step
-// garbage collection cost (STACK.md) buy nothing for a single smooth head.
+// (as the rigid-chain guides do, and as Kim 2023's adhesion needs anyway)
+// rather than Bullet's soft-rigid sparse SDF, whose cell (0.25 m by default,
+// ~5 mm needed for a head) and per-step btSparseSdf::GarbageCollect (~22% of
+// a rope step in a probe at 845 strands) buy nothing for a single smooth head.
 // Worlds have no broadphase pairs (collision mask 0), so a world's cost is
 // linear in its guides and worlds run in parallel.
 #include "sim/collision/bullet_adapter.h"
@@ -76,7 +77,7 @@ BulletCurlyWorld::BulletCurlyWorld(CurlySet& set, size_t begin, size_t end) : se
             mass[i] = i == 0 ? 0.f : set.mass[set.particle(g, i)];  // root: kinematic
         }
         // Link rest lengths from the rest shape (initialize puts every guide
-        // there); damping is the seed's springs and ξ, ζ; head contact the
+        // there); damping is Kim 2023's springs and ξ, ζ; head contact the
         // signed-distance projection.
         auto* body = new btSoftBody(&world_.info(), n, pos.data(), mass.data());
         for (int j = 0; j + 1 < n; ++j) body->appendLink(j, j + 1);

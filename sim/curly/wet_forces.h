@@ -1,10 +1,10 @@
-// Wet-hair effects of seed 001 (Kim 2023, "Representation of curl
-// exaggeration, cohesion, adhesion and stiffness in wet curly hair"): pure
-// kernels with the seed's equations, driven by a per-particle saturation
+// Wet-hair effects of Kim, "Representation of Curl Exaggeration, Cohesion,
+// Adhesion and Stiffness in Wet Curly Hair" (2023; Kim 2023 below): pure
+// kernels with Kim 2023's equations, driven by a per-particle saturation
 // σ ∈ [0, 1]. Every effect vanishes exactly at σ = 0, so dry hair is the
 // plain curly model of sim/curly/curly_kernels.h.
 //
-// Where the seed's printed equations are ambiguous, the reading taken here is
+// Where Kim 2023's printed equations are ambiguous, the reading taken here is
 // stated at the kernel.
 #pragma once
 
@@ -22,12 +22,12 @@ namespace hp::curly {
 ///   σ(s) = clamp(σ_scene · ((1 - s)·root + s·tip), 0, 1).
 float saturationAt(float scene, float root, float tip, float s);
 
-// ---- Curl exaggeration (seed §2, eq. 6-9) ------------------------------------
+// ---- Curl exaggeration (Kim 2023 §2, eq. 6-9) ------------------------------------
 
-/// The rotation taking unit vector `from` onto unit vector `to` (seed eq. 7-8,
+/// The rotation taking unit vector `from` onto unit vector `to` (Kim 2023 eq. 7-8,
 /// Rodrigues): with γ = from × to and c = from·to,
 ///   M = I + Ψ + Ψ²(1 - c)/|γ|²,   Ψ = [γ]× (the cross-product matrix).
-/// (The seed prints γ = p × h and "2Ψ"; that maps the strand onto the helix.
+/// (Kim 2023 prints γ = p × h and "2Ψ"; that maps the strand onto the helix.
 /// Its eq. 9 applies M to helix edges, so the rotation needed is the one from
 /// the helix onto the strand, and the quadratic term is Ψ².) For `from` ≈ -`to`
 /// it returns the half turn about an axis perpendicular to `from`.
@@ -37,8 +37,8 @@ Mat3f alignRotation(const Vec3f& from, const Vec3f& to);
 /// `helix` holds the n helix points of eq. (6) in root-local coordinates
 /// (same particle count as the strand), `root` the root frame R. M is
 /// alignRotation(R ĥ, p̂)·R with ĥ, p̂ the unit root-to-tip vectors of the
-/// helix and of the strand: the seed's rotation onto the strand's direction,
-/// after the root frame has fixed the curl's phase about it (the seed leaves
+/// helix and of the strand: Kim 2023's rotation onto the strand's direction,
+/// after the root frame has fixed the curl's phase about it (Kim 2023 leaves
 /// the phase to the minimal rotation, which makes it jump when the head turns
 /// about the strand). w_s,i = (σ_i + σ_{i+1})/2.
 /// The force acts on the edge's child (+f) and parent (-f); on an inextensible
@@ -47,7 +47,7 @@ Mat3f alignRotation(const Vec3f& from, const Vec3f& to);
 void curlForces(const Vec3f* p, size_t n, const Vec3f* helix, const Mat3f& root, const float* sigma,
                 float weight, Vec3f* force);
 
-// ---- Cohesion (seed §3, eq. 10) ----------------------------------------------
+// ---- Cohesion (Kim 2023 §3, eq. 10) ----------------------------------------------
 
 /// Neighbour search for the cohesion pass: a uniform grid over the points'
 /// bounding box (the dense form of a spatial hash: a cell's key is its linear
@@ -92,15 +92,15 @@ class SpatialGrid {
 /// kernel-averaged position of its neighbours on other strands,
 ///   p̄_i = Σ_j (p_j σ_j + p_i (1 - σ_j)) V_j W_ij / Σ_j V_j W_ij,
 /// with W the poly6 kernel of radius r and V_j = m_j/ρ_j (equal for all
-/// hair particles, so it cancels: Shepard normalisation of the seed's sum).
+/// hair particles, so it cancels: Shepard normalisation of Kim 2023's sum).
 /// The particle itself is part of the normalisation (j = i, as in SPH sums)
 /// so that one far neighbour pulls weakly and the pull fades in smoothly.
-/// The result is the seed's second, cohesive position p^w_i, as an offset
+/// The result is Kim 2023's second, cohesive position p^w_i, as an offset
 /// from p_i with the tightness λ:
 ///   o_i = p^w_i - p_i = λ Σ_j σ_j (p_j - p_i) W_ij / (W_0 + Σ_j W_ij),
 /// and `weight` = λ Σ_j σ_j W_ij / (W_0 + Σ_j W_ij) = -∂o_i/∂p_i (for the
 /// implicit step). The solver pulls p_i toward p^w_i with a spring, so the
-/// strands' own curl dynamics are never overwritten (the seed's point: the
+/// strands' own curl dynamics are never overwritten (Kim 2023's point: the
 /// cohesive position does not disturb the curl motion, so clumps are stable).
 struct CohesionTarget {
     Vec3f offset = Vec3f::Zero();
@@ -120,13 +120,13 @@ void cohesionTargets(const SpatialGrid& grid, const float* sigma, size_t begin, 
 /// The poly6 kernel W(r, h) = 315/(64π h⁹) (h² - r²)³ for r < h, else 0.
 float poly6(float r2, float h);
 
-// ---- Adhesion (seed §4, eq. 11-12) -------------------------------------------
+// ---- Adhesion (Kim 2023 §4, eq. 11-12) -------------------------------------------
 
 /// The adhesion kernel of eq. (12) with the |φ| factors of eq. (11) cancelled:
 ///   A(r) = 0.007/h^3.25 · (-4r²/h + 6r - 2h)   for h/2 < r ≤ h, else 0,
 /// zero at h/2 and h, largest at 3h/4 (Akinci et al.'s adhesion kernel
-/// without its fourth root, as the seed prints it). r and h are taken in
-/// centimetres: the seed's constants give an adhesive pull of the order of
+/// without its fourth root, as Kim 2023 prints it). r and h are taken in
+/// centimetres: Kim 2023's constants give an adhesive pull of the order of
 /// gravity in that unit (peak 0.00175·h^-2.25 times ν; in metres the same
 /// constants would pull at ~10⁵ m/s²).
 float adhesionKernel(float rCm, float hCm);
@@ -134,15 +134,15 @@ float adhesionKernel(float rCm, float hCm);
 /// Adhesion acceleration of eq. (11) on a particle at signed distance φ from
 /// the head (our φ: negative inside) with outward normal n:
 ///   a = -σ ν A(φ) n     for 0 < φ ≤ h (pulls toward the surface), else 0.
-/// The seed's field is positive inside the obstacle, so its "φ < 0" is the
+/// Kim 2023's field is positive inside the obstacle, so its "φ < 0" is the
 /// outside of the head, and A's support (h/2, h] is a shell just outside the
 /// contact distance: hair that touches the head and is pulled away is held
 /// back while it is within h, and released beyond (the stretching of wet hair
-/// on an obstacle, seed Fig. 9). Dry hair (σ = 0) feels nothing.
+/// on an obstacle, Kim 2023 Fig. 9). Dry hair (σ = 0) feels nothing.
 /// `radius` h in metres.
 Vec3f adhesionAcceleration(float phi, const Vec3f& normal, float sigma, float nu, float radius);
 
-// ---- Stiffness (seed §5, eq. 13) ---------------------------------------------
+// ---- Stiffness (Kim 2023 §5, eq. 13) ---------------------------------------------
 
 /// The saturation-dependent velocity factor of eq. (13): ζ = σγ0 + (1-σ)γ1.
 /// Applied per reference step together with the global ξ:

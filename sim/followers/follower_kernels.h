@@ -1,4 +1,4 @@
-// @brief Pure per-segment kernels of the follower strands (seed 000,
+// @brief Pure per-segment kernels of the follower strands (Gomes 2024,
 // Algorithm 1), testable without a groom or a frame.
 //
 // Conventions shared by every function here and by sim/followers/followers.h:
@@ -36,7 +36,7 @@ namespace hp::follower {
 
 /// Fixed offset of segment y of a strand of S segments:
 ///   d_f(y) = 1 - (y - qs)^2 / qs^2,   qs = (S - 1) / 2.
-/// The seed writes qs = "half the segment count" with its 23 segments indexed
+/// Gomes 2024 writes qs = "half the segment count" with its 23 segments indexed
 /// 0..22: in integer arithmetic 23 / 2 = 11 = (23 - 1) / 2, which gives
 /// d_f(0) = d_f(2 qs) = d_f(22) = 0 (root and tip follow the nearest guide)
 /// and d_f(11) = 1, the symmetric curve of its Figure 4.11. Writing qs as
@@ -49,7 +49,7 @@ HP_FOLLOWER_KERNEL float fixedOffsetCurve(float y, float segments) {
     return 1.f - u * u;
 }
 
-/// Variable offset: d_v = clamp(|v|, 0, maxVelocity), |v| in m/s (the seed
+/// Variable offset: d_v = clamp(|v|, 0, maxVelocity), |v| in m/s (Gomes 2024
 /// clamps the nearest guide's speed to [0, 0.1]).
 HP_FOLLOWER_KERNEL float variableOffset(float speed, float maxVelocity) {
     return speed < maxVelocity ? (speed > 0.f ? speed : 0.f) : maxVelocity;

@@ -1,7 +1,7 @@
 // @brief k-nearest guide roots for follower roots: a uniform grid over the
 // guide roots searched in rings of cells, exact and deterministic.
 //
-// Seed 000 (section 4.5): "for each follower root, the distance to the guide
+// Gomes 2024 (section 4.5): "for each follower root, the distance to the guide
 // roots; select, ordered, the two nearest neighbours". Brute force is
 // F × G distance evaluations (400k × 845 = 3.4e8); the grid visits a few
 // cells per follower. Ties are broken by guide index, so the result equals a

@@ -1,6 +1,6 @@
 // @brief The guide-root triangulation that barycentric followers read
-// (FollowerMode::Barycentric): three guides per follower instead of the
-// seed's two, so followers fill the volume between guides instead of lying
+// (FollowerMode::Barycentric): three guides per follower instead of
+// Gomes 2024's two, so followers fill the volume between guides instead of lying
 // on the ruled sheets between guide pairs (issue 19, item 5).
 //
 // Scalp roots lie on a curved surface, so they are mapped to a plane first:

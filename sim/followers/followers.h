@@ -1,4 +1,4 @@
-// @brief Follower strands (seed 000): strands without physics that copy or
+// @brief Follower strands (Gomes 2024): strands without physics that copy or
 // interpolate the per-segment rotations of their two nearest guides, rebuilt
 // every step from their own root frame on the deformed scalp.
 //
@@ -27,12 +27,12 @@
 // shape exactly; a follower whose root frame is the guide's moved rigidly is
 // the guide moved rigidly.
 //
-// Choices where the seed is silent or Unity-specific:
+// Choices where Gomes 2024 is silent or Unity-specific:
 // - d_v reads guide 1's speed at the same segment (mean of the segment's two
-//   vertex velocities, world space, m/s): the seed buffers each guide
+//   vertex velocities, world space, m/s): Gomes 2024 buffers each guide
 //   segment's Rigidbody velocity. World space, as there: a turning head is
 //   motion and switches the variation on; a still head lets followers align.
-// - d_f uses qs = (S - 1) / 2 (sim/followers/follower_kernels.h: equal to the seed's
+// - d_f uses qs = (S - 1) / 2 (sim/followers/follower_kernels.h: equal to Gomes 2024's
 //   integer "half the segment count" for its 23 segments; 0 at root and tip).
 // - d_r below 0 (rand < 0 near root and tip) extrapolates the slerp past
 //   guide 1 instead of clamping to [0, 1] as Unity's Quaternion.Slerp would,
@@ -41,7 +41,7 @@
 // - Velocities of followers: finite differences of what is drawn (see update()).
 //
 // Why rotations relative to the root frame and transported along the strand:
-// the seed's Unity prototype slerps the segments' transform rotations; here a
+// Gomes 2024's Unity prototype slerps the segments' transform rotations; here a
 // strand is positions only, so a rotation must be derived. Expressing it in
 // the guide's root frame removes the head's motion (a follower on the other
 // side of a turning head gets its own frame's motion, not a translated copy of
@@ -64,7 +64,7 @@ namespace hp {
 enum class FollowerMode {
     Cluster,      ///< copy the nearest guide's segment rotations
     Interpolate,  ///< slerp between the two nearest guides by relative root distance
-    Varied,       ///< seed 000's Algorithm 1 (recommended)
+    Varied,       ///< Gomes 2024's Algorithm 1 (recommended)
     /// Three guides, the corners of the guide-root triangle over the
     /// follower (sim/followers/follower_triangles.h), rotations blended by the
     /// barycentric weights b: q = normalize(b1 q1 + b2 ±K2 q2 K2⁻¹ + b3 ±K3 q3 K3⁻¹)
@@ -76,7 +76,7 @@ enum class FollowerMode {
 };
 
 enum class NeighbourRule {
-    Nearest,          ///< the two nearest guide roots (the seed's rule)
+    Nearest,          ///< the two nearest guide roots (Gomes 2024's rule)
     ShapeSimilarity,  ///< among the nearest few, the guides whose rest shapes match best
 };
 
@@ -91,7 +91,7 @@ struct FollowerSettings {
     uint32_t seed = 1;         ///< seeds rand_xy
     float rootRadius = 0.00004f;  ///< follower radius at the root, m
     float tipRadius = 0.00001f;   ///< follower radius at the tip, m
-    /// Update the followers on TBB's threads (false: one thread, the seed's
+    /// Update the followers on TBB's threads (false: one thread, Gomes 2024's
     /// "without parallelisation"). Results are identical either way.
     bool parallel = true;
 };

@@ -30,6 +30,10 @@ GuideFormulation parseFormulation(const std::string& name) {
     throw Error(cat("unknown guide formulation '", name, "' (choices: rod, rope, rigid)"));
 }
 
+double GuideSettings::guideMassPerLength() const {
+    return formulation == GuideFormulation::Rod ? guides::rodMassPerLength(*this) : double(massPerLength);
+}
+
 void GuideSettings::validate() const {
     auto check = [](bool ok, const char* what) {
         if (!ok) throw Error(cat("guide settings: ", what));
@@ -43,10 +47,11 @@ void GuideSettings::validate() const {
     check(massPerLength > 0.f, "mass per length must be positive");
     check(bendStiffness >= 0.f && limitStiffness >= 0.f && bendDamping >= 0.f, "stiffness and damping must be ≥ 0");
     check(damping >= 0.f, "damping must be ≥ 0");
-    check(youngsModulus >= 0.f && shearModulus >= 0.f, "Young's and shear moduli must be ≥ 0");
+    check(youngsModulus >= 0.f, "Young's modulus must be ≥ 0");
     check(density > 0.f && hairsPerGuide > 0.f, "density and hairs per guide must be positive");
     check(formulation != GuideFormulation::Rod || rootRadius > 0.f, "the rod needs a fibre radius (root radius) > 0");
     check(rodSubsteps >= 1, "rod substeps must be ≥ 1");
+    check(preloadProbes >= 0, "pre-load probes must be ≥ 0");
     check(friction >= 0.f, "friction must be ≥ 0");
     check(bendLimit > 0.f && bendLimit < 180.f, "bend limit must be in (0, 180) degrees");
     check(twistLimit > 0.f && twistLimit < 90.f, "twist limit must be in (0, 90) degrees");
@@ -187,8 +192,7 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
             }
         }
         // Lumped masses: each vertex carries half of its two segments.
-        const float mu =
-            s.formulation == GuideFormulation::Rod ? float(guides::rodMassPerLength(s)) : s.massPerLength;
+        const float mu = float(s.guideMassPerLength());
         for (int j = 0; j < set.segments; ++j) {
             const float half = 0.5f * mu * set.restLength[set.segment(g, j)];
             if (j > 0) set.mass[set.vertex(g, j)] += half;

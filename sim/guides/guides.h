@@ -1,27 +1,35 @@
-// Guide strands simulated with Bullet (seed 000's "fios guia").
+// Guide strands: the simulated strands of Gomes, "Estudo de Otimização de
+// Simulação de Cabelo em Tempo Real Baseado em Física em Unity" (2024;
+// Gomes 2024 below), which the followers copy.
 //
 // A guide is a chain of `segments` segments rooted on the animated scalp. The
 // solver advances all guides by one fixed step at a time, given where the
 // roots are at the end of the step (the head moves them kinematically, with
-// real velocities) and the head's collider. Two formulations share this
-// interface (see sim/guides/guide_group.h for how each one maps onto Bullet):
+// real velocities) and the head's collider. Three formulations share this
+// interface; what Bullet computes differs in each (sim/guides/guide_group.h):
 //
 // - `Rod` (default): each guide is an inextensible elastic rod with physical
-//   parameters (E, G, ρ, fibre radius, hairs per guide), advanced by XPBD
+//   parameters (E, ρ, fibre radius, hairs per guide), advanced by XPBD
 //   with a direct banded solve per strand (sim/guides/rod_kernels.h,
-//   sim/guides/rod_group.cpp); no Bullet world, Bullet only for strand-strand pairs.
-// - `Rope` (the previous production formulation): each guide is a Bullet btSoftBody rope;
-//   Bullet integrates gravity and solves the stretch links, interleaved with
-//   the bend limits; the kernels of sim/guides/joint_kernels.h turn the joints
-//   toward the (gravity pre-loaded) rest shape on Bullet's prediction and,
-//   after the step, restore exact lengths and push vertices out of the
-//   head's signed distance with Coulomb friction. Meets the length,
-//   penetration and speed goals; sim/guides/rope_group.cpp says why it is built so.
-// - `Rigid`: the seed's own arrangement, kept faithful for comparison: capsule
-//   btRigidBody segments joined by btGeneric6DofSpring2Constraint (Unity's
-//   ConfigurableJoint): locked linear motion, soft ±bend/±twist limits,
-//   springs toward the rest pose, a projection limit; the head is a kinematic
-//   Bullet triangle-mesh body.
+//   sim/guides/rod_group.cpp). Bullet integrates nothing here: it only finds
+//   strand-strand contact pairs and their closest points (broadphase and
+//   capsule narrowphase, sim/guides/strand_contacts.cpp) when
+//   strandCollision is on, and distances to the colliders beside the head
+//   (sim/collision/collision_world.h); dynamics, head contact and friction
+//   are this project's kernels.
+// - `Rope`: each guide is a Bullet btSoftBody rope. Bullet integrates
+//   gravity and velocities and solves the stretch links (its Gauss-Seidel
+//   link passes), interleaved with the bend limits; the kernels of
+//   sim/guides/joint_kernels.h turn the joints toward the (gravity
+//   pre-loaded) rest shape on Bullet's prediction and, after the step,
+//   restore exact lengths and push vertices out of the head's signed
+//   distance with Coulomb friction (sim/guides/rope_group.cpp says why).
+// - `Rigid`: Gomes 2024's own arrangement, kept faithful for comparison, and the
+//   one where Bullet computes everything: capsule btRigidBody segments
+//   joined by btGeneric6DofSpring2Constraint (Unity's ConfigurableJoint):
+//   locked linear motion, soft ±bend/±twist limits, springs toward the rest
+//   pose, a projection limit; the head is a kinematic Bullet triangle-mesh
+//   body.
 //
 // The stepping itself (time, head interpolation, scene cuts, written frames,
 // statistics) is the skeleton every strand model shares
@@ -49,7 +57,7 @@ GuideFormulation parseFormulation(const std::string& name);
 
 /// Everything the guide solver needs to know (the step, scene cuts, render
 /// radii and partition: StepSettings). Units: metres, seconds, kg, degrees
-/// for angles. Defaults are seed 000's values where the seed gives one.
+/// for angles. Defaults are Gomes 2024's Unity settings where it gives one.
 struct GuideSettings : StepSettings {
     GuideFormulation formulation = GuideFormulation::Rod;
 
@@ -58,35 +66,39 @@ struct GuideSettings : StepSettings {
     float length = 0.25f;           ///< rest length of a guide, m
     float collisionRadius = 0.001f; ///< capsule radius for head and strand-strand contact, m
 
-    // Time stepping (seed: fixed step 0.02 s, 20 solver iterations; the step
+    // Time stepping (Gomes 2024: fixed step 0.02 s, 20 solver iterations; the step
     // and substeps: StepSettings).
     int iterations = 20;            ///< Bullet solver iterations per Bullet step
 
     // Material.
     float massPerLength = 0.005f;   ///< rope, rigid: kg/m (a guide stands for a clump of hairs)
     float bendStiffness = 5e-5f;    ///< rope, rigid: joint spring toward the rest pose, N·m/rad
-    // Rod material (SI): μ = N·ρ·πr², EI = N·E·πr⁴/4, GJ = N·G·πr⁴/2, r = rootRadius (sim/guides/rod_kernels.h).
+    // Rod material (SI): μ = N·ρ·πr², EI = N·E·πr⁴/4, r = rootRadius (sim/guides/rod_kernels.h).
+    // No shear modulus: the rod carries no twist (sim/guides/rod_group.cpp).
     float youngsModulus = 3.8e9f;   ///< rod: E, Pa
-    float shearModulus = 1.3e9f;    ///< rod: G, Pa (GJ is reported; see sim/guides/rod_group.cpp for why it enters nothing)
     float density = 1300.f;         ///< rod: ρ, kg/m³
-    float hairsPerGuide = 100.f;    ///< rod: N, the hairs of the wisp a guide stands for
+    /// rod: N, the hairs of the wisp a guide stands for. Mass and EI both
+    /// scale with N, drag is a rate and contacts are positions, so N cancels
+    /// out of the rod's motion: only the energies reported scale with it.
+    float hairsPerGuide = 100.f;
     int rodSubsteps = 2;            ///< rod: XPBD steps per solver substep
+    int preloadProbes = 3;          ///< rod: probe steps refining the pre-load (rod::preload)
     float bendDamping = 0.f;        ///< rigid only: joint spring damping, N·m·s/rad
     float damping = 1.0f;           ///< velocity decay rate, 1/s: v *= exp(-damping·t), any step size (rod: air drag)
     float friction = 0.2f;          ///< Coulomb friction against the head and between strands
     Vec3f gravity = Vec3f(0.f, -9.81f, 0.f);  ///< m/s²
     bool preload = true;            ///< pre-load the springs so the rest shape holds under gravity at t0
 
-    // Joint limits (seed: ±30° about the bending axes, ±10° twist, soft).
+    // Joint limits (Gomes 2024: ±30° about the bending axes, ±10° twist, soft).
     float bendLimit = 30.f;         ///< deg
     float twistLimit = 10.f;        ///< deg (rigid only: a rope has no twist)
     float limitStiffness = 1e-3f;   ///< spring pushing a joint back inside its limit, N·m/rad
-    float projectionAngle = 5.f;    ///< beyond limit + this, a joint is snapped back (seed: projection limit), deg
+    float projectionAngle = 5.f;    ///< beyond limit + this, a joint is snapped back (Gomes 2024: projection limit), deg
     float projectionDistance = 0.1f;///< rigid only: joint separation snapped back, fraction of a segment
 
     // Contacts.
     bool headCollision = true;      ///< project vertices out of the head's signed distance each Bullet step
-    bool strandCollision = false;   ///< strand-strand collision (seed table row 7); serialises contact solving
+    bool strandCollision = false;   ///< strand-strand collision (Gomes 2024, Table 5.1 row 7); serialises contact solving
 
 
     // Guard: a vertex faster than this after a step is numerical, not
@@ -98,6 +110,9 @@ struct GuideSettings : StepSettings {
 
     /// Throws hp::Error naming the first setting out of range.
     void validate() const;
+    /// A guide's mass per length as its formulation has it, kg/m: rod
+    /// N·ρ·πr² (hair.material), rope and rigid massPerLength.
+    double guideMassPerLength() const;
 };
 
 /// Drives all guides of a shot (stepping, written frames, time, statistics:

@@ -1,4 +1,4 @@
-// The seed's own formulation, kept faithful: a guide is a chain of capsule
+// Gomes 2024's own formulation, kept faithful: a guide is a chain of capsule
 // btRigidBody segments, each joined to its parent (the previous segment, or
 // a kinematic root body moved with the scalp) at the end of the parent by a
 // btGeneric6DofSpring2Constraint, Bullet's closest analogue of Unity's
@@ -19,7 +19,7 @@
 //  - damping through btRigidBody::setDamping, whose v·(1-d)^h is exp(-c·h)
 //    for d = 1 - exp(-c), so step-size independent.
 // With strand-strand collision on, all guides share one world (capsules of
-// different guides collide), as in the seed; otherwise each world holds
+// different guides collide), as in Gomes 2024; otherwise each world holds
 // `strandsPerWorld` guides and the capsules collide only with the head.
 // Optional position-level projection out of the head's signed distance is
 // applied to the segment bodies (settings.headCollision), as in the rope.
@@ -29,7 +29,7 @@
 // N·m/rad), so the chains hang on their limits and the pre-load cannot hold
 // the rest shape; a plain chain at one step per 0.02 s breaks its limits
 // (100°+) and tears (checked without the projection), so the projection limit
-// does the holding and the chains jitter at its bounds — the seed's "chaotic
+// does the holding and the chains jitter at its bounds — Gomes 2024's "chaotic
 // effects"; segment ends drift apart by up to ~0.6 segment between
 // projections; ~27 ms/step for 94 guides, ~155 for 845 on one core.
 #include "sim/collision/bullet_adapter.h"

@@ -7,13 +7,15 @@
 //
 // Parameters (GuideSettings → rod::Material): mass per length μ and bending
 // stiffness EI from E, ρ, the fibre radius (hair.radius.root; the render
-// taper is not physical here: a uniform fibre) and hairs_per_guide. GJ is
-// computed but enters nothing: with an isotropic section (EI the same about
+// taper is not physical here: a uniform fibre) and hairs_per_guide, which
+// cancels out of the motion (μ and EI are both N times one hair's). The
+// shear modulus is not read: with an isotropic section (EI the same about
 // both axes) and a free tip, the quasistatic twist moment is zero along the
-// rod (Bergou et al. 2008, §4.2: the material frame relaxes to the
-// twist-free Bishop frame), so the material frame is the transported frame
-// and the bending energy alone drives the dynamics. That is the model's
-// twist assumption; anisotropic (elliptic) fibres would need twist.
+// rod (Bergou et al., "Discrete Elastic Rods", 2008, §4.2: the material
+// frame relaxes to the twist-free Bishop frame), so the material frame is
+// the transported frame and the bending energy alone drives the dynamics.
+// That is the model's twist assumption; anisotropic (elliptic) fibres would
+// need twist, and GJ with it (the curly model uses it: sim/curly/).
 //
 // Why this solver (measured on the 2-core machine, loaded; README "Physics
 // of the guides"): the direct banded solve is exact per linearisation, so
@@ -36,7 +38,6 @@ namespace {
 rod::Material materialOf(const GuideSettings& s) {
     rod::Material m;
     m.youngs = s.youngsModulus;
-    m.shear = s.shearModulus;
     m.density = s.density;
     m.radius = s.rootRadius;
     m.hairsPerGuide = s.hairsPerGuide;
@@ -85,7 +86,8 @@ class RodGroup final : public GuideGroup {
         const rod::RodStrand s = strand(g);
         rod::Vec2f* c = &curvature_[(g - begin_) * size_t(set_.segments)];
         rod::restCurvature(s, x.data(), R, c);
-        if (preloadStep > 0.f) rod::preload(s, x.data(), R, set_.settings.gravity, preloadStep, c, scratch_);
+        if (preloadStep > 0.f)
+            rod::preload(s, x.data(), R, set_.settings.gravity, preloadStep, set_.settings.preloadProbes, c, scratch_);
     }
 
     const double bendStiffness_;  ///< EI of the settings' material (the same for every guide)

@@ -85,8 +85,8 @@ void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec2f* c)
     });
 }
 
-void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gravity, float h, Vec2f* c,
-             RodScratch& sc) {
+void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gravity, float h, int probes,
+             Vec2f* c, RodScratch& sc) {
     const int n = s.vertices;
     std::vector<Vec3f> f(size_t(n), Vec3f::Zero()), xt(size_t(n), Vec3f::Zero()), vt(size_t(n), Vec3f::Zero());
     for (int i = 1; i < n; ++i) f[size_t(i)] = gravity / s.invMass[i];
@@ -94,8 +94,11 @@ void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gr
     // The analytic pre-load balances the forces at x; rodStep linearises at
     // its prediction y = x + h²g, about a millimetre away. Each probe step
     // from rest measures the drift δ that remains and cancels its force
-    // M·δ/h² the same way (measured: the error shrinks ~10× per probe).
-    for (int probe = 0; probe < 3; ++probe) {
+    // M·δ/h² the same way. How much each probe gains depends on the strand:
+    // ~10× on a free strand, ~1.2× on the default shot's settled guides,
+    // whose median drift per step goes 9.3 → 7.2 → 6.5 → 6.0 µm with 0, 1,
+    // 2, 3 probes (simulation.preload_probes says so to the user).
+    for (int probe = 0; probe < probes; ++probe) {
         for (int i = 0; i < n; ++i) {
             xt[size_t(i)] = x[i];
             vt[size_t(i)] = Vec3f::Zero();

@@ -116,11 +116,12 @@ void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec2f* c)
 /// since a bend row's force multiplier is Λ = -C/α = (c - κ)/α.
 void preloadOffset(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f* force, Vec2f* c);
 
-/// Pre-loads c (holding the rest curvatures) so that x is an exact static
+/// Pre-loads c (holding the rest curvatures) so that x is a static
 /// equilibrium of rodStep with step h under gravity: preloadOffset for the
-/// weights, then three probe steps from rest, each cancelling the drift left.
-void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gravity, float h, Vec2f* c,
-             RodScratch& scratch);
+/// weights, then `probes` probe steps from rest, each cancelling the drift
+/// left (GuideSettings::preloadProbes).
+void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gravity, float h, int probes,
+             Vec2f* c, RodScratch& scratch);
 
 /// One XPBD step of length h for one strand (x: positions at the step's
 /// start, v: velocities; root at rootPos with frame rootFrame at the end):

@@ -1,4 +1,4 @@
-// Strand-strand collision for the rope formulation (seed table row 7): every
+// Strand-strand collision for the rope formulation (Gomes 2024, Table 5.1 row 7): every
 // segment is a Bullet capsule in one btCollisionWorld; Bullet's dynamic AABB
 // tree finds the overlapping pairs and its capsule-capsule narrowphase the
 // closest points, and the contacts are resolved at position level in a fixed

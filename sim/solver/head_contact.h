@@ -52,7 +52,7 @@ enum class Reattach {
     /// one move (the guides; up to 4 rounds).
     Slide,
     /// Pulls it back along the parent-child direction, x ← p + l·(x - p)/|x - p|
-    /// (the curly guides, as the seed does; up to 16 rounds, since alternating
+    /// (the curly guides, as Kim 2023 does; up to 16 rounds, since alternating
     /// projections creep toward the corner where plane and sphere meet).
     Radial,
 };

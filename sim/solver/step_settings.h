@@ -9,7 +9,7 @@ namespace hp {
 
 /// @brief What the solver skeleton (sim/solver/skeleton.h) needs of a model's settings.
 struct StepSettings {
-    // Time stepping (seed: fixed step 0.02 s).
+    // Time stepping (Gomes 2024: fixed step 0.02 s).
     float timeStep = 0.02f;         ///< one step, s
     int substeps = 1;               ///< Bullet (or rod) substeps per step
 

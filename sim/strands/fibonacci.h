@@ -1,4 +1,4 @@
-// The Fibonacci sphere lattice (González 2010), seed 000's root placement:
+// The Fibonacci sphere lattice (González 2010), the root placement of Gomes 2024:
 // n nearly uniform points on the unit sphere from the golden angle, of which
 // a cap (the "scalp" of a sphere head) can be kept.
 #pragma once

@@ -1,6 +1,6 @@
 // Procedural grooms: the rest shape of every guide at the start of a shot.
 //
-// `straight` is seed 000's default (each strand straight along its root
+// `straight` is Gomes 2024's default (each strand straight along its root
 // normal). `combed` lays the hair down the way a comb would: each strand
 // leaves the scalp along its normal and turns smoothly toward a comb
 // direction (gravity's, by default), sliding over the head instead of

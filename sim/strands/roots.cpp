@@ -108,7 +108,7 @@ std::vector<SurfacePoint> fibonacciRoots(const TriangleMesh& mesh, const std::ve
         return size_t(std::count_if(hits.begin(), hits.end(), [](const RayHit& h) { return h.hit(); }));
     };
 
-    // The smallest lattice that puts `want` roots on the scalp (the seed's
+    // The smallest lattice that puts `want` roots on the scalp (Gomes 2024's
     // lattice itself when the scalp is its cap). Hits grow nearly in
     // proportion to the lattice size, so proportional guesses, kept inside
     // the bracket [lo, hi] found so far, converge in a few casts. Large

@@ -3,7 +3,7 @@
 // Roots are SurfacePoints (triangle + barycentrics), so evaluate(pose.mesh,
 // root) puts them on the deformed surface of every frame with a frame that
 // turns with it. Two methods:
-// - Fibonacci (seed 000): the Fibonacci sphere lattice around a centre inside
+// - Fibonacci (Gomes 2024): the Fibonacci sphere lattice around a centre inside
 //   the head, each direction projected radially onto the outermost surface
 //   (a ray from outside toward the centre); directions whose hit is not on
 //   the scalp are dropped, and the lattice is sized so that exactly `count`
@@ -23,7 +23,7 @@
 
 namespace hp {
 
-/// @brief How roots are spread over the scalp: the seed's Fibonacci lattice,
+/// @brief How roots are spread over the scalp: Gomes 2024's Fibonacci lattice,
 /// or blue noise (Yuksel's sample elimination).
 enum class RootMethod { Fibonacci, BlueNoise };
 
@@ -36,7 +36,7 @@ struct RootSettings {
     /// sphere fitted to the scalp (the skull's centre for a cap-like scalp).
     std::optional<Vec3f> center;
     /// Fibonacci: the lattice's pole; default: the mean direction of the scalp
-    /// from the centre (a scalp cap's own axis makes the lattice the seed's).
+    /// from the centre (a scalp cap's own axis makes the lattice Gomes 2024's).
     std::optional<Vec3f> axis;
     /// Blue noise: candidates per root (Yuksel uses 3-5; more is slower and slightly more even).
     float candidateRatio = 4.f;

@@ -1,4 +1,4 @@
-// B-sim (docs/benchmarks.md) for the curly/wet strand model (seed 001): curly
+// B-sim (docs/benchmarks.md) for the curly/wet strand model (Kim 2023): curly
 // guides of 24 particles, 0.25 m, on a 0.1 m sphere head spinning 90°/s
 // about Y, roots on a Fibonacci lattice over the upper hemisphere, 0.02 s
 // steps, 20 warm-up + 250 timed steps. Reports steps/s (median of 3 runs and

@@ -1,4 +1,4 @@
-// B-follow (docs/benchmarks.md): milliseconds per follower update for the seed's
+// B-follow (docs/benchmarks.md): milliseconds per follower update for Gomes 2024's
 // case (94 guides, 751 followers) and 845 guides with 10k, 100k and 400k
 // followers × 24 vertices, modes varied / cluster / interpolate, on 1 and 2
 // threads; medians of 3 runs with their spread.
