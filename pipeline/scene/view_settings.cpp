@@ -2,7 +2,7 @@
 #include "pipeline/scene/key_fields.h"
 
 #include "core/errors.h"
-#include "render/reference/hair_bsdf.h"
+#include "render/reference/hair_fit.h"
 
 namespace hp {
 
@@ -57,6 +57,10 @@ View makeView(const Scene& s) {
         {"render.hair.secondary_color", &HairMaterial::secondaryColor},
         {"render.hair.transmittance", &HairMaterial::transmittance},
     });
+    // Fitted: the diffuse colour, lobes and dual scattering from the
+    // physical fibre (render/reference/hair_fit.h); the plain Kajiya-Kay
+    // keys above then only matter in mode kajiya-kay.
+    if (s.text("render.hair.shading") == "fitted") fitHairMaterial(hairFiber(s), &h);
 
     readKeys(s, v.head, {
         {"render.head.color", &SurfaceMaterial::color},
@@ -66,6 +70,16 @@ View makeView(const Scene& s) {
         {"render.head.shininess", &SurfaceMaterial::shininess},
     });
     return v;
+}
+
+HairFiberParams hairFiber(const Scene& s) {
+    HairFiberParams f;
+    f.longitudinalRoughness = float(s.number("reference.physical.roughness"));
+    f.azimuthalRoughness = float(s.number("reference.physical.azimuthal_roughness"));
+    f.cuticleTiltDegrees = float(s.number("reference.physical.cuticle_tilt"));
+    f.ior = float(s.number("reference.physical.ior"));
+    f.sigmaA = hairAbsorption(s);
+    return f;
 }
 
 float hairRoughness(const Scene& s) { return float(s.number("reference.physical.azimuthal_roughness")); }
