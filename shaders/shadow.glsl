@@ -29,19 +29,29 @@ float shadowMapVisibility(vec3 world) {
 // average C over 2 x 2 voxels across the beam (a tent over ~3 x 3): regularly
 // spaced hair otherwise casts moire rings, since one-voxel-wide lines fill
 // neighbouring columns unevenly.
-float voxelDensity(vec3 world) {
-    vec3 g = lightGrid(world) - vec3(0.0, 0.0, 0.5 / uGridDepth.w);
+float voxelDensityAt(vec3 g) {
     if ((uCounts.z & kFlagVoxelFilter) == 0) return texture(uDensity, g).r;
     float h = 0.75 / uGridDepth.w;
     return 0.25 * (texture(uDensity, g + vec3(-h, -h, 0.0)).r + texture(uDensity, g + vec3(h, -h, 0.0)).r +
                    texture(uDensity, g + vec3(-h, h, 0.0)).r + texture(uDensity, g + vec3(h, h, 0.0)).r);
 }
 
+float voxelDensity(vec3 world) { return voxelDensityAt(lightGrid(world) - vec3(0.0, 0.0, 0.5 / uGridDepth.w)); }
+
 // Expected hair crossings C in front of a point toward light i (0 for an
 // unshadowed light or without the voxel grid).
 float hairCrossings(int light, vec3 world) {
     if (light != uCounts.y || (uCounts.z & kFlagVoxels) == 0) return 0.0;
     return voxelDensity(world);
+}
+
+// Expected crossings of the light's ray beyond the point (the hair behind
+// it, seen from the light): the whole column's C less the point's; -1 when
+// unknown (unshadowed light, no voxel grid).
+float hairCrossingsBehind(int light, vec3 world, float crossings) {
+    if (light != uCounts.y || (uCounts.z & kFlagVoxels) == 0) return -1.0;
+    vec3 g = lightGrid(world);
+    return max(voxelDensityAt(vec3(g.xy, 1.0 - 0.5 / uGridDepth.w)) - crossings, 0.0);
 }
 
 // The head's shadow map toward light i (1 unshadowed).

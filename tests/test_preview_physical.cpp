@@ -51,8 +51,8 @@ Measured measure(const Image& physical, const Image& preview) {
     return {m.flip, hairLuminance(preview, physical) / hairLuminance(physical, preview)};
 }
 
-// Drooping hair on a sphere head, no head drawn (hair against black: what
-// the hair looks like, not the skin model), lit by one shadowed directional
+// Drooping hair grown on a sphere, the sphere not drawn (hair against black:
+// what the hair looks like, not the skin model, which another change owns), lit by one shadowed directional
 // light from the upper right front. Bounds: measured values (printed) with
 // a margin; the plain Kajiya-Kay preview misses them, and so does the fitted
 // one without its multiple scattering.
@@ -66,7 +66,6 @@ TEST(PreviewPhysical, FittedPreviewPredictsThePhysicalRender) {
     hs.tipRadius = 0.00002f;
     hs.droop = 0.9f;
     const StrandFrame hair = makeSyntheticHair(hs);
-    const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 24, 48);
     View view = simpleView(Vec3f(0.46f, 0.09f, 0.68f), Vec3f(0.f, -0.04f, -0.02f), 38.f, 160, 90,
                            Vec3f(-0.6f, -0.7f, -0.4f));
     view.lights[0].intensity = 3.f;
@@ -79,7 +78,7 @@ TEST(PreviewPhysical, FittedPreviewPredictsThePhysicalRender) {
     rs.samplesPerPixel = 128;
     rs.bounces = 8;
     ReferenceRenderer reference;
-    const Image physical = reference.render(view, &hair, &head, rs);
+    const Image physical = reference.render(view, &hair, nullptr, rs);
     dump("physical.reference", physical);
 
     PreviewSettings ps;
@@ -87,7 +86,6 @@ TEST(PreviewPhysical, FittedPreviewPredictsThePhysicalRender) {
     PreviewRenderer renderer(ps);
     PreviewFrame frame;
     frame.strands = &hair;
-    frame.head = &head;
     View plain = view;
     plain.hair.color = hairColorFromAbsorption(fibre.sigmaA, fibre.azimuthalRoughness);
     View fitted = view;

@@ -2,6 +2,8 @@
 #include "pipeline/scene/key_fields.h"
 
 #include "core/errors.h"
+
+#include <algorithm>
 #include "render/reference/hair_fit.h"
 
 namespace hp {
@@ -60,7 +62,13 @@ View makeView(const Scene& s) {
     // Fitted: the diffuse colour, lobes and dual scattering from the
     // physical fibre (render/reference/hair_fit.h); the plain Kajiya-Kay
     // keys above then only matter in mode kajiya-kay.
-    if (s.text("render.hair.shading") == "fitted") fitHairMaterial(hairFiber(s), &h);
+    if (s.text("render.hair.shading") == "fitted") {
+        fitHairMaterial(hairFiber(s), &h);
+        // A shadow ray through a fibre keeps what the fibre scatters forward
+        // (Zinke 2008's a_f): the Kajiya-Kay reference's grey per-crossing
+        // transmittance, the preview's per channel.
+        h.transmittance = std::clamp(h.dual.forward.dot(Vec3f(0.2126f, 0.7152f, 0.0722f)), 0.f, 1.f);
+    }
 
     readKeys(s, v.head, {
         {"render.head.color", &SurfaceMaterial::color},
