@@ -54,8 +54,9 @@ Measured measure(const Image& physical, const Image& preview) {
 // Drooping hair grown on a sphere, the sphere not drawn (hair against black:
 // what the hair looks like, not the skin model, which another change owns), lit by one shadowed directional
 // light from the upper right front. Bounds: measured values (printed) with
-// a margin; the plain Kajiya-Kay preview misses them, and so does the fitted
-// one without its multiple scattering.
+// a margin; the plain Kajiya-Kay preview misses them by far. (The scene's
+// 2000 strands are sparse: dual scattering changes little here; the default
+// scene's numbers are in scenes/default.yaml and README.md.)
 TEST(PreviewPhysical, FittedPreviewPredictsThePhysicalRender) {
     HP_REQUIRE_GL();
     SyntheticHairSettings hs;
@@ -105,10 +106,13 @@ TEST(PreviewPhysical, FittedPreviewPredictsThePhysicalRender) {
               << mPlain.luminanceRatio << ", fitted single scattering " << mSingle.flip << " / "
               << mSingle.luminanceRatio << ", fitted dual scattering " << mFitted.flip << " / "
               << mFitted.luminanceRatio << "\n";
-    EXPECT_LT(mFitted.flip, 0.2);
-    EXPECT_NEAR(mFitted.luminanceRatio, 1.0, 0.2);
-    EXPECT_LT(mFitted.flip, mPlain.flip);
-    EXPECT_LT(mFitted.flip, mSingle.flip);
+    // Measured: fitted with dual scattering FLIP 0.041, hair luminance 0.98 of
+    // the physical; without dual scattering (Kajiya-Kay's grey shadows)
+    // 0.042 / 0.97; the plain Kajiya-Kay preview 0.42 / 9.6 (its hand-set
+    // specular and the old convention, several times too bright).
+    EXPECT_LT(mFitted.flip, 0.06);
+    EXPECT_NEAR(mFitted.luminanceRatio, 1.0, 0.1);
+    EXPECT_LT(mFitted.flip, 0.5 * mPlain.flip);
 }
 
 }  // namespace
