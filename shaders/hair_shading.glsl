@@ -14,6 +14,10 @@
 #include "kajiya_kay.glsl"
 #include "shadow.glsl"
 
+// Zinke 2008's forward density factor d_f (their 0.7 for human hair): the
+// share of forward-scattered light that meets the next fibre of a chain.
+const float kForwardDensity = 0.7;
+
 vec3 shadeHair(vec3 world, vec3 tangent, vec3 albedo) {
     vec3 t = normalize(tangent);
     vec3 v = normalize(uEye.xyz - world);
@@ -45,17 +49,17 @@ vec3 shadeHair(vec3 world, vec3 tangent, vec3 albedo) {
             // what they scatter forward: n fibres deep a_f^n, spread n beta_f^2.
             // Summed over n = 1..N with N Poisson of mean C_h, half the
             // shadowed light's column here (the hair's half thickness, the
-            // grid's one measure of it; without a grid Zinke's density
-            // factor d_f = 0.7 times the infinite sum):
-            //   a_f (1 - exp(-(1 - a_f) C_h)) / (1 - a_f),
+            // grid's one measure of it; without a grid the infinite sum),
+            // times Zinke's d_f:
+            //   d_f a_f (1 - exp(-(1 - a_f) C_h)) / (1 - a_f),
             // spread at the series' mean depth 1 / (1 - a_f), capped by C_h.
             vec3 deep = af / max(vec3(1.0) - af, vec3(0.05));
             float meanDepth = 1.0 / max(1.0 - dot(af, vec3(0.2126, 0.7152, 0.0722)), 0.05);
-            vec3 chain = 0.7 * deep;
+            vec3 chain = kForwardDensity * deep;
             float reach = meanDepth;
             if (column >= 0.0) {
                 float half_ = 0.5 * column;
-                chain = deep * (vec3(1.0) - exp(-(vec3(1.0) - af) * half_));
+                chain = kForwardDensity * deep * (vec3(1.0) - exp(-(vec3(1.0) - af) * half_));
                 reach = min(meanDepth, max(half_, 1.0));
             }
             float spreadU = uShadowColor.w * reach;
