@@ -25,12 +25,21 @@ layout(std140, binding = 0) uniform Frame {
     vec4 uWind;         // xyz wind, w gust strength
     vec4 uFurTime;      // time (s), gust frequency (Hz), gust wavelength (m), inner level
     vec4 uFurLevels;    // outer level
-    ivec4 uCounts;      // light count, shadowed light (-1 none), flags (kFlag*), two lobes
+    vec4 uLobeShape[4]; // fitted lobes R, TRT, TT, back (render/view/view.h HairLobe): exponent, shift (rad),
+                        // azimuth power m, azimuth sign * norm w(m)
+    vec4 uLobeStrength[36]; // lobe k's strength table: [9k + node], rgb, at |thetaO| = node * 11.25 deg
+    vec4 uShadowColor;  // rgb optical depth per unit of C (1 - T, or 1 - a_f fitted), w: beta_f^2 per unit of C
+    ivec4 uCounts;      // light count, shadowed light (-1 none), flags (kFlag*), hair model (kHair*)
 };
 
 const int kFlagVoxels = 1;
 const int kFlagShadowMap = 2;
 const int kFlagVoxelFilter = 4;
+
+// uCounts.w: Kajiya-Kay with one or two lobes, or the fitted model with dual scattering.
+const int kHairKajiyaKay = 0;
+const int kHairKajiyaKayTwoLobes = 1;
+const int kHairFitted = 2;
 
 // Fixed point of the r32ui voxel grid: this many units make 1 (one strand
 // crossing, or one fragment in the seed's count). Mirrors kVoxelUnit in

@@ -1,9 +1,22 @@
-// Radiance leaving a hair point toward the camera: Kajiya-Kay under every
-// light times that light's visibility (voxel grid, shadow map). Evaluated per
-// ribbon vertex (default; Gouraud along the strand, which software
-// rasterizers need for speed) or per fragment (SHADE_PER_FRAGMENT).
+// Radiance leaving a hair point toward the camera, under every light.
+// Kajiya-Kay: the model times the light's visibility (voxel grid, shadow map).
+// Fitted (render/reference/hair_fit.h): the dual-scattering approximation of
+// Zinke, Yuksel, Weber and Keyser 2008. Behind C expected fibre crossings
+// toward the light (the voxel grid) the light arriving is the forward-
+// scattered T_f = exp(-(1 - a_f) C) (coloured: each fibre keeps what it
+// scatters forward, a_f per channel), spread along the fibre by
+// sigma_f^2 = C beta_f^2, which widens every lobe; the fibres around the point
+// add the local back-scatter d_b f_back (lobe 3), scaled by how much hair lies
+// behind the point (C_b, the rest of the voxel column):
+//   L = sum over lights of E T_f shadowMap (f_fitted(sigma_f^2) + (1 - exp(-(1 - a_f^2) C_b)) d_b f_back(sigma_f^2)).
+// Evaluated per ribbon vertex (default; Gouraud along the strand, which
+// software rasterizers need for speed) or per fragment (SHADE_PER_FRAGMENT).
 #include "kajiya_kay.glsl"
 #include "shadow.glsl"
+
+// Zinke 2008's forward density factor d_f (their 0.7 for human hair): the
+// share of forward-scattered light that meets the next fibre of a chain.
+const float kForwardDensity = 0.7;
 
 vec3 shadeHair(vec3 world, vec3 tangent, vec3 albedo) {
     vec3 t = normalize(tangent);
@@ -13,10 +26,57 @@ vec3 shadeHair(vec3 world, vec3 tangent, vec3 albedo) {
     vec3 n = v - dot(v, t) * t;
     n = dot(n, n) > 1e-12 ? normalize(n) : vec3(0.0);
     vec3 color = vec3(0.0);
+    // Fitted: the shadowed light's voxel column through the point, C in front
+    // and the column's whole C, once for all lights.
+    bool fitted = uCounts.w == kHairFitted;
+    float front = 0.0, column = -1.0;
+    if (fitted && uCounts.y >= 0) {
+        front = hairCrossings(uCounts.y, world);
+        float behind = hairCrossingsBehind(uCounts.y, world, front);
+        column = behind < 0.0 ? -1.0 : front + behind;
+    }
+    vec3 af = vec3(1.0) - uShadowColor.rgb;
     for (int i = 0; i < uCounts.x; ++i) {
         vec3 radiance;
         vec3 l = toLight(i, world, radiance);
-        color += kajiyaKay(albedo, t, n, l, v) * radiance * lightVisibility(i, world);
+        if (!fitted) {
+            color += kajiyaKay(albedo, t, n, l, v) * radiance * lightVisibility(i, world);
+            continue;
+        }
+        if (i != uCounts.y || column < 0.0) {
+            // A light without a grid (unshadowed: it reaches every fibre, as
+            // in the reference). The fibres toward it are lit too and pass on
+            // what they scatter forward: n fibres deep a_f^n, spread n beta_f^2.
+            // Summed over n = 1..N with N Poisson of mean C_h, half the
+            // shadowed light's column here (the hair's half thickness, the
+            // grid's one measure of it; without a grid the infinite sum),
+            // times Zinke's d_f:
+            //   d_f a_f (1 - exp(-(1 - a_f) C_h)) / (1 - a_f),
+            // spread at the series' mean depth 1 / (1 - a_f), capped by C_h.
+            vec3 deep = af / max(vec3(1.0) - af, vec3(0.05));
+            float meanDepth = 1.0 / max(1.0 - dot(af, vec3(0.2126, 0.7152, 0.0722)), 0.05);
+            vec3 chain = kForwardDensity * deep;
+            float reach = meanDepth;
+            if (column >= 0.0) {
+                float half_ = 0.5 * column;
+                chain = kForwardDensity * deep * (vec3(1.0) - exp(-(vec3(1.0) - af) * half_));
+                reach = min(meanDepth, max(half_, 1.0));
+            }
+            float spreadU = uShadowColor.w * reach;
+            vec3 f = fittedHair(albedo, t, l, v, 0.0) + chain * fittedHair(albedo, t, l, v, spreadU) +
+                     hairLobe(3, t, l, v, spreadU) * (column >= 0.0 ? vec3(1.0) - exp(-(vec3(1.0) - af * af) * 0.5 * column) : vec3(1.0));
+            color += f * radiance * headVisibility(i, world);
+            continue;
+        }
+        // The shadowed light: forward transmittance and spread through the
+        // C fibres in front, back-scatter from the C_b = column - C behind.
+        // Zinke's A_b sums paths into a half-space of hair; through C_b
+        // fibres the round trips a_f^2k stop after about C_b, the factor
+        // 1 - exp(-(1 - a_f^2) C_b) (Poisson mean of 1 - a_f^(2n)).
+        float spread = uShadowColor.w * front;
+        vec3 depthFactor = vec3(1.0) - exp(-(vec3(1.0) - af * af) * (column - front));
+        vec3 f = fittedHair(albedo, t, l, v, spread) + hairLobe(3, t, l, v, spread) * depthFactor;
+        color += f * radiance * exp(-uShadowColor.rgb * front) * headVisibility(i, world);
     }
     return color;
 }

@@ -2,7 +2,8 @@
 // render/view/view.cpp (the Embree reference calls that function), so preview and
 // reference shade the same model: kd*color*sin(t,l) + ks*spec*sin(t',h)^alpha
 // with h = normalize(l + v) (seed 004 eq. 4, 5) and the optional second,
-// shifted-tangent lobe.
+// shifted-tangent lobe; hairLobe() mirrors the fitted lobes of the same
+// family (render/view/view.cpp hairLobe, render/reference/hair_fit.h).
 
 float sinBetween(vec3 a, vec3 b) {
     float c = clamp(dot(a, b), -1.0, 1.0);
@@ -24,8 +25,36 @@ vec3 kajiyaKay(vec3 albedo, vec3 t, vec3 n, vec3 l, vec3 v) {
     vec3 diffuse = uHairColor.w * sinBetween(t, l) * albedo;
     vec3 specular = uSpecColor.w * pow(sinBetween(shiftedTangent(t, n, uHairShape.z), h), uHairShape.x) *
                     uSpecColor.rgb;
-    if (uCounts.w != 0)
+    if (uCounts.w == kHairKajiyaKayTwoLobes)
         specular += uSecondColor.w * pow(sinBetween(shiftedTangent(t, n, uHairShape.w), h), uHairShape.y) *
                     uSecondColor.rgb;
     return diffuse + specular;
+}
+
+// Fitted lobe k (render/view/view.cpp hairLobe): strength(|thetaO|) * cos(thetaI + thetaO - shift)^n'
+// * sqrt(n'/n) / sqrt(cos thetaI cos thetaO) * N(phi), N = w(m) ((1 + sign cos phi)/2)^m, with
+// 1/n' = 1/n + spread (rad^2): light spread by the fibres it crossed.
+vec3 hairLobe(int k, vec3 t, vec3 l, vec3 v, float spread) {
+    vec4 shape = uLobeShape[k];
+    float si = clamp(dot(t, l), -1.0, 1.0), so = clamp(dot(t, v), -1.0, 1.0);
+    float ci = sqrt(1.0 - si * si), co = sqrt(1.0 - so * so);
+    float c = (ci * co - si * so) * cos(shape.y) + (si * co + ci * so) * sin(shape.y);
+    if (c <= 0.0) return vec3(0.0);
+    float n = shape.x / (1.0 + shape.x * max(spread, 0.0));
+    float longitudinal = sqrt(n / shape.x) * pow(c, n) * inversesqrt(max(ci * co, 0.01));
+    vec3 lp = l - si * t, vp = v - so * t;
+    float norms = sqrt(dot(lp, lp) * dot(vp, vp));
+    float azimuthal = norms > 1e-12 ? abs(shape.w) * pow(max(0.0, 0.5 * (1.0 + sign(shape.w) * dot(lp, vp) / norms)), shape.z)
+                                    : 0.15915494;
+    float x = clamp(asin(abs(so)) * (16.0 / 3.14159265), 0.0, 8.0);  // |thetaO| in node units (11.25 deg)
+    int i = min(int(x), 7);
+    vec3 strength = mix(uLobeStrength[9 * k + i].rgb, uLobeStrength[9 * k + i + 1].rgb, x - float(i));
+    return strength * (longitudinal * azimuthal);
+}
+
+// The fitted single-fibre response (kajiyaKay() in HairShading::Fitted):
+// diffuse kd * albedo * cos(thetaI) plus R, TRT and TT, each spread by `spread`.
+vec3 fittedHair(vec3 albedo, vec3 t, vec3 l, vec3 v, float spread) {
+    return uHairColor.w * sinBetween(t, l) * albedo + hairLobe(0, t, l, v, spread) + hairLobe(1, t, l, v, spread) +
+           hairLobe(2, t, l, v, spread);
 }

@@ -1,9 +1,9 @@
 // Visibility of the shadowed light (seed 004, 2.3): hair transmittance
 // exp(-k C) = alpha^C from the summed voxel grid, times the PCF shadow map of
 // the head. C counts strand crossings in front of the point (or fragments,
-// the seed's count) and k = uShadow.x is the optical depth of one: 1 - T for
-// a per-crossing transmittance T (render/preview/preview.h says why), -ln(alpha) for
-// the seed's alpha.
+// the seed's count) and k = uShadowColor.rgb is the optical depth of one: 1 - T
+// for a per-crossing transmittance T (render/preview/preview.h says why),
+// -ln(alpha) for the seed's alpha, 1 - a_f per channel for the fitted hair.
 
 layout(binding = 0) uniform sampler3D uDensity;        // C (or V when the sum is off), trilinear
 layout(binding = 1) uniform sampler2DShadow uShadowMap; // head depth from the light, compare mode on
@@ -29,26 +29,43 @@ float shadowMapVisibility(vec3 world) {
 // average C over 2 x 2 voxels across the beam (a tent over ~3 x 3): regularly
 // spaced hair otherwise casts moire rings, since one-voxel-wide lines fill
 // neighbouring columns unevenly.
-float voxelDensity(vec3 world) {
-    vec3 g = lightGrid(world) - vec3(0.0, 0.0, 0.5 / uGridDepth.w);
+float voxelDensityAt(vec3 g) {
     if ((uCounts.z & kFlagVoxelFilter) == 0) return texture(uDensity, g).r;
     float h = 0.75 / uGridDepth.w;
     return 0.25 * (texture(uDensity, g + vec3(-h, -h, 0.0)).r + texture(uDensity, g + vec3(h, -h, 0.0)).r +
                    texture(uDensity, g + vec3(-h, h, 0.0)).r + texture(uDensity, g + vec3(h, h, 0.0)).r);
 }
 
+float voxelDensity(vec3 world) { return voxelDensityAt(lightGrid(world) - vec3(0.0, 0.0, 0.5 / uGridDepth.w)); }
+
+// Expected hair crossings C in front of a point toward light i (0 for an
+// unshadowed light or without the voxel grid).
+float hairCrossings(int light, vec3 world) {
+    if (light != uCounts.y || (uCounts.z & kFlagVoxels) == 0) return 0.0;
+    return voxelDensity(world);
+}
+
+// Expected crossings of the light's ray beyond the point (the hair behind
+// it, seen from the light): the whole column's C less the point's; -1 when
+// unknown (unshadowed light, no voxel grid).
+float hairCrossingsBehind(int light, vec3 world, float crossings) {
+    if (light != uCounts.y || (uCounts.z & kFlagVoxels) == 0) return -1.0;
+    vec3 g = lightGrid(world);
+    return max(voxelDensityAt(vec3(g.xy, 1.0 - 0.5 / uGridDepth.w)) - crossings, 0.0);
+}
+
+// The head's shadow map toward light i (1 unshadowed).
+float headVisibility(int light, vec3 world) {
+    if (light != uCounts.y || (uCounts.z & kFlagShadowMap) == 0) return 1.0;
+    return shadowMapVisibility(world);
+}
+
 // The head's own visibility: hair shadows only, as in the reference
 // (render/reference/embree_scene.h RayStart::throughHead: a low-poly head shadowing
 // itself cuts its smooth shading into a staircase along the terminator).
-float hairOnlyVisibility(int light, vec3 world) {
-    if (light != uCounts.y || (uCounts.z & kFlagVoxels) == 0) return 1.0;
-    return exp(-uShadow.x * voxelDensity(world));
-}
+// Coloured: exp(-k C) per channel, k = uShadowColor.rgb (1 - T for
+// Kajiya-Kay, 1 - a_f for the fitted hair: the light fibres scatter forward
+// reaches the skin, Zinke 2008's forward transmittance).
+vec3 hairOnlyVisibility(int light, vec3 world) { return exp(-uShadowColor.rgb * hairCrossings(light, world)); }
 
-float lightVisibility(int light, vec3 world) {
-    if (light != uCounts.y) return 1.0;
-    float v = 1.0;
-    if ((uCounts.z & kFlagVoxels) != 0) v *= exp(-uShadow.x * voxelDensity(world));
-    if ((uCounts.z & kFlagShadowMap) != 0) v *= shadowMapVisibility(world);
-    return v;
-}
+vec3 lightVisibility(int light, vec3 world) { return hairOnlyVisibility(light, world) * headVisibility(light, world); }

@@ -60,4 +60,33 @@ TEST(CompareReport, SidesAreLabelledFromTheScene) {
     }
 }
 
+// The gate pair and the diagnostic pair say which pair they are, in the
+// report and metrics.json; the diagnostic writes beside the gate, never
+// over it, and has no thresholds.
+TEST(CompareReport, GateAndDiagnosticPairsAreNamed) {
+    const Scene scene = Scene::parse("reference: {mode: physical, samples: 8, kajiya_kay: {enabled: true}}\n"
+                                     "compare: {diagnostic: reference/kajiya-kay.####.exr, max_flip: 0.5}\n",
+                                     "pairs.yaml", ".");
+    const CompareJob gate = compareJobFromScene(scene, "/tmp/shot");
+    EXPECT_EQ(gate.bLabel, "reference (Embree, physical, 8 spp)");
+    EXPECT_NE(gate.pair.find("gate"), std::string::npos) << gate.pair;
+    const std::optional<CompareJob> diag = diagnosticJobFromScene(scene, "/tmp/shot");
+    ASSERT_TRUE(diag);
+    EXPECT_EQ(diag->b, "/tmp/shot/reference/kajiya-kay.####.exr");
+    EXPECT_EQ(diag->bLabel, "reference (Embree, kajiya-kay, 8 spp)");
+    EXPECT_NE(diag->pair.find("same model, other visibility"), std::string::npos) << diag->pair;
+    EXPECT_EQ(diag->outputDir, gate.outputDir / "diagnostic");
+    EXPECT_NE(diag->report, gate.report);
+    EXPECT_EQ(diag->thresholds.maxFlip, 1.0);
+    EXPECT_NE(compareReportHtml(*diag, {}).find("same model, other visibility"), std::string::npos);
+    EXPECT_NE(metricsJson(*diag, {}).find("\"pair\": \"diagnostic, same model, other visibility"), std::string::npos);
+    EXPECT_NE(compareReportHtml(gate, {}).find(gate.pair), std::string::npos);
+    // None without the key; the gate's own sequence is refused.
+    EXPECT_FALSE(diagnosticJobFromScene(Scene::parse("", "pairs.yaml", "."), "/tmp/shot"));
+    EXPECT_THROW(diagnosticJobFromScene(Scene::parse("compare: {diagnostic: reference/reference.####.exr}\n",
+                                                     "pairs.yaml", "."),
+                                        "/tmp/shot"),
+                 SceneError);
+}
+
 }  // namespace hp

@@ -203,6 +203,7 @@ TEST(Schema, ReferencePageIsUpToDate) {
 
 #include "pipeline/scene/view_settings.h"
 #include "render/reference/hair_bsdf.h"
+#include "render/reference/hair_fit.h"
 
 TEST(SceneLists, DefaultListAndItemDefaults) {
     const Scene s = Scene::parse("", "shot.yaml", ".");
@@ -268,10 +269,23 @@ TEST(ViewSettings, DisplayAndMelaninKeys) {
     EXPECT_EQ(d.exposure, 1.5f);
     EXPECT_EQ(d.backdrop.kind, Backdrop::Kind::Gradient);
     EXPECT_TRUE(d.backdrop.top.isApprox(Vec3f(0.2f, 0.2f, 0.2f)));
-    // One key drives both renderers: the physical σa and the Kajiya-Kay colour.
+    // One key drives both renderers: the physical σa and the preview's
+    // material fitted to that fibre (render.hair.shading: fitted, the default)...
     const View v = makeView(s);
     EXPECT_TRUE(hairAbsorption(s).isApprox(hairAbsorptionFromMelanin(0.3f, 0.f)));
-    EXPECT_TRUE(v.hair.color.isApprox(hairColorFromAbsorption(hairAbsorptionFromMelanin(0.3f, 0.f), 0.3f)));
+    EXPECT_TRUE(hairFiber(s).sigmaA.isApprox(hairAbsorptionFromMelanin(0.3f, 0.f)));
+    EXPECT_EQ(v.hair.shading, HairShading::Fitted);
+    HairMaterial fitted;
+    fitHairMaterial(hairFiber(s), &fitted);
+    EXPECT_TRUE(v.hair.color.isApprox(fitted.color));
+    EXPECT_TRUE(v.hair.tt.strength[0].isApprox(fitted.tt.strength[0]));
+    EXPECT_FLOAT_EQ(v.hair.transmittance, fitted.dual.forward.dot(Vec3f(0.2126f, 0.7152f, 0.0722f)));
+    // ...or, in shading kajiya-kay, the Kajiya-Kay colour through Chiang's colour fit.
+    const Scene kk = Scene::parse("render:\n  hair: {melanin: 0.3, shading: kajiya-kay}\n", "shot.yaml", ".");
+    const View vk = makeView(kk);
+    EXPECT_EQ(vk.hair.shading, HairShading::KajiyaKay);
+    EXPECT_TRUE(vk.hair.color.isApprox(hairColorFromAbsorption(hairAbsorptionFromMelanin(0.3f, 0.f), 0.3f)));
+    EXPECT_FLOAT_EQ(vk.hair.transmittance, 0.8f);
     // A view the built-in transform does not know names the key and its line.
     const Scene bad = Scene::parse("render:\n  ocio:\n    view: nope\n", "shot.yaml", ".");
     try {

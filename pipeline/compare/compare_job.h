@@ -16,6 +16,7 @@
 #include "render/image/display_transform.h"
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,12 +48,21 @@ struct CompareJob {
     std::string aLabel, bLabel;
     /// A third sequence the report shows beside A and B without measuring it; empty: none.
     std::string beside, besideLabel;
+    /// Which pair this is and what it measures ("gate: preview against the
+    /// physical reference", "diagnostic: same model, other visibility"),
+    /// written into the report and metrics.json; empty: none.
+    std::string pair;
 };
 
 /// The job the scene's compare.* keys describe, with templates and folders
 /// resolved against the shot's output folder (stage_compare.cpp). Throws
 /// SceneError at compare.a / compare.b when a template has no frame number.
 CompareJob compareJobFromScene(const Scene& scene, const std::filesystem::path& outputDir);
+
+/// The diagnostic pair compare.diagnostic describes (compare.a against it,
+/// measured and reported in compare.output/diagnostic/, never failing the
+/// run), or nothing when compare.diagnostic is empty.
+std::optional<CompareJob> diagnosticJobFromScene(const Scene& scene, const std::filesystem::path& outputDir);
 
 /// The outcome for one frame.
 struct FrameRecord {

@@ -244,7 +244,9 @@ std::string compareReportHtml(const CompareJob& job, const std::vector<FrameReco
            "style-src 'unsafe-inline'; script-src 'unsafe-inline'\">\n"
         << "<title>hairpipe compare: " << verdict << "</title>\n<style>" << kStyle << "</style></head>\n"
         << "<body data-status=\"loading\">\n<h1>hairpipe compare: <span class=\"" << (s.pass() ? "pass" : "fail")
-        << "\">" << verdict << "</span></h1>\n"
+        << "\">" << verdict << "</span></h1>\n";
+    if (!job.pair.empty()) out << "<p class=\"pair\">" << html(job.pair) << "</p>\n";
+    out
         << "<table><tr><th class=\"l\">" << html(sideName("A", job.aLabel)) << "</th><td class=\"l\"><code>"
         << html(job.a) << "</code></td></tr>"
         << "<tr><th class=\"l\">" << html(sideName("B", job.bLabel)) << "</th><td class=\"l\"><code>"

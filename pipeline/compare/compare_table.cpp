@@ -153,7 +153,7 @@ std::string metricsJson(const CompareJob& job, const std::vector<FrameRecord>& r
     const CompareSummary s = summarize(records);
     const CompareThresholds& t = job.thresholds;
     std::ostringstream out;
-    out << "{\n  \"a\": " << jsonString(job.a) << ",\n  \"b\": " << jsonString(job.b) << ",\n"
+    out << "{\n  \"pair\": " << jsonString(job.pair) << ",\n  \"a\": " << jsonString(job.a) << ",\n  \"b\": " << jsonString(job.b) << ",\n"
         << "  \"settings\": {\"mask\": " << jsonString(maskName(job.settings.mask))
         << ", \"pixels_per_degree\": " << jsonNumber(job.settings.flip.pixelsPerDegree) << "},\n"
         << "  \"thresholds\": {\"max_flip\": " << jsonNumber(t.maxFlip) << ", \"min_psnr\": " << jsonNumber(t.minPsnr)

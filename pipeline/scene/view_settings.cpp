@@ -4,6 +4,9 @@
 #include "core/errors.h"
 #include "render/reference/environment_light.h"
 #include "render/reference/hair_bsdf.h"
+#include "render/reference/hair_fit.h"
+
+#include <algorithm>
 
 namespace hp {
 
@@ -74,6 +77,16 @@ View makeView(const Scene& s) {
         {"render.hair.secondary_color", &HairMaterial::secondaryColor},
         {"render.hair.transmittance", &HairMaterial::transmittance},
     });
+    // Fitted: the diffuse colour, lobes and dual scattering from the
+    // physical fibre (render/reference/hair_fit.h); the plain Kajiya-Kay
+    // keys above then only matter in mode kajiya-kay.
+    if (s.text("render.hair.shading") == "fitted") {
+        fitHairMaterial(hairFiber(s), &h);
+        // A shadow ray through a fibre keeps what the fibre scatters forward
+        // (Zinke 2008's a_f): the Kajiya-Kay reference's grey per-crossing
+        // transmittance, the preview's per channel.
+        h.transmittance = std::clamp(h.dual.forward.dot(Vec3f(0.2126f, 0.7152f, 0.0722f)), 0.f, 1.f);
+    }
 
     readKeys(s, v.head, {
         {"render.head.color", &SurfaceMaterial::color},
@@ -83,6 +96,16 @@ View makeView(const Scene& s) {
         {"render.head.shininess", &SurfaceMaterial::shininess},
     });
     return v;
+}
+
+HairFiberParams hairFiber(const Scene& s) {
+    HairFiberParams f;
+    f.longitudinalRoughness = float(s.number("reference.physical.roughness"));
+    f.azimuthalRoughness = float(s.number("reference.physical.azimuthal_roughness"));
+    f.cuticleTiltDegrees = float(s.number("reference.physical.cuticle_tilt"));
+    f.ior = float(s.number("reference.physical.ior"));
+    f.sigmaA = hairAbsorption(s);
+    return f;
 }
 
 float hairRoughness(const Scene& s) { return float(s.number("reference.physical.azimuthal_roughness")); }

@@ -3,6 +3,7 @@
 
 #include "pipeline/scene/scene.h"
 #include "render/image/display_transform.h"
+#include "render/reference/hair_bsdf.h"
 #include "render/view/view.h"
 
 namespace hp {
@@ -11,6 +12,13 @@ namespace hp {
 /// combinations single keys cannot check (camera target at its position,
 /// zero light direction).
 View makeView(const Scene& scene);
+
+/// The physical hair fibre, the one source of truth for hair optics: the
+/// physical reference renders it, and render.hair.shading: fitted derives
+/// the preview's (and the Kajiya-Kay reference's) material from it.
+/// Absorption from hairAbsorption(); roughness, tilt and index from
+/// reference.physical.*.
+HairFiberParams hairFiber(const Scene& scene);
 
 /// Absorption σa of the physical hair: render.hair.melanin when set (the one
 /// key that drives both renderers), else reference.physical.*.

@@ -1,7 +1,10 @@
 // The "compare" stage: compares two of the shot's sequences (compare.a and
 // compare.b, by default the preview against the reference) frame by frame,
 // and at the end of the run writes the tables and the HTML report for all
-// the run's frames and fails the run when a frame exceeds a threshold.
+// the run's frames and fails the run when a frame exceeds a threshold. A
+// second, diagnostic pair (compare.diagnostic: by default the Kajiya-Kay
+// reference, "same model, other visibility") is measured and reported beside
+// it in compare.output/diagnostic/ and never fails the run.
 #include "core/log.h"
 #include "pipeline/compare/compare_job.h"
 #include "pipeline/batch/path_template.h"
@@ -67,6 +70,27 @@ CompareJob compareJobFromScene(const Scene& scene, const fs::path& outputDir) {
     job.thresholds.maxRmse = scene.number("compare.max_rmse");
     job.reportWidth = int(scene.integer("compare.report_width"));
     job.display = makeDisplaySettings(scene);
+    job.pair = cat("gate: ", job.aLabel, " against ", job.bLabel,
+                   " (the thresholds apply to this pair)");
+    return job;
+}
+
+std::optional<CompareJob> diagnosticJobFromScene(const Scene& scene, const fs::path& outputDir) {
+    const std::string& t = scene.text("compare.diagnostic");
+    if (t.empty()) return std::nullopt;
+    if (!hasFrameToken(t)) scene.fail("compare.diagnostic", "'" + t + "' has no frame number (use #### or %04d)");
+    CompareJob job = compareJobFromScene(scene, outputDir);
+    if (resolved(outputDir, t) == job.b)
+        scene.fail("compare.diagnostic", "is the gate's own sequence compare.b; name another one or leave it empty");
+    job.b = resolved(outputDir, t);
+    job.bLabel = sequenceLabel(scene, outputDir, "compare.diagnostic");
+    job.beside.clear();
+    job.besideLabel.clear();
+    job.thresholds = CompareThresholds{};
+    job.outputDir = job.outputDir / "diagnostic";
+    if (!job.report.empty()) job.report = job.report.parent_path() / "diagnostic.html";
+    job.pair = cat("diagnostic, ", scene.text("compare.diagnostic_pair"), ": ", job.aLabel, " against ", job.bLabel,
+                   " (no thresholds; the gate is ", scene.text("compare.b"), ")");
     return job;
 }
 
@@ -74,10 +98,16 @@ namespace {
 
 class CompareStage final : public FrameStage {
   public:
-    explicit CompareStage(CompareJob job) : job_(std::move(job)) {}
+    CompareStage(CompareJob job, std::optional<CompareJob> diagnostic)
+        : job_(std::move(job)), diagnostic_(std::move(diagnostic)) {}
 
     std::string name() const override { return "compare"; }
-    std::vector<fs::path> outputs(int frame) const override { return frameOutputs(job_, frame); }
+    std::vector<fs::path> outputs(int frame) const override {
+        std::vector<fs::path> out = frameOutputs(job_, frame);
+        if (diagnostic_)
+            for (fs::path& p : frameOutputs(*diagnostic_, frame)) out.push_back(std::move(p));
+        return out;
+    }
     bool needsFrameData() const override { return false; }
 
     void run(const FrameData& data) override {
@@ -86,9 +116,15 @@ class CompareStage final : public FrameStage {
         // resumed run skips); a warning here gives early notice.
         for (const std::string& f : checkThresholds(r.metrics, job_.thresholds))
             logWarning("frame ", data.frame, " compare: ", f);
+        if (diagnostic_) compareFrame(*diagnostic_, data.frame);
     }
 
     void finish(const ShotSettings& shot) override {
+        if (diagnostic_) {
+            std::vector<FrameRecord> diagnostic;
+            for (int frame : shot.frames) diagnostic.push_back(loadFrameRecord(*diagnostic_, frame));
+            finishCompare(*diagnostic_, diagnostic);
+        }
         std::vector<FrameRecord> records;
         for (int frame : shot.frames) records.push_back(loadFrameRecord(job_, frame));
         finishCompare(job_, records);
@@ -109,14 +145,16 @@ class CompareStage final : public FrameStage {
 
   private:
     CompareJob job_;
+    std::optional<CompareJob> diagnostic_;
 };
 
 }  // namespace
 
 StagePtr makeCompareStage(const Scene& scene, const ShotSettings& shot) {
     CompareJob job = compareJobFromScene(scene, shot.outputDir);  // validates even when disabled
+    std::optional<CompareJob> diagnostic = diagnosticJobFromScene(scene, shot.outputDir);
     if (!scene.flag("compare.enabled")) return nullptr;
-    return std::make_unique<CompareStage>(std::move(job));
+    return std::make_unique<CompareStage>(std::move(job), std::move(diagnostic));
 }
 
 }  // namespace hp

@@ -57,12 +57,7 @@ ReferenceSettings referenceSettings(const Scene& s, const ShotSettings& shot) {
                                                                                         : UnshadowedLights::Shadowed;
     r.diffuseSpecularLayers = s.flag("reference.layers.diffuse_specular");
     r.strandIdLayer = s.flag("reference.layers.strand_id");
-    HairFiberParams& f = r.fiber;
-    f.longitudinalRoughness = float(s.number("reference.physical.roughness"));
-    f.azimuthalRoughness = float(s.number("reference.physical.azimuthal_roughness"));
-    f.cuticleTiltDegrees = float(s.number("reference.physical.cuticle_tilt"));
-    f.ior = float(s.number("reference.physical.ior"));
-    f.sigmaA = hairAbsorption(s);
+    r.fiber = hairFiber(s);
     return r;
 }
 

@@ -199,6 +199,20 @@ struct PreviewRenderer::Impl {
                                        : -std::log(std::clamp(sh.alpha, 1e-6f, 1.f));
         set4(u.shadow, depthPerUnit, float(std::max(0, sh.pcfRadius)), 1.f / float(std::max(1, sh.shadowMapSize)),
              0.002f);
+        // Fitted hair: each crossing keeps the light the fibre scatters
+        // forward, a_f per colour, and spreads it by β_f² (Zinke 2008).
+        const bool fittedHair = h.shading == HairShading::Fitted;
+        if (fittedHair && sh.weight == VoxelWeight::Crossings)
+            set3(u.shadowColor, Vec3f::Ones() - h.dual.forward.cwiseMin(Vec3f::Ones()), h.dual.forwardVariance);
+        else
+            set4(u.shadowColor, depthPerUnit, depthPerUnit, depthPerUnit, fittedHair ? h.dual.forwardVariance : 0.f);
+        const HairLobe* lobes[4] = {&h.r, &h.trt, &h.tt, &h.dual.back};
+        for (int k = 0; k < 4; ++k) {
+            const HairLobe& lobe = *lobes[k];
+            set4(u.lobeShape[k], lobe.exponent, lobe.shift, lobe.azimuthPower, lobe.azimuthSign * lobe.azimuthNorm);
+            for (int node = 0; node < kHairLobeNodes; ++node)
+                set3(u.lobeStrength[k * kHairLobeNodes + node], lobe.strength[size_t(node)], 0.f);
+        }
         set4(u.tess, float(std::clamp(settings.tessellationLevel, 1, 64)), settings.tessellationPixels * float(ss),
              settings.curve == CurveType::BSpline ? 1.f : 0.f, settings.minPixelWidth * float(ss));
         set4(u.blend, blendReference, std::max(settings.blendDepthScale, 1e-5f), 0.f, 0.f);
@@ -209,7 +223,7 @@ struct PreviewRenderer::Impl {
              float(std::clamp(g.innerLevel, 1, 64)));
         set4(u.furLevels, float(std::clamp(g.outerLevel, 1, 64)), 0.f, 0.f, 0.f);
         u.counts[0] = int(lights);
-        u.counts[3] = h.twoLobes ? 1 : 0;
+        u.counts[3] = h.shading == HairShading::Fitted ? kHairFitted : h.twoLobes ? kHairKajiyaKayTwoLobes : kHairKajiyaKay;
     }
 
     void drawStrands(const GlProgram& program) {

@@ -35,12 +35,19 @@ struct FrameUniforms {
     float wind[4];
     float furTime[4];
     float furLevels[4];
+    float lobeShape[4][4];
+    float lobeStrength[4 * kHairLobeNodes][4];
+    float shadowColor[4];
     int counts[4];
 };
 
 inline constexpr int kFlagVoxels = 1;
 inline constexpr int kFlagShadowMap = 2;
 inline constexpr int kFlagVoxelFilter = 4;
+/// FrameUniforms::counts[3], the hair model (kHair* in shaders/common.glsl).
+inline constexpr int kHairKajiyaKay = 0;
+inline constexpr int kHairKajiyaKayTwoLobes = 1;
+inline constexpr int kHairFitted = 2;
 /// Fixed point of the r32ui voxel grid (kVoxelUnit in shaders/common.glsl).
 inline constexpr float kVoxelUnit = 4096.f;
 

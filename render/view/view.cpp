@@ -116,10 +116,50 @@ Vec3f shifted(const Vec3f& t, const Vec3f& n, float shift) {
 }
 }  // namespace
 
+bool HairLobe::empty() const {
+    for (const Vec3f& k : strength)
+        if (k.maxCoeff() > 0.f) return false;
+    return true;
+}
+
+Vec3f HairLobe::strengthAt(float absThetaO) const {
+    const float x = std::clamp(absThetaO / float(0.5 * M_PI), 0.f, 1.f) * float(kHairLobeNodes - 1);
+    const int i = std::min(int(x), kHairLobeNodes - 2);
+    const float f = x - float(i);
+    return (1.f - f) * strength[size_t(i)] + f * strength[size_t(i) + 1];
+}
+
+Vec3f hairLobe(const HairLobe& lobe, const Vec3f& t, const Vec3f& l, const Vec3f& v, float extraVariance) {
+    const float si = std::clamp(t.dot(l), -1.f, 1.f), so = std::clamp(t.dot(v), -1.f, 1.f);
+    const float ci = std::sqrt(1.f - si * si), co = std::sqrt(1.f - so * so);
+    // cos(θi + θo − shift) from the sines and cosines the dot products give.
+    const float cosSum = ci * co - si * so, sinSum = si * co + ci * so;
+    const float c = cosSum * std::cos(lobe.shift) + sinSum * std::sin(lobe.shift);
+    if (c <= 0.f) return Vec3f::Zero();
+    const float n = lobe.exponent;
+    const float nSpread = n / (1.f + n * std::max(extraVariance, 0.f));  // 1/n' = 1/n + σ²
+    const float longitudinal = std::sqrt(nSpread / n) * std::pow(c, nSpread) / std::sqrt(std::max(ci * co, 0.01f));
+    // Azimuth: the light's and the viewer's directions projected into the
+    // normal plane; along the fibre the azimuth is undefined and N its mean.
+    const Vec3f lp = l - si * t, vp = v - so * t;
+    const float norms = std::sqrt(lp.squaredNorm() * vp.squaredNorm());
+    const float azimuthal =
+        norms > 1e-12f ? lobe.azimuthNorm * std::pow(std::max(0.f, 0.5f * (1.f + lobe.azimuthSign * lp.dot(vp) / norms)),
+                                                     lobe.azimuthPower)
+                       : 0.5f / float(M_PI);
+    return lobe.strengthAt(std::asin(std::abs(so))) * (longitudinal * azimuthal);
+}
+
 Vec3f kajiyaKay(const HairMaterial& m, const Vec3f& t, const Vec3f& n, const Vec3f& l, const Vec3f& v,
                 Vec3f* diffuseOut, Vec3f* specularOut) {
-    const Vec3f h = (l + v).normalized();
     const Vec3f diffuse = m.kd * sinBetween(t, l) * m.color;
+    if (m.shading == HairShading::Fitted) {
+        const Vec3f lobes = hairLobe(m.r, t, l, v) + hairLobe(m.trt, t, l, v) + hairLobe(m.tt, t, l, v);
+        if (diffuseOut) *diffuseOut = diffuse;
+        if (specularOut) *specularOut = lobes;
+        return diffuse + lobes;
+    }
+    const Vec3f h = (l + v).normalized();
     Vec3f specular = m.ks * std::pow(sinBetween(shifted(t, n, m.primaryShift), h), m.shininess) * m.specularColor;
     if (m.twoLobes) {
         specular += m.secondaryKs * std::pow(sinBetween(shifted(t, n, m.secondaryShift), h), m.secondaryShininess) *

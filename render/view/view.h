@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -119,8 +120,60 @@ struct EnvironmentMap {
     bool empty() const { return !rgb || width <= 0 || height <= 0; }
 };
 
+/// How hair is shaded: Kajiya-Kay's hand-set terms, or the same family with
+/// every term fitted to the physical fibre (render/reference/hair_fit.h).
+enum class HairShading { KajiyaKay, Fitted };
+
+/// Nodes of a fitted lobe's strength table over |θo|: 0°, 11.25°, ..., 90°.
+inline constexpr int kHairLobeNodes = 9;
+
+/// One fitted lobe of the Kajiya-Kay family (render/reference/hair_fit.h):
+///   k(|θo|) cos(θi + θo − shift)^exponent / √(cos θi cos θo) · N(φ),
+/// Kajiya & Kay 1989's specular cone, moved along the fibre by a shift angle
+/// as Scheuermann 2004 moves it with a shifted tangent; 1/√(cos θi cos θo) is
+/// the large-argument form of d'Eon et al. 2011's longitudinal lobe (whose
+/// Bessel I0(x) ≈ e^x/√(2πx)) and k(|θo|) the lobe's attenuation (Fresnel,
+/// absorption along the refracted path), which depends on θo alone in Chiang
+/// et al. 2016, tabulated at kHairLobeNodes angles and interpolated linearly.
+/// N(φ) = w(m) ((1 + sign cos φ)/2)^m is normalised to ∫ N dφ = 1 (sign +1:
+/// back toward the light, −1: forward, through the fibre; m = 1/2 is a smooth
+/// fibre's reflection |cos(φ/2)|/4). θ are angles to the fibre's normal plane
+/// (sin θ = t·w), φ the azimuth between light and view around the fibre.
+struct HairLobe {
+    std::array<Vec3f, kHairLobeNodes> strength{};  ///< k (1/sr) at |θo| = 90° i / (nodes − 1)
+    float exponent = 1.f;
+    float shift = 0.f;               ///< radians, peak at θi + θo = shift
+    float azimuthPower = 0.f;        ///< m
+    float azimuthSign = 1.f;         ///< +1 backward, −1 forward
+    float azimuthNorm = 0.f;         ///< w(m) = Γ(m+1) / (2√π Γ(m+½))
+
+    bool empty() const;
+    /// k at |θo| = `absThetaO` (radians), linear between the nodes.
+    Vec3f strengthAt(float absThetaO) const;
+    void setStrength(const Vec3f& k) { strength.fill(k); }
+};
+
+/// Zinke, Yuksel, Weber and Keyser 2008's dual-scattering constants of a
+/// fibre (render/reference/hair_fit.h derives them from the physical BSDF),
+/// averaged over the longitudinal angle. A point behind C expected fibre
+/// crossings toward a light receives the forward-scattered light
+/// T_f = exp(−(1 − a_f) C) (a_f^n averaged over Poisson crossing counts n),
+/// spread by the longitudinal variance σ_f² = C β_f², plus the light that the
+/// fibres around it scatter back (the `back` lobe).
+struct HairDualScattering {
+    Vec3f forward = Vec3f::Ones();  ///< a_f: fraction of light one fibre scatters forward
+    float forwardVariance = 0.f;    ///< β_f² (rad²): longitudinal spread per fibre crossed
+    HairLobe back;                  ///< d_b f_back: local multiple back-scattering, a lobe of the same family
+};
+
 /// Kajiya-Kay hair material. The preview's GLSL (shaders/) mirrors kajiyaKay().
 struct HairMaterial {
+    /// KajiyaKay: the terms below as set. Fitted: diffuse kd·color·cos θi
+    /// plus the lobes r, trt, tt (hair_fit.h); kd = 1, color the fitted
+    /// diffuse colour; the plain specular fields are unused.
+    HairShading shading = HairShading::KajiyaKay;
+    HairLobe r, trt, tt;  ///< fitted: reflection (white), TRT (coloured), transmission (back light)
+    HairDualScattering dual;
     Vec3f color{0.35f, 0.22f, 0.12f};          ///< diffuse albedo (linear)
     Vec3f specularColor{1.f, 1.f, 1.f};
     float kd = 0.6f;                            ///< diffuse weight
@@ -195,8 +248,18 @@ std::vector<Light> threePointRig();
 /// Reflected radiance factor of Kajiya-Kay for tangent `t`, normal `n` (the
 /// shading normal used only to shift tangents), unit direction to the light
 /// `l` and to the viewer `v`: kd * color * sin(t,l) + ks * spec * sin(t,h)^alpha
-/// (seed 004), with h = normalize(l + v). Multiply by the light's radiance.
+/// (Kajiya & Kay 1989, with Scheuermann 2004's half vector h = normalize(l + v)).
+/// Multiply by the light's radiance. HairShading::Fitted: kd * color * sin(t,l)
+/// plus the fitted lobes (hairLobe), in the physical BSDF's units, so it
+/// approximates HairBsdf::eval averaged over the fibre's width (no π factor);
+/// `specularOut` then receives the lobes.
 Vec3f kajiyaKay(const HairMaterial& m, const Vec3f& t, const Vec3f& n, const Vec3f& l, const Vec3f& v,
                 Vec3f* diffuseOut = nullptr, Vec3f* specularOut = nullptr);
+
+/// One fitted lobe (HairLobe) for unit tangent t and unit directions l, v;
+/// `extraVariance` (rad²) widens the cone as light spread by the fibres it
+/// crossed (Zinke 2008: variances add; the strength is rescaled so the lobe
+/// keeps its integral, cos^n x ≈ exp(−n x²/2) having the integral √(2π/n)).
+Vec3f hairLobe(const HairLobe& lobe, const Vec3f& t, const Vec3f& l, const Vec3f& v, float extraVariance = 0.f);
 
 }  // namespace hp
