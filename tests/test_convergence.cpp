@@ -1,8 +1,8 @@
 // The reference renderer's sampling (render/reference/pixel_filter.h,
 // render/reference/adaptive_sampling.h, the passes of reference.cpp): the
 // filter's samples follow the filter, the error estimate and the dilation
-// do what Cycles' do, the path tracer's error falls as 1/√n against an
-// independent high-sample image, two seeds at a noise threshold agree within
+// do what Cycles' do, the path tracer's error falls at least as 1/√n
+// against an independent high-sample image, two seeds at a noise threshold agree within
 // it, and adaptive images keep the same bits on one and two threads.
 #include "render_support.h"
 #include "test_support.h"
@@ -27,7 +27,11 @@ using namespace hp::test;
 namespace {
 
 /// The physical hair-on-head shot the convergence tests render: 3000
-/// strands on a sphere, one shadowed key light, two bounces.
+/// strands on a sphere, one shadowed key light of 8° angular diameter (a
+/// light with size, sampled by MIS: with a delta light, paths skin → glossy
+/// hair → light are found only by chance and their variance is
+/// heavy-tailed, so no estimator converges as 1/√n at these counts), two
+/// bounces.
 struct PhysicalShot {
     HairOnHead shot;
     ReferenceSettings settings;
@@ -35,6 +39,7 @@ struct PhysicalShot {
 
 PhysicalShot physicalShot(int width, int height) {
     PhysicalShot p{hairOnHead(width, height), {}};
+    p.shot.view.lights[0].angle = 8.f;
     p.settings.mode = ReferenceMode::Physical;
     p.settings.bounces = 2;
     p.settings.fiber.sigmaA = hairAbsorptionFromMelanin(0.3f, 0.1f);  // blond: long, bright paths
@@ -123,22 +128,25 @@ TEST(AdaptiveSampling, DilationKeepsTheNeighboursOfActivePixelsSampling) {
 }
 
 TEST(Convergence, ErrorFallsAsOneOverRootN) {
-    // Independent seeds: the N-sample image against a 1024-sample one of
+    // Independent seeds: the N-sample image against a 4096-sample one of
     // another seed. A same-seed reference would share its first samples
     // and read too clean. The reference's own variance is 1/32 of the
-    // 32-sample image's, which moves the slope by under 0.02.
+    // 128-sample image's, which moves the slope by under 0.02. Below 16
+    // samples the estimate is not yet Gaussian (a path through the hair to
+    // the light is a rare, bright sample), so the fit starts there.
     PhysicalShot p = physicalShot(40, 30);
     ReferenceSettings ref = p.settings;
-    ref.samplesPerPixel = 1024;
+    ref.samplesPerPixel = 4096;
     ref.seed = 99;
     const Image truth = render(p, ref);
     std::vector<double> logN, logE;
-    for (int n : {4, 8, 16, 32}) {
+    for (int n : {16, 32, 64, 128}) {
         ReferenceSettings s = p.settings;
         s.samplesPerPixel = n;
         s.seed = 7;
         logN.push_back(std::log(double(n)));
         logE.push_back(std::log(rmse(render(p, s), truth)));
+        std::printf("%d spp: RMSE %.5f\n", n, std::exp(logE.back()));
     }
     // Least-squares slope of log RMSE against log n.
     const double mn = std::accumulate(logN.begin(), logN.end(), 0.0) / 4.0;
@@ -147,7 +155,16 @@ TEST(Convergence, ErrorFallsAsOneOverRootN) {
     for (size_t i = 0; i < 4; ++i) sxy += (logN[i] - mn) * (logE[i] - me), sxx += (logN[i] - mn) * (logN[i] - mn);
     const double slope = sxy / sxx;
     std::printf("log-log slope of RMSE against samples: %.3f\n", slope);
-    EXPECT_NEAR(slope, -0.5, 0.1);
+    // Monte Carlo's 1/√n is the slowest an unbiased sampler without
+    // fireflies converges (the renderer of before, with unshadowed lights
+    // inside the path tracer, fell as n^-0.38 and is what the upper bound
+    // catches). Owen-scrambled Sobol' points converge faster where the
+    // integrand is low-dimensional (pixel coverage, direct light): up to
+    // n^-0.75 for discontinuous integrands (Owen 1997), measured here about
+    // n^-0.7. A slope steeper than that would mean the "truth" shares
+    // samples with the images.
+    EXPECT_LT(slope, -0.4);
+    EXPECT_GT(slope, -0.8);
 }
 
 TEST(Convergence, TwoSeedsAtTheThresholdAgreeWithinIt) {
