@@ -42,7 +42,7 @@ const int kHairKajiyaKayTwoLobes = 1;
 const int kHairFitted = 2;
 
 // Fixed point of the r32ui voxel grid: this many units make 1 (one strand
-// crossing, or one fragment in the seed's count). Mirrors kVoxelUnit in
+// crossing, or one fragment in Dehlin and Styngberg's count). Mirrors kVoxelUnit in
 // render/preview/preview_gpu.h.
 const float kVoxelUnit = 4096.0;
 

@@ -1,4 +1,4 @@
-// Generated hair (seed 004, 2.1.3): one strand per tessellated triangle, from
+// Generated hair (Dehlin and Styngberg 2017, 2.1.3): one strand per tessellated triangle, from
 // its centre along its mean normal; after each segment the direction turns
 // toward the force: d <- normalize(d + weight * force). The hair type (colour,
 // segment count and length, force weight, root and tip radius) is read from

@@ -1,5 +1,5 @@
 // Generated hair: the PN-triangle (Vlachos et al. 2001) control net of a head
-// triangle (seed 004, 2.1.2): cubic Bezier position coefficients b_ijk from the
+// triangle (Dehlin and Styngberg 2017, 2.1.2): cubic Bezier position coefficients b_ijk from the
 // corners and their normals, quadratic normal coefficients n_ijk, and the
 // inner/outer tessellation levels. The triangle's hair type comes along.
 #include "common.glsl"

@@ -1,4 +1,4 @@
-// Generated hair: a point of the PN triangle (seed 004 eqs. for p(u,v) and
+// Generated hair: a point of the PN triangle (Dehlin and Styngberg 2017 eqs. for p(u,v) and
 // n(u,v)); u, v, w weight corners 1, 2, 3.
 #include "common.glsl"
 

@@ -1,7 +1,7 @@
 // Kajiya-Kay hair shading, a line-for-line mirror of kajiyaKay() in
 // render/view/view.cpp (the Embree reference calls that function), so preview and
 // reference shade the same model: kd*color*sin(t,l) + ks*spec*sin(t',h)^alpha
-// with h = normalize(l + v) (seed 004 eq. 4, 5) and the optional second,
+// with h = normalize(l + v) (Dehlin and Styngberg 2017 eq. 4, 5) and the optional second,
 // shifted-tangent lobe; hairLobe() mirrors the fitted lobes of the same
 // family (render/view/view.cpp hairLobe, render/reference/hair_fit.h).
 

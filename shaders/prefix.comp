@@ -1,7 +1,7 @@
-// Sums the voxel grid along the light's depth (seed 004 eq. 7): for each
+// Sums the voxel grid along the light's depth (Dehlin and Styngberg 2017 eq. 7): for each
 // column, C at voxel z = sum of V over voxels strictly in front of it (the
 // light reaching its front face is alpha^C). With uSum = 0 it copies V
-// instead, the seed's look at the bare voxelization.
+// instead, Dehlin and Styngberg's look at the bare voxelization.
 #include "common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;

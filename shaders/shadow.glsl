@@ -1,9 +1,9 @@
-// Visibility of the shadowed light (seed 004, 2.3): hair transmittance
+// Visibility of the shadowed light (Dehlin and Styngberg 2017, 2.3): hair transmittance
 // exp(-k C) = alpha^C from the summed voxel grid, times the PCF shadow map of
 // the head. C counts strand crossings in front of the point (or fragments,
-// the seed's count) and k = uShadowColor.rgb is the optical depth of one: 1 - T
+// Dehlin and Styngberg's count) and k = uShadowColor.rgb is the optical depth of one: 1 - T
 // for a per-crossing transmittance T (render/preview/preview.h says why),
-// -ln(alpha) for the seed's alpha, 1 - a_f per channel for the fitted hair.
+// -ln(alpha) for Dehlin and Styngberg's alpha, 1 - a_f per channel for the fitted hair.
 
 layout(binding = 0) uniform sampler3D uDensity;        // C (or V when the sum is off), trilinear
 layout(binding = 1) uniform sampler2DShadow uShadowMap; // head depth from the light, compare mode on

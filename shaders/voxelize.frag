@@ -1,4 +1,4 @@
-// Hair voxelization from the light's view (seed 004, 2.3.1): each fragment of
+// Hair voxelization from the light's view (Dehlin and Styngberg 2017, 2.3.1): each fragment of
 // a strand updates the r32ui grid with image atomics, in fixed point
 // (kVoxelUnit = 1):
 //   uMode 0  binary, nearest:     the fragment's voxel is set to w (the largest w wins)

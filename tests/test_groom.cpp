@@ -215,8 +215,8 @@ TEST(Settle, ConvergesLiesOnTheHeadHoldsStillAndIsReusedByteForByte) {
     // M = guides × N·ρ·πr² × L (the rod's mass, from the scene's keys).
     const double r = s.number("hair.radius.root"),
                  mu = s.number("hair.material.hairs_per_guide") * s.number("hair.material.density") * M_PI * r * r,
-                 v = s.number("hair.groom.settle_speed");
-    EXPECT_LT(stats.settleEnergy, 0.5 * 24 * mu * s.number("hair.guides.length") * v * v);
+                 speed = s.number("hair.groom.settle_speed");
+    EXPECT_LT(stats.settleEnergy, 0.5 * 24 * mu * s.number("hair.guides.length") * speed * speed);
     EXPECT_FALSE(stats.settleCached);
     ASSERT_TRUE(fs::is_regular_file(cache));
     const std::string bytes = readFile(cache);

@@ -1,4 +1,4 @@
-// Generated hair (seed 004, "Badhairday"): short hair and fur grown on the GPU
+// Generated hair (Dehlin and Styngberg 2017, "Badhairday"): short hair and fur grown on the GPU
 // from the head mesh itself, with no simulation. The region's triangles are
 // tessellated as PN triangles (cubic Bezier positions, quadratic normals) and
 // one strand is grown per generated triangle in a geometry shader, bending

@@ -1,5 +1,5 @@
 // The shadowed light's view of the scene: one mapping from world space to a
-// unit cube used by both the voxel grid (seed 004's self-shadowing) and the
+// unit cube used by both the voxel grid (Dehlin and Styngberg's self-shadowing) and the
 // shadow map. Plain CPU code, so tests can voxelize on the CPU with exactly
 // the mapping the GPU used.
 #pragma once

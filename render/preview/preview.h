@@ -1,4 +1,4 @@
-// The real-time preview pass (seed 004): strands and generated hair drawn with
+// The real-time preview pass (Dehlin and Styngberg 2017): strands and generated hair drawn with
 // OpenGL 4.5 core — isoline tessellation, camera-facing ribbons, Kajiya-Kay
 // shading, voxel self-shadows plus a PCF shadow map of the head — into an
 // offscreen multisampled framebuffer, read back as an Image.
@@ -34,7 +34,7 @@
 //   which lets hair deep in the volume tint the front (unsorted, cheaper).
 //   Opaque head fragments hide the hair behind them through the depth test.
 // - Shadows of one light: the hair voxelized from the light into an r32ui 3D
-//   texture with image atomics (seed 004's binary/additive, nearest/trilinear),
+//   texture with image atomics (Dehlin and Styngberg's binary/additive, nearest/trilinear),
 //   summed along the light in a compute pass, transmittance alpha^C; times a
 //   PCF shadow map of the head. Point lights use a perspective frustum.
 // - Output: R, G, B premultiplied linear radiance (the environment colour
@@ -66,7 +66,7 @@ enum class HairBlend { Sorted, Weighted };
 enum class VoxelSplat { Nearest, Trilinear };
 /// What a voxel counts: expected strand crossings of a light ray (each
 /// fragment weighted by its strand's projected area in the voxel's column),
-/// or fragments (seed 004: each fragment adds 1, whatever the hair's width).
+/// or fragments (Dehlin and Styngberg 2017: each fragment adds 1, whatever the hair's width).
 enum class VoxelWeight { Crossings, Fragments };
 
 /// Shadows of the one shadowed light (other lights are unshadowed).
@@ -75,8 +75,8 @@ struct PreviewShadowSettings {
     bool voxels = true;           ///< hair self-shadowing through the voxel grid
     VoxelMode mode = VoxelMode::Additive;
     VoxelSplat splat = VoxelSplat::Nearest;
-    /// Sum the grid along the light (the seed's C); false shades with the raw
-    /// voxel value V, the seed's visualisation of the voxelization itself.
+    /// Sum the grid along the light (Dehlin and Styngberg's C); false shades with the raw
+    /// voxel value V, Dehlin and Styngberg's visualisation of the voxelization itself.
     bool sumAlongLight = true;
     int resolution = 256;         ///< voxels along each axis of the light's box
     /// Average C over 2 x 2 voxels across the beam at lookup: hides the moire
@@ -87,7 +87,7 @@ struct PreviewShadowSettings {
     /// counts as one crossing of its widest strand), and light reaching the
     /// point is exp(-(1 - T) C) with T = View::hair.transmittance, the
     /// reference renderer's per-crossing transmittance: both renderers derive
-    /// hair shadows from that one parameter. Fragments: the seed's count,
+    /// hair shadows from that one parameter. Fragments: Dehlin and Styngberg's count,
     /// light = alpha^C with the `alpha` below.
     VoxelWeight weight = VoxelWeight::Crossings;
     /// Fragments only: transmittance per counted fragment (or occupied voxel).

@@ -71,7 +71,7 @@ void onKey(GLFWwindow* window, int key, int, int action, int) {
         case GLFW_KEY_G: s.generated.enabled = !s.generated.enabled; break;
         case GLFW_KEY_H: s.drawHead = !s.drawHead; break;
         case GLFW_KEY_F: s.shadePerFragment = !s.shadePerFragment; break;
-        case GLFW_KEY_B:  // the seed's three voxelizations, in turn
+        case GLFW_KEY_B:  // Dehlin and Styngberg's three voxelizations, in turn
             if (sh.mode == VoxelMode::Binary) sh.mode = VoxelMode::Additive, sh.splat = VoxelSplat::Nearest;
             else if (sh.splat == VoxelSplat::Nearest) sh.splat = VoxelSplat::Trilinear;
             else sh.mode = VoxelMode::Binary, sh.splat = VoxelSplat::Nearest;

@@ -1,6 +1,6 @@
 // The interactive preview viewer: the same GL pass as the preview stage, in a
 // GLFW window, with play/pause, frame scrubbing, an orbit camera and toggles
-// for the seed's shadow variants. A scripted mode (exitAfter) renders a few
+// for Dehlin and Styngberg's shadow variants. A scripted mode (exitAfter) renders a few
 // frames, saves a screenshot and quits, for tests and remote checks.
 #pragma once
 
