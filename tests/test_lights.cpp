@@ -311,24 +311,43 @@ TEST(EnvironmentLight, LoadsAnExrAndNamesABrokenFile) {
 
 // --------------------------------------------------------- first-hit lights --
 
+namespace {
+
+/// `strands` synthetic strands on a 0.1 m sphere head, seen from
+/// (0, 0.05, 0.9), lit only by one directional light from (−1, −1, −1)
+/// marked unshadowed, black environment.
+struct HairUnderOneLight {
+    StrandFrame strands;
+    TriangleMesh head;
+    View view;
+};
+
+HairUnderOneLight hairUnderOneUnshadowedLight(size_t strands, int width, int height) {
+    SyntheticHairSettings hs;
+    hs.strands = strands;
+    HairUnderOneLight h{makeSyntheticHair(hs), makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32), View{}};
+    h.view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
+    h.view.camera.width = width;
+    h.view.camera.height = height;
+    h.view.environment = Vec3f::Zero();
+    h.view.lights = {Light{}};
+    h.view.lights[0].direction = Vec3f(-1.f, -1.f, -1.f);
+    h.view.lights[0].castsShadows = false;
+    return h;
+}
+
+}  // namespace
+
 TEST(Lights, FirstHitLightsNeverContributeAfterABounce) {
     // Hair on a head, lit only by a light marked unshadowed. With first-hit,
     // a path with bounces must give exactly the picture of direct light alone
     // and unshadowed (nothing after the first hit), while the shadowed default
     // shows that this scene does have light after a bounce.
-    SyntheticHairSettings hs;
-    hs.strands = 3000;
-    const StrandFrame strands = makeSyntheticHair(hs);
-    const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
-    View view;
-    view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
-    view.camera.width = 48;
-    view.camera.height = 32;
-    view.environment = Vec3f::Zero();
+    const HairUnderOneLight shot = hairUnderOneUnshadowedLight(3000, 48, 32);
+    const StrandFrame& strands = shot.strands;
+    const TriangleMesh& head = shot.head;
+    View view = shot.view;
     view.head.color = Vec3f::Ones();
-    view.lights = {Light{}};
-    view.lights[0].direction = Vec3f(-1.f, -1.f, -1.f);
-    view.lights[0].castsShadows = false;
     ReferenceSettings s;
     s.mode = ReferenceMode::Physical;
     s.samplesPerPixel = 16;
@@ -413,18 +432,10 @@ TEST(Lights, ShadowRouletteOnlyWhereAShadowRayIsTraced) {
     // noise for skipped shadow rays; a light sample that traces no shadow
     // ray (a first-hit light, or shadows off) must not pay that noise: its
     // image may not depend on the threshold. With shadow rays it does.
-    SyntheticHairSettings hs;
-    hs.strands = 600;
-    const StrandFrame strands = makeSyntheticHair(hs);
-    const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 16, 32);
-    View view;
-    view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
-    view.camera.width = 40;
-    view.camera.height = 30;
-    view.environment = Vec3f::Zero();
-    view.lights = {Light{}};
-    view.lights[0].direction = Vec3f(-1.f, -1.f, -1.f);
-    view.lights[0].castsShadows = false;
+    const HairUnderOneLight shot = hairUnderOneUnshadowedLight(600, 40, 30);
+    const StrandFrame& strands = shot.strands;
+    const TriangleMesh& head = shot.head;
+    View view = shot.view;
     ReferenceSettings s;
     s.mode = ReferenceMode::Physical;
     s.samplesPerPixel = 4;
