@@ -5,6 +5,10 @@
 # them. They still run in every normal `ctest`. Entries are
 # "<executable>:<Suite.Case>"; the executable stays a label too.
 set(_hp_slow_tests
+  test_convergence:Convergence.ErrorFallsAsOneOverRootN       # a 4096-spp image and four more
+  test_convergence:Convergence.TwoSeedsAtTheThresholdAgreeWithinIt  # four adaptive renders to ~700 spp
+  test_hair_bsdf:HairBsdf.WhiteFurnaceByQuadratureLosesAtMostOnePercent  # 16 materials by quadrature
+  test_preview_physical:PreviewPhysical.FittedPreviewPredictsThePhysicalRender  # a 128-spp physical render
   test_hair_bsdf:HairBsdf.WhiteFurnaceConservesEnergy          # 10^6 BSDF samples
   test_hair_bsdf:HairBsdf.SampledWhiteFurnaceConservesEnergy
   test_compare:CompareReport.IsSelfContainedAndRendersInHeadlessChromium  # Chromium start-up
