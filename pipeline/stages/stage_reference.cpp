@@ -164,7 +164,9 @@ class ReferenceStage final : public FrameStage {
         const Image image = renderer_.render(view, data.strands, head, settings, &stats);
         logVerbose("reference: frame ", data.frame, ": ", stats.strands, " strands, ", referenceModeName(settings.mode),
                    ", ", samplesText(settings, stats), ", build ", fixed(stats.buildSeconds, 2), " s, render ",
-                   fixed(stats.renderSeconds, 2), " s, Embree ", stats.sceneBytes / (1 << 20), " MiB");
+                   fixed(stats.renderSeconds, 2), " s (", fixed(stats.renderCpuSeconds, 1), " CPU-s, ",
+                   fixed(double(stats.rays) / std::max(1.0, stats.meanSamples * double(image.width) * image.height), 1),
+                   " rays a sample), Embree ", stats.sceneBytes / (1 << 20), " MiB");
 
         ImageWriteOptions options;
         options.metadata = {{"hairpipe:stage", "reference"},
