@@ -117,6 +117,7 @@ struct GuideSolver::Impl final : solver::StrandModel {
     std::unique_ptr<volume::HairGrid> grid;  ///< hair against hair (null: off)
     solver::Skeleton skeleton;
     size_t strandContacts = 0;  ///< of the current step
+    volume::GridStats gridStats;  ///< of the current step: densest node, vertex pushes (summed over substeps)
 
     explicit Impl(const GuideSettings& s) : skeleton(*this, set, "guide solver", s) {
         set.settings = s;
@@ -150,9 +151,11 @@ struct GuideSolver::Impl final : solver::StrandModel {
         in.lengthPerMass = float(double(set.settings.hairsPerGuide) / set.settings.guideMassPerLength());
         in.head = sub.headTransform;
         in.h = sub.h;
-        grid->apply(in, [&](size_t count, const std::function<void(size_t, size_t)>& f) {
+        const volume::GridStats st = grid->apply(in, [&](size_t count, const std::function<void(size_t, size_t)>& f) {
             skeleton.parallel(count, std::max<size_t>(1, count / 64), f);
         });
+        gridStats.maxDensity = std::max(gridStats.maxDensity, st.maxDensity);
+        gridStats.pushed += st.pushed;
         ++set.version;  // the rope's Bullet nodes reload x and v
     }
 
@@ -273,6 +276,7 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
 void GuideSolver::Impl::beginStep(const HeadPose& head, bool cut) {
     set.headTransform = head.transform;
     strandContacts = 0;
+    gridStats = volume::GridStats{};
     if (!cut) formulation->beginStep(head);
 }
 
@@ -323,6 +327,8 @@ void GuideSolver::Impl::endStep(bool cut, StepStats& counters) {
     }
     counters.clampedCount = clamped;
     counters.strandContacts = strandContacts;
+    counters.maxHairDensity = gridStats.maxDensity;
+    counters.volumePushed = gridStats.pushed;
     for (auto& grp : groups) counters.pinnedCount += grp->takePinned();
 }
 

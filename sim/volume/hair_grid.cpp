@@ -97,10 +97,9 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     };
     auto index = [&](int i, int j, int k) { return (size_t(k) * size_t(ny) + size_t(j)) * size_t(nx) + size_t(i); };
 
-    nodes_.resize(nodes);
-    parallel(size_t(nz), [&](size_t b, size_t e) {
-        std::fill(nodes_.begin() + std::ptrdiff_t(b * plane), nodes_.begin() + std::ptrdiff_t(e * plane), Node{0, 0, 0, 0, 0});
-    });
+    // The node array is all zeros between calls (apply() clears the nodes it
+    // touched before returning), so only growth costs a fill.
+    if (nodes_.size() < nodes) nodes_.resize(nodes, Node{0, 0, 0, 0, 0});
 
     // Vertices by z slab, in vertex order within a slab (stable counting sort).
     slabOf_.resize(n);
@@ -117,56 +116,45 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
             if (slabOf_[i] >= 0) order_[fill[size_t(slabOf_[i])]++] = unsigned(i);
     }
 
-    // Splat: even slabs, then odd slabs (each writes node planes k and k+1).
+    // Even slabs, then odd slabs: each writes node planes k and k+1 only.
+    auto bySlab = [&](auto&& vertexBody) {
+        for (int parity = 0; parity < 2; ++parity) {
+            const size_t slabs = size_t(std::max(0, (nz - parity) / 2));
+            parallel(slabs, [&](size_t b, size_t e) {
+                for (size_t sl = b; sl < e; ++sl) {
+                    const size_t k = 2 * sl + size_t(parity);
+                    for (unsigned o = slabStart_[k]; o < slabStart_[k + 1]; ++o) vertexBody(size_t(order_[o]));
+                }
+            });
+        }
+    };
+
+    // Splat.
     const float lengthPerMass = in.lengthPerMass;
-    for (int parity = 0; parity < 2; ++parity) {
-        const size_t slabs = size_t(std::max(0, (nz - 1 - parity + 1) / 2));
-        parallel(slabs, [&](size_t b, size_t e) {
-            for (size_t s = b; s < e; ++s) {
-                const int k = int(2 * s) + parity;
-                for (unsigned o = slabStart_[size_t(k)]; o < slabStart_[size_t(k) + 1]; ++o) {
-                    const size_t i = order_[o];
-                    const Cell c = cellOf(i);
-                    const float m = in.mass[i], l = m * lengthPerMass;
-                    const Vec3f p = m * in.v[i];
-                    const float wx[2] = {1.f - c.tx, c.tx}, wy[2] = {1.f - c.ty, c.ty}, wz[2] = {1.f - c.tz, c.tz};
-                    for (int dk = 0; dk < 2; ++dk)
-                        for (int dj = 0; dj < 2; ++dj) {
-                            Node* row = &nodes_[index(c.i, c.j + dj, c.k + dk)];
-                            const float wyz = wy[dj] * wz[dk];
-                            for (int di = 0; di < 2; ++di) {
-                                const float w = wx[di] * wyz;
-                                Node& nd = row[di];
-                                nd.m += w * m;
-                                nd.l += w * l;
-                                nd.px += w * p.x();
-                                nd.py += w * p.y();
-                                nd.pz += w * p.z();
-                            }
-                        }
+    bySlab([&](size_t i) {
+        const Cell c = cellOf(i);
+        const float m = in.mass[i], l = m * lengthPerMass;
+        const Vec3f p = m * in.v[i];
+        const float wx[2] = {1.f - c.tx, c.tx}, wy[2] = {1.f - c.ty, c.ty}, wz[2] = {1.f - c.tz, c.tz};
+        for (int dk = 0; dk < 2; ++dk)
+            for (int dj = 0; dj < 2; ++dj) {
+                Node* row = &nodes_[index(c.i, c.j + dj, c.k + dk)];
+                const float wyz = wy[dj] * wz[dk];
+                for (int di = 0; di < 2; ++di) {
+                    const float w = wx[di] * wyz;
+                    Node& nd = row[di];
+                    nd.m += w * m;
+                    nd.l += w * l;
+                    nd.px += w * p.x();
+                    nd.py += w * p.y();
+                    nd.pz += w * p.z();
                 }
             }
-        });
-    }
-
-    // Nodes: velocity V = P/M and density ratio r = λ/λ₀ in place.
-    const float perNodeVolume = 1.f / (d * d * d);
-    const float target = s_.targetDensity * 1e4f;  // hairs per cm² -> per m²
-    parallel(size_t(nz), [&](size_t b, size_t e) {
-        for (size_t q = b * plane; q < e * plane; ++q) {
-            Node& nd = nodes_[q];
-            if (nd.m > 0.f) {
-                const float inv = 1.f / nd.m;
-                nd.px *= inv;
-                nd.py *= inv;
-                nd.pz *= inv;
-            }
-            nd.l *= perNodeVolume / target;
-        }
     });
-    float maxR = 0.f;
-    for (const Node& nd : nodes_) maxR = std::max(maxR, nd.l);
-    st.maxDensity = maxR * s_.targetDensity;
+
+    // Node velocity V = P/M and density ratio r = λ/λ₀ are read on the fly.
+    const float toRatio = 1.f / (d * d * d * s_.targetDensity * 1e4f);  // hairs per cm² -> per m²
+    std::atomic<float> maxR{0.f};  // a maximum: the same whatever the order
 
     // Gather: friction, then the volume push (reads only the grid).
     const float s = blendFraction(in.h), push = pushFraction(in.h) * d * d;
@@ -174,6 +162,7 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     std::atomic<size_t> pushed{0};
     parallel(n, [&](size_t b, size_t e) {
         size_t moved = 0;
+        float localMax = 0.f;
         for (size_t i = b; i < e; ++i) {
             if (slabOf_[i] < 0) continue;
             const Cell c = cellOf(i);
@@ -187,9 +176,11 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
                     for (int di = 0; di < 2; ++di) {
                         const Node& nd = row[di];
                         const float w = wx[di] * wy[dj] * wz[dk];
-                        V += w * Vec3f(nd.px, nd.py, nd.pz);
-                        r += w * nd.l;
-                        const float excess = std::max(0.f, nd.l - 1.f);
+                        if (nd.m > 0.f) V += (w / nd.m) * Vec3f(nd.px, nd.py, nd.pz);
+                        const float ratio = nd.l * toRatio;
+                        r += w * ratio;
+                        localMax = std::max(localMax, ratio);
+                        const float excess = std::max(0.f, ratio - 1.f);
                         grad += excess * Vec3f(dw[di] * wy[dj] * wz[dk], wx[di] * dw[dj] * wz[dk], wx[di] * wy[dj] * dw[dk]);
                     }
                 }
@@ -200,8 +191,21 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
             }
         }
         pushed += moved;
+        for (float m = maxR.load(); localMax > m && !maxR.compare_exchange_weak(m, localMax);) {
+        }
     });
     st.pushed = pushed;
+    st.maxDensity = maxR.load() * s_.targetDensity;
+
+    // Leave the array all zeros for the next call: clear what the splat touched.
+    bySlab([&](size_t i) {
+        const Cell c = cellOf(i);
+        for (int dk = 0; dk < 2; ++dk)
+            for (int dj = 0; dj < 2; ++dj) {
+                Node* row = &nodes_[index(c.i, c.j + dj, c.k + dk)];
+                row[0] = row[1] = Node{0, 0, 0, 0, 0};
+            }
+    });
     return st;
 }
 

@@ -74,7 +74,7 @@ struct GridInput {
 struct GridStats {
     float cellSize = 0.f;           ///< Δ used, m (coarser than the setting when the hair spreads too far)
     size_t nodes = 0;
-    float maxDensity = 0.f;         ///< largest node density, hairs per cm²
+    float maxDensity = 0.f;         ///< largest density of a node a vertex reads, hairs per cm²
     size_t pushed = 0;              ///< vertices the volume step moved
 };
 
@@ -93,7 +93,7 @@ class HairGrid {
 
   private:
     struct Node {
-        float m, l, px, py, pz;  ///< mass, hair length, momentum; after the splat: m, r, V
+        float m, l, px, py, pz;  ///< mass, hair length, momentum (all zero between calls)
     };
     VolumeSettings s_;
     std::vector<Vec3f> local_;   ///< head-local positions
