@@ -191,7 +191,7 @@ TEST(HairGrid, SameBitsOnAnyThreadCountAndChunkOrder) {
     VolumeSettings s;
     s.enabled = true;
     s.targetDensity = 50.f;
-    std::vector<Cloud> runs(4, Cloud(5000, 5));
+    std::vector<Cloud> runs(4, Cloud(20000, 5));  // above the serial threshold: the parallel passes run
     const volume::ParallelFor fors[4] = {arenaFor(1, 1), arenaFor(2, 1), arenaFor(2, 64), reversedFor};
     Eigen::Isometry3f head = Eigen::Isometry3f::Identity();
     head.rotate(Eigen::AngleAxisf(0.7f, Vec3f(1, 2, 3).normalized()));

@@ -34,11 +34,8 @@ constexpr double kMaxNodes = 4.0e6;
 /// overshoots (1.85x) and lifts hair (the crossing wisps' energy rises).
 constexpr float kMaxPush = 0.5f;
 
-/// Base node and trilinear fractions of a head-local position.
-struct Cell {
-    int i, j, k;
-    float tx, ty, tz;
-};
+/// Vertices below which apply() runs on the calling thread.
+constexpr size_t kParallelVertices = 8192;
 
 }  // namespace
 
@@ -53,10 +50,17 @@ float HairGrid::pushFraction(float h) const {
 GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     GridStats st;
     const size_t n = in.count;
+    // Below this many vertices the passes run on the calling thread: waking
+    // workers costs more than the work (same bits either way).
+    const bool serial = n < kParallelVertices;
+    auto run = [&](size_t count, const std::function<void(size_t, size_t)>& f) {
+        if (serial) f(0, count);
+        else parallel(count, f);
+    };
     local_.resize(n);
     const Eigen::Isometry3f toLocal = in.head.inverse();
     auto valid = [&](size_t i) { return in.mass[i] > 0.f && local_[i].allFinite(); };
-    parallel(n, [&](size_t b, size_t e) {
+    run(n, [&](size_t b, size_t e) {
         for (size_t i = b; i < e; ++i) local_[i] = toLocal * in.x[i];
     });
 
@@ -101,26 +105,26 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     // touched before returning), so only growth costs a fill.
     if (nodes_.size() < nodes) nodes_.resize(nodes, Node{0, 0, 0, 0, 0});
 
-    // Vertices by z slab, in vertex order within a slab (stable counting sort).
-    slabOf_.resize(n);
+    // Each vertex's cell once; then vertices by z slab, in vertex order
+    // within a slab (a stable counting sort).
+    cells_.resize(n);
+    run(n, [&](size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i) cells_[i] = valid(i) ? cellOf(i) : Cell{-1, 0, 0, 0.f, 0.f, 0.f};
+    });
     slabStart_.assign(size_t(nz) + 1, 0u);
-    for (size_t i = 0; i < n; ++i) {
-        slabOf_[i] = valid(i) ? cellOf(i).k : -1;
-        if (slabOf_[i] >= 0) ++slabStart_[size_t(slabOf_[i]) + 1];
-    }
+    for (size_t i = 0; i < n; ++i)
+        if (cells_[i].i >= 0) ++slabStart_[size_t(cells_[i].k) + 1];
     for (int k = 0; k < nz; ++k) slabStart_[size_t(k) + 1] += slabStart_[size_t(k)];
     order_.resize(slabStart_[size_t(nz)]);
-    {
-        std::vector<unsigned> fill(slabStart_.begin(), slabStart_.end() - 1);
-        for (size_t i = 0; i < n; ++i)
-            if (slabOf_[i] >= 0) order_[fill[size_t(slabOf_[i])]++] = unsigned(i);
-    }
+    fill_.assign(slabStart_.begin(), slabStart_.end() - 1);
+    for (size_t i = 0; i < n; ++i)
+        if (cells_[i].i >= 0) order_[fill_[size_t(cells_[i].k)]++] = unsigned(i);
 
     // Even slabs, then odd slabs: each writes node planes k and k+1 only.
     auto bySlab = [&](auto&& vertexBody) {
         for (int parity = 0; parity < 2; ++parity) {
             const size_t slabs = size_t(std::max(0, (nz - parity) / 2));
-            parallel(slabs, [&](size_t b, size_t e) {
+            run(slabs, [&](size_t b, size_t e) {
                 for (size_t sl = b; sl < e; ++sl) {
                     const size_t k = 2 * sl + size_t(parity);
                     for (unsigned o = slabStart_[k]; o < slabStart_[k + 1]; ++o) vertexBody(size_t(order_[o]));
@@ -132,7 +136,7 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     // Splat.
     const float lengthPerMass = in.lengthPerMass;
     bySlab([&](size_t i) {
-        const Cell c = cellOf(i);
+        const Cell& c = cells_[i];
         const float m = in.mass[i], l = m * lengthPerMass;
         const Vec3f p = m * in.v[i];
         const float wx[2] = {1.f - c.tx, c.tx}, wy[2] = {1.f - c.ty, c.ty}, wz[2] = {1.f - c.tz, c.tz};
@@ -160,12 +164,12 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     const float s = blendFraction(in.h), push = pushFraction(in.h) * d * d;
     const Eigen::Matrix3f R = in.head.linear();
     std::atomic<size_t> pushed{0};
-    parallel(n, [&](size_t b, size_t e) {
+    run(n, [&](size_t b, size_t e) {
         size_t moved = 0;
         float localMax = 0.f;
         for (size_t i = b; i < e; ++i) {
-            if (slabOf_[i] < 0) continue;
-            const Cell c = cellOf(i);
+            const Cell& c = cells_[i];
+            if (c.i < 0) continue;
             const float wx[2] = {1.f - c.tx, c.tx}, wy[2] = {1.f - c.ty, c.ty}, wz[2] = {1.f - c.tz, c.tz};
             const float dw[2] = {-invD, invD};
             Vec3f V = Vec3f::Zero(), grad = Vec3f::Zero();
@@ -199,7 +203,7 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
 
     // Leave the array all zeros for the next call: clear what the splat touched.
     bySlab([&](size_t i) {
-        const Cell c = cellOf(i);
+        const Cell& c = cells_[i];
         for (int dk = 0; dk < 2; ++dk)
             for (int dj = 0; dj < 2; ++dj) {
                 Node* row = &nodes_[index(c.i, c.j + dj, c.k + dk)];

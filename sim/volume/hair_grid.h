@@ -91,14 +91,20 @@ class HairGrid {
     float blendFraction(float h) const;
     float pushFraction(float h) const;
 
+    /// Base node and trilinear fractions of a head-local position (i < 0: not gridded).
+    struct Cell {
+        int i, j, k;
+        float tx, ty, tz;
+    };
+
   private:
     struct Node {
         float m, l, px, py, pz;  ///< mass, hair length, momentum (all zero between calls)
     };
     VolumeSettings s_;
     std::vector<Vec3f> local_;   ///< head-local positions
-    std::vector<unsigned> order_, slabStart_;
-    std::vector<int> slabOf_;
+    std::vector<Cell> cells_;    ///< per vertex
+    std::vector<unsigned> order_, slabStart_, fill_;
     std::vector<Node> nodes_;
 };
 
