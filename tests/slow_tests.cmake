@@ -18,6 +18,7 @@ set(_hp_slow_tests
   test_vdb:VdbFile.BytesAreIdenticalForOneAndTwoThreadsAndRepeatedWrites
   test_shot_simulation:ShotSimulation.DefaultClipKeepsLengthsRootsAndClearance
   test_shot_simulation:ShotSimulation.CheckpointRestoreContinuesBitForBit
+  test_hair_grid:Volume.BallOfStrandsDroppedOnSphereStaysLessDense   # two 3 s drops of 48 strands
   test_shot_simulation:ShotSimulation.HairHangsUnderGravityAndSwingsWithTheHead  # three shots, 120 frames
   test_sim_guards:SimGuards.LongViolentRunStaysBoundedAndFinite  # 10^4+ steps
   test_rod:Rod.HeavyElasticaTipMatchesShootingToTheChainsDiscretisation  # 12 runs of 6 s settling

@@ -42,6 +42,14 @@ GuideSettings guideSettings(const Scene& scene) {
         {"simulation.max_speed", &GuideSettings::maxSpeed},
     });
 
+    readKeys(scene, s.volume, {
+        {"simulation.volume.enabled", &VolumeSettings::enabled},
+        {"simulation.volume.cell_size", &VolumeSettings::cellSize},
+        {"simulation.volume.target_density", &VolumeSettings::targetDensity},
+        {"simulation.volume.friction", &VolumeSettings::friction},
+        {"simulation.volume.relax_time", &VolumeSettings::relaxTime},
+    });
+
     const float segment = s.length / float(s.segments);
     if (2.f * s.collisionRadius >= segment)
         scene.fail("hair.guides.collision_radius",

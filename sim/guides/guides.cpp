@@ -9,6 +9,7 @@
 #include "core/errors.h"
 #include "sim/guides/guide_group.h"
 #include "sim/solver/skeleton.h"
+#include "sim/volume/hair_grid.h"
 
 #include <algorithm>
 #include <cmath>
@@ -60,6 +61,7 @@ void GuideSettings::validate() const {
     check(strandsPerWorld >= 1, "strands per world must be ≥ 1");
     check(threads >= 0, "threads must be ≥ 0");
     check(gravity.allFinite(), "gravity must be finite");
+    volume.validate();
 }
 
 namespace guides {
@@ -112,8 +114,10 @@ struct GuideSolver::Impl final : solver::StrandModel {
     std::unique_ptr<guides::Formulation> formulation;
     std::vector<std::unique_ptr<guides::GuideGroup>> groups;
     std::unique_ptr<guides::StrandContacts> contacts;
+    std::unique_ptr<volume::HairGrid> grid;  ///< hair against hair (null: off)
     solver::Skeleton skeleton;
     size_t strandContacts = 0;  ///< of the current step
+    volume::GridStats gridStats;  ///< of the current step: densest node, vertex pushes (summed over substeps)
 
     explicit Impl(const GuideSettings& s) : skeleton(*this, set, "guide solver", s) {
         set.settings = s;
@@ -132,6 +136,27 @@ struct GuideSolver::Impl final : solver::StrandModel {
         for (int j = 0; j < set.segments; ++j)
             strand::placeSegment(x[j], x[j + 1], set.restLength[set.segment(g, j)], head,
                                  set.settings.collisionRadius);
+    }
+
+    /// Hair against hair: the grid's friction and volume on the state the
+    /// substep starts from (sim/volume/hair_grid.h); the formulation's step
+    /// then restores lengths and clearance, and computes velocities from
+    /// positions, so the volume push adds no velocity.
+    void couple(const solver::Substep& sub) {
+        volume::GridInput in;
+        in.x = set.x.data();
+        in.v = set.v.data();
+        in.mass = set.mass.data();
+        in.count = set.x.size();
+        in.lengthPerMass = float(double(set.settings.hairsPerGuide) / set.settings.guideMassPerLength());
+        in.head = sub.headTransform;
+        in.h = sub.h;
+        const volume::GridStats st = grid->apply(in, [&](size_t count, const std::function<void(size_t, size_t)>& f) {
+            skeleton.parallel(count, std::max<size_t>(1, count / 64), f);
+        });
+        gridStats.maxDensity = std::max(gridStats.maxDensity, st.maxDensity);
+        gridStats.pushed += st.pushed;
+        ++set.version;  // the rope's Bullet nodes reload x and v
     }
 
     // solver::StrandModel: the guides' own step.
@@ -233,6 +258,9 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
     m.contacts.reset();
     if (s.strandCollision && s.formulation != GuideFormulation::Rigid)
         m.contacts = std::make_unique<guides::StrandContacts>(set);
+    m.grid.reset();
+    if (s.volume.enabled && s.formulation != GuideFormulation::Rigid)
+        m.grid = std::make_unique<volume::HairGrid>(s.volume);
 
     ++set.version;
     if (s.preload) {
@@ -248,6 +276,7 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
 void GuideSolver::Impl::beginStep(const HeadPose& head, bool cut) {
     set.headTransform = head.transform;
     strandContacts = 0;
+    gridStats = volume::GridStats{};
     if (!cut) formulation->beginStep(head);
 }
 
@@ -270,6 +299,7 @@ void GuideSolver::Impl::substep(const solver::Substep& sub) {
     guides::SubstepContext ctx;
     static_cast<solver::Substep&>(ctx) = sub;
     ctx.headCollision = set.settings.headCollision;
+    if (grid) couple(sub);
     forGroups([&](guides::GuideGroup& grp) { grp.substep(ctx); });
     if (contacts) {
         const strand::HeadQuery* hq = ctx.collidingHead();
@@ -297,6 +327,8 @@ void GuideSolver::Impl::endStep(bool cut, StepStats& counters) {
     }
     counters.clampedCount = clamped;
     counters.strandContacts = strandContacts;
+    counters.maxHairDensity = gridStats.maxDensity;
+    counters.volumePushed = gridStats.pushed;
     for (auto& grp : groups) counters.pinnedCount += grp->takePinned();
 }
 

@@ -41,6 +41,7 @@
 #include "sim/solver/strand_solver.h"
 #include "sim/strands/head.h"
 #include "sim/strands/strand.h"
+#include "sim/volume/volume_settings.h"
 
 #include <memory>
 #include <string>
@@ -99,6 +100,9 @@ struct GuideSettings : StepSettings {
     // Contacts.
     bool headCollision = true;      ///< project vertices out of the head's signed distance each Bullet step
     bool strandCollision = false;   ///< strand-strand collision (Gomes 2024, Table 5.1 row 7); serialises contact solving
+    /// Hair against hair through a grid (sim/volume/hair_grid.h): friction
+    /// and volume, before every substep. Rod and rope formulations.
+    VolumeSettings volume;
 
 
     // Guard: a vertex faster than this after a step is numerical, not

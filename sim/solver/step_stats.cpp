@@ -16,6 +16,8 @@ void StepStats::accumulate(const StepStats& s) {
     clampedCount += s.clampedCount;
     pinnedCount = std::max(pinnedCount, s.pinnedCount);
     strandContacts = std::max(strandContacts, s.strandContacts);
+    maxHairDensity = std::max(maxHairDensity, s.maxHairDensity);
+    volumePushed = std::max(volumePushed, s.volumePushed);
     meanSaturation = s.meanSaturation;
     meanCohesionNeighbours = s.meanCohesionNeighbours;
     adhesionCount = std::max(adhesionCount, s.adhesionCount);
@@ -29,6 +31,8 @@ void StepStats::setCounters(const StepStats& c) {
     clampedCount = c.clampedCount;
     strandContacts = c.strandContacts;
     pinnedCount = c.pinnedCount;
+    maxHairDensity = c.maxHairDensity;
+    volumePushed = c.volumePushed;
     meanCohesionNeighbours = c.meanCohesionNeighbours;
     adhesionCount = c.adhesionCount;
     implicitFailures = c.implicitFailures;

@@ -26,6 +26,8 @@ struct StepStats {
     size_t clampedCount = 0;        ///< vertex velocities scaled back to maxSpeed
     size_t strandContacts = 0;      ///< strand-strand contacts resolved in the step
     size_t pinnedCount = 0;         ///< rod: vertices pinned (no place outside the head at their length)
+    double maxHairDensity = 0;      ///< hair-hair grid: densest node in the step, hairs per cm² (sim/volume/hair_grid.h)
+    size_t volumePushed = 0;        ///< hair-hair grid: vertex pushes of the volume step in the step (all substeps)
 
     // Curly and wet guides (sim/curly/curly_wet.h).
     double meanSaturation = 0;      ///< mean σ over the free particles

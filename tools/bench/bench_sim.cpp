@@ -7,7 +7,8 @@
 // timed steps. Reports steps/s (median of --runs runs, with min-max), the
 // largest segment stretch |len/rest - 1| and the deepest vertex penetration
 // over the timed steps, NaN count, threads — for every formulation (rod,
-// rope, rigid), with and without strand-strand collision, on 1 and 2 threads.
+// rope, rigid), with and without strand-strand collision, with the hair-hair
+// grid off and on (--volume; the library default is off), on 1 and 2 threads.
 //
 // --collider picks how the head collides, so one run compares them:
 //   sphere  the analytic sphere (the benchmark's own head, the default);
@@ -21,7 +22,7 @@
 //           the head (the default scene's case: the head on its grid, the
 //           body through Bullet).
 //
-//   bench_sim [--guides 94,845] [--formulation rod,rope,rigid] [--strand-collision off,on]
+//   bench_sim [--guides 94,845] [--formulation rod,rope,rigid] [--strand-collision off,on] [--volume off,on]
 //             [--threads 1,2] [--runs 3] [--warmup 20] [--steps 250]
 //             [--substeps 1] [--iterations 20] [--rod-substeps 2] [--per-world 16] [--rate 90]
 //             [--preload on|off] [--collider sphere,grid,bullet,grid+box] [--range 0.05] [--digest]
@@ -157,7 +158,7 @@ RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int 
 
 int main(int argc, char** argv) {
     std::vector<std::string> guideList{"94", "845"}, formList{"rod", "rope", "rigid"}, collList{"off", "on"},
-        threadList{"1", "2"}, colliderList{"sphere"};
+        threadList{"1", "2"}, colliderList{"sphere"}, volList{"off"};
     int runs = 3, warmup = 20, steps = 250, substeps = 1, iterations = 20, perWorld = 16, rodSubsteps = 2;
     float rate = 90.f;
     bool preload = true, digest = false;
@@ -174,6 +175,7 @@ int main(int argc, char** argv) {
         else if (a == "--formulation") formList = split(next());
         else if (a == "--strand-collision") collList = split(next());
         else if (a == "--threads") threadList = split(next());
+        else if (a == "--volume") volList = split(next());
         else if (a == "--runs") runs = std::stoi(next());
         else if (a == "--warmup") warmup = std::stoi(next());
         else if (a == "--steps") steps = std::stoi(next());
@@ -195,16 +197,18 @@ int main(int argc, char** argv) {
                 "24 vertices, 0.25 m, collision radius 1 mm; substeps %d, iterations %d, %d guides per world; "
                 "median of %d runs (min-max)\n\n",
                 rate, warmup, steps, substeps, iterations, perWorld, runs);
-    std::printf("| guides | formulation | collider | strand coll. | threads | steps/s median (min-max) | CPU ms/step (min) | "
+    std::printf("| guides | formulation | collider | strand coll. | volume | threads | steps/s median (min-max) | CPU ms/step (min) | "
                 "max stretch | max penetration mm | NaN | strand contacts/step (max) | load avg |%s\n",
                 digest ? " state digest |" : "");
-    std::printf("|---:|---|---|---|---:|---|---:|---:|---:|---:|---:|---:|%s\n", digest ? "---|" : "");
+    std::printf("|---:|---|---|---|---|---:|---|---:|---:|---:|---:|---:|---:|%s\n", digest ? "---|" : "");
     for (const std::string& gs : guideList)
       for (const std::string& collider : colliderList)
         for (const std::string& form : formList)
             for (const std::string& coll : collList)
-                for (const std::string& th : threadList) {
+                for (const std::string& th : threadList)
+                  for (const std::string& vol : volList) {
                     GuideSettings s;
+                    s.volume.enabled = vol == "on";
                     s.formulation = parseFormulation(form);
                     s.strandCollision = coll == "on";
                     s.threads = std::stoi(th);
@@ -227,8 +231,8 @@ int main(int argc, char** argv) {
                     const double median = sps[sps.size() / 2];
                     double load[1] = {0};
                     getloadavg(load, 1);
-                    std::printf("| %s | %s | %s | %s | %s | %.1f (%.1f-%.1f) | %.2f (%.2f) | %.2e | %.3f | %zu | %zu | %.2f |",
-                                gs.c_str(), form.c_str(), collider.c_str(), coll.c_str(), th.c_str(), median, sps.front(), sps.back(),
+                    std::printf("| %s | %s | %s | %s | %s | %s | %.1f (%.1f-%.1f) | %.2f (%.2f) | %.2e | %.3f | %zu | %zu | %.2f |",
+                                gs.c_str(), form.c_str(), collider.c_str(), coll.c_str(), vol.c_str(), th.c_str(), median, sps.front(), sps.back(),
                                 cpu[cpu.size() / 2], cpu.front(), worst.maxLengthError,
                                 worst.maxPenetration * 1000.0, worst.nanCount, worst.strandContacts, load[0]);
                     if (digest) {

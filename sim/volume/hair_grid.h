@@ -1,0 +1,111 @@
+// @brief Hair against hair through a grid: the guides' mass, velocity and
+// hair length splatted onto a grid that follows the head, then friction
+// and volume read back from it (issue 30).
+//
+// The method is the hybrid Eulerian/Lagrangian one of Petrovic, Henne and
+// Anderson, "Volumetric Methods for Simulation and Rendering of Hair"
+// (Pixar technical memo 06-08, 2005) and McAdams, Selle, Ward, Sifakis and
+// Teran, "Detail Preserving Continuum Simulation of Straight Hair"
+// (SIGGRAPH 2009): strands stay Lagrangian; the grid only couples them.
+//
+// Each solver substep, with vertices i of mass m_i, hair length ℓ_i (the
+// vertex's share of its segments times the hairs its guide stands for),
+// head-local position p_i and velocity v_i, and trilinear weights w_ic
+// (Σ_c w_ic = 1) on nodes c of spacing Δ:
+//
+//   splat     M_c = Σ_i w_ic m_i,   P_c = Σ_i w_ic m_i v_i,
+//             λ_c = Σ_i w_ic ℓ_i / Δ³          (hair length per volume, 1/m²:
+//                                               hairs crossing a unit section)
+//   grid      V_c = P_c / M_c,   r_c = λ_c / λ₀,   e_c = max(0, r_c − 1)
+//   friction  v_i ← v_i + s·(V̄_i − v_i),  V̄_i = Σ_c w_ic V_c,  s = 1 − exp(−k·h)
+//   volume    x_i ← x_i − c·Δ²·∇ē(x_i) / max(1, r̄_i),   c = c_max·(1 − exp(−h/τ))
+//
+// Friction (PIC blend) conserves momentum exactly: Σ_i m_i V̄_i =
+// Σ_c V_c Σ_i w_ic m_i = Σ_c P_c = Σ_i m_i v_i. It never adds kinetic
+// energy: V̄_i is a mass-weighted average of the velocities near i (Jensen:
+// Σ m_i |V̄_i|² ≤ Σ m_i |v_i|²) and the blend is a convex combination.
+// The volume step moves positions only, never velocities (like the head's
+// projection), so it adds no kinetic energy; the strand solver's next step
+// restores lengths and clearance. Dividing by r̄ makes it a step of linear
+// diffusion of the excess density (∂λ/∂t = D∇²λ where λ > λ₀, D = c·Δ²/h).
+// Explicit diffusion on a grid is stable for c ≤ 1/6; c_max = 1/2 trades
+// some grid-scale jitter for a push that can hold hair up against gravity
+// (hair_grid.cpp says what was measured). One push a substep is not a
+// constraint: a pile under gravity settles where c·Δ·(r − 1)/r, the push a
+// substep, matches the fall g·h² a substep, above the target.
+//
+// Determinism: the splat is a sum, so its order is fixed. Vertices are
+// bucketed by the z slab of their base node (a stable counting sort, in
+// vertex order); a vertex of slab k writes node planes k and k+1 only, so
+// even slabs run in parallel, then odd ones. Every node therefore receives
+// its terms in the same order whatever the thread count; the gather reads
+// only. The grid's lattice is fixed to the head (origin a multiple of Δ in
+// head coordinates), so it follows the head and a still head sees the
+// same cells every step.
+#pragma once
+
+#include "sim/volume/volume_settings.h"
+
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+namespace hp::volume {
+
+using Vec3f = Eigen::Vector3f;
+
+/// Runs f(begin, end) over [0, count) in parallel chunks (the caller's arena).
+using ParallelFor = std::function<void(size_t count, const std::function<void(size_t, size_t)>& f)>;
+
+/// The vertices the grid couples (structure of arrays, `count` entries each).
+struct GridInput {
+    Vec3f* x = nullptr;             ///< world positions, moved by the volume push
+    Vec3f* v = nullptr;             ///< world velocities, blended by friction
+    const float* mass = nullptr;    ///< kg; 0: kinematic (a root), neither splatted nor moved
+    size_t count = 0;
+    float lengthPerMass = 0.f;      ///< hair length a kilogram of guide stands for, m/kg
+    Eigen::Isometry3f head = Eigen::Isometry3f::Identity();  ///< the frame the grid follows
+    float h = 0.f;                  ///< substep, s
+};
+
+/// What one apply() did (diagnostics and tests).
+struct GridStats {
+    float cellSize = 0.f;           ///< Δ used, m (coarser than the setting when the hair spreads too far)
+    size_t nodes = 0;
+    float maxDensity = 0.f;         ///< largest density of a node a vertex reads, hairs per cm²
+    size_t pushed = 0;              ///< vertices the volume step moved
+};
+
+/// The grid and its scratch, reused step after step.
+class HairGrid {
+  public:
+    explicit HairGrid(const VolumeSettings& s);
+
+    /// One coupling pass: splat, friction, volume (see the file comment).
+    /// Results are the same bits for any thread count `parallel` uses.
+    GridStats apply(const GridInput& in, const ParallelFor& parallel);
+
+    /// Friction's blend fraction s and the volume step's c for a substep h.
+    float blendFraction(float h) const;
+    float pushFraction(float h) const;
+
+    /// Base node and trilinear fractions of a head-local position (i < 0: not gridded).
+    struct Cell {
+        int i, j, k;
+        float tx, ty, tz;
+    };
+
+  private:
+    struct Node {
+        float m, l, px, py, pz;  ///< mass, hair length, momentum (all zero between calls)
+    };
+    VolumeSettings s_;
+    std::vector<Vec3f> local_;   ///< head-local positions
+    std::vector<Cell> cells_;    ///< per vertex
+    std::vector<unsigned> order_, slabStart_, fill_;
+    std::vector<Node> nodes_;
+};
+
+}  // namespace hp::volume

@@ -1,0 +1,26 @@
+// @brief The hair-hair grid's settings (scene keys simulation.volume.*,
+// pipeline/scene/keys/simulation.yaml). Plain data: sim/guides/guides.h
+// holds one in GuideSettings.
+#pragma once
+
+namespace hp {
+
+struct VolumeSettings {
+    /// Off in the library (tests and benchmarks ask for it); the scene key
+    /// simulation.volume.enabled turns it on by default.
+    bool enabled = false;
+    float cellSize = 0.01f;        ///< Δ, m
+    /// Hair length per volume above which the volume step pushes, in hairs
+    /// per cm² (hairs crossing a square centimetre of section). Default: the
+    /// mean scalp density of Barman, Astore and Pecoraro, "The normal
+    /// trichogram of the adult" (J. Invest. Dermatol., 1965), 223 hairs/cm²
+    /// (175–300): loose hair packed no denser than where it grows.
+    float targetDensity = 223.f;
+    float friction = 10.f;         ///< k: velocities blend toward the grid's at rate k, 1/s
+    float relaxTime = 0.01f;       ///< τ: the volume step's time constant, s (0: off)
+
+    /// Throws hp::Error naming the first setting out of range.
+    void validate() const;
+};
+
+}  // namespace hp
