@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cfloat>
 #include <cmath>
 
 using namespace hp;
@@ -168,7 +169,16 @@ TEST(CollisionWorld, HairOnAShoulderBoxStaysOnIt) {
     EXPECT_EQ(below, 0u) << "no vertex falls through the shoulders";
     EXPECT_GT(resting, 50u) << "hair lies on the top face";
     EXPECT_LE(depth, 1e-3f) << "deepest vertex inside the box, every step";
-    EXPECT_LE(stretch, 1e-3) << "lying on the box does not stretch the strands";
+    // The rope's finish pass puts every vertex at exactly its rest length
+    // from its parent (follow-the-leader; the head's last projection wins
+    // over the length only for a parent inside, which never happens here),
+    // so what is left is float rounding: each coordinate is rounded to
+    // FLT_EPSILON/2 of its magnitude (here |x| < 0.6 m), at both ends of a
+    // segment, and the measurement rounds again: within 4·0.6·FLT_EPSILON/l
+    // of the rest length l = 0.2/23 m (3.3e-5; measured 3.8e-6). Bullet's
+    // link passes alone leave errors orders of magnitude larger.
+    const double rounding = 4.0 * 0.6 * FLT_EPSILON / (0.2 / 23);
+    EXPECT_LE(stretch, rounding) << "lying on the box does not stretch the strands";
 }
 
 // A prop from a second file, placed and keyed by head.colliders[] keys.
