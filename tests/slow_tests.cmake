@@ -29,6 +29,7 @@ set(_hp_slow_tests
   test_render_parity:RenderParity.ThreePointRigAndSkinMatch    # 5 reference renders
   test_scene_cut:SceneCut.NoVertexInsideAnyColliderOnTheCutFrameAndAfter  # 60 solver steps, two formulations
   test_scene_cut:SceneCut.InfoListsTheCutsOfTheClip             # three head imports
+  test_cli:Cli.EveryBundledSceneRendersWithTheDefaultLook       # seven scenes simulated and previewed
   test_scene_cut:SceneCut.StressClipCutFrameHasNoVertexInsideAnyCollider  # exact collider per step
   test_collision_world:CollisionWorld.HairOnAShoulderBoxStaysOnIt  # 300 solver steps
   test_collision_world:CollisionWorld.PropColliderFromASecondFile  # head import + grid

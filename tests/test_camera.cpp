@@ -187,11 +187,9 @@ TEST(CameraAuto, StressClipIsReframedAtItsSceneCut) {
     // The stress clip cuts to another pose at 2 s (frame 50; `hairpipe info
     // scenes/stress.yaml`): the camera changes exactly there, and head and
     // hair stay in frame on both sides.
-    std::string yaml = test::readFile(test::sourcePath("scenes/stress.yaml"));
-    const size_t at = yaml.find("position: [0.55, 0.05, 0.55], target: [0, -0.1, -0.02], ");
-    ASSERT_NE(at, std::string::npos) << "the stress scene's fixed camera moved; update this test";
-    yaml.erase(at, std::string("position: [0.55, 0.05, 0.55], target: [0, -0.1, -0.02], ").size());  // camera auto
-    const Scene scene = Scene::parse(yaml, "stress.yaml", test::sourcePath("scenes"));
+    // Camera auto (one framing per segment) by the hair's reach.
+    const Scene scene = Scene::load(test::sourcePath("scenes/stress.yaml"),
+                                    {"render.camera.mode=auto", "render.camera.hair=reach"});
     const CameraTrack track = makeCameraTrack(scene, makeView(scene).camera, std::filesystem::temp_directory_path(), false);
     for (int frame = 2; frame <= 62; ++frame) {
         const bool moved = !track.at(frame).position.isApprox(track.at(frame - 1).position);
@@ -234,6 +232,24 @@ TEST(CameraAuto, MissingStrandCacheNamesTheFile) {
         EXPECT_NE(std::string(e.what()).find("strands.0001.hpc"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("render.camera.hair: reach"), std::string::npos) << e.what();
     }
+}
+
+TEST(CameraAuto, DefaultFramesTheCachedHairUnlessTheSceneWritesNoCache) {
+    // The default camera is the default shot's: follow, on the cached hair.
+    const std::string head = "head: {file: " + test::sourcePath("scenes/assets/head.glb").string() + "}\n";
+    const Scene plain = Scene::parse(head, "cam.yaml", ".");
+    EXPECT_EQ(plain.text("render.camera.mode"), "follow");
+    EXPECT_TRUE(cameraReadsStrandCache(plain));
+    // Without a cache the default frames by the hair's reach instead of
+    // failing the scene; asked for explicitly, the cache stays an error.
+    const Scene noCache = Scene::parse(head + "cache: {enabled: false}\n", "cam.yaml", ".");
+    EXPECT_FALSE(cameraReadsStrandCache(noCache));
+    EXPECT_NO_THROW(checkCameraKeys(noCache));
+    const Scene asked = Scene::parse(head + "cache: {enabled: false}\nrender: {camera: {hair: cache}}\n", "cam.yaml", ".");
+    const SceneError e = test::sceneErrorOf([&] { checkCameraKeys(asked); }, "hair: cache without a cache");
+    EXPECT_EQ(e.key(), "render.camera.hair");
+    // A fixed camera reads nothing.
+    EXPECT_FALSE(cameraReadsStrandCache(Scene::parse(head + "render: {camera: {position: [0, 0, 1]}}\n", "c.yaml", ".")));
 }
 
 /// Straight strands from every scalp vertex of `mesh`, `length` long, along
@@ -312,6 +328,12 @@ TEST(CameraAuto, RunSimulatesTheClipFirstAndChunksFrameAlike) {
     ASSERT_EQ(one.exitCode, 0) << one.output;
     EXPECT_NE(one.output.find("of the whole clip"), std::string::npos) << one.output;
     EXPECT_TRUE(std::filesystem::exists(dir / "one/cache/strands.0006.hpc")) << "the clip's last frame is cached";
+    // A run that renders nothing needs no camera: it simulates its own frames only.
+    const test::ProcessResult sim = test::runHairpipe("run -q " + test::q(scene) + " --out " + test::q(dir / "sim") +
+                                                      " --frames 1-2 --stages sim");
+    ASSERT_EQ(sim.exitCode, 0) << sim.output;
+    EXPECT_TRUE(std::filesystem::exists(dir / "sim/cache/strands.0002.hpc"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "sim/cache/strands.0003.hpc")) << "sim alone stops at its frames";
     const test::ProcessResult jobs = test::runHairpipe("run -q " + test::q(scene) + " --out " + test::q(dir / "jobs") +
                                                        " --frames 1-6 --stages reference --jobs 2 --chunk 1");
     ASSERT_EQ(jobs.exitCode, 0) << jobs.output;

@@ -90,3 +90,59 @@ TEST(Cli, EveryBundledSceneValidates) {
     }
     EXPECT_GE(count, 7u) << "default, curly_wet and the Table 5.1 rows";
 }
+
+#include "render/image/image_io.h"
+
+#include <algorithm>
+
+// Every shipped scene renders with the default look (the render keys'
+// defaults, pipeline/scene/keys/render.yaml): the preview of its first frame
+// is a 560x720 portrait, opaque over the gradient backdrop (lighter at the
+// top), with the head and its hair framed tightly by the follow camera. Kept
+// small: a two-frame clip of 20 guides and 200 followers, no settling.
+TEST(Cli, EveryBundledSceneRendersWithTheDefaultLook) {
+    TempDir out;
+    size_t count = 0;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(sourcePath("scenes"))) {
+        if (entry.path().extension() != ".yaml") continue;
+        ++count;
+        const std::string name = entry.path().stem().string() + std::to_string(count);
+        SCOPED_TRACE(entry.path().string());
+        const ProcessResult r = runHairpipe(
+            "render --preview '" + entry.path().string() + "' --out '" + (out / name).string() + "'" +
+            " --frames 1 --set frames=1-2 --set hair.guides.count=20 --set hair.followers.count=200"
+            " --set hair.groom.settle=0");
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+        const hp::Image png = hp::readImage((out / name / "preview/preview.0001.png").string());
+        ASSERT_EQ(png.width, 560);
+        ASSERT_EQ(png.height, 720);
+        ASSERT_EQ(png.channelCount(), 4);
+        float alpha = 1.f;
+        for (int y = 0; y < png.height; ++y)
+            for (int x = 0; x < png.width; ++x) alpha = std::min(alpha, png.at(x, y, 3));
+        EXPECT_EQ(alpha, 1.f) << "the backdrop fills the display image";
+        // The EXR keeps coverage in alpha: where the head and hair are.
+        const hp::Image exr = hp::readImage((out / name / "preview/preview.0001.exr").string());
+        const int a = exr.channelIndex("A");
+        ASSERT_GE(a, 0);
+        int top = exr.height, bottom = -1, left = exr.width, right = -1;
+        for (int y = 0; y < exr.height; ++y)
+            for (int x = 0; x < exr.width; ++x)
+                if (exr.at(x, y, a) > 0.02f) {
+                    top = std::min(top, y), bottom = std::max(bottom, y);
+                    left = std::min(left, x), right = std::max(right, x);
+                }
+        ASSERT_GE(bottom, 0) << "nothing drawn";
+        // A background pixel (no coverage) at the top is lighter than one at the bottom.
+        if (exr.at(0, 0, a) == 0.f && exr.at(0, exr.height - 1, a) == 0.f) {
+            EXPECT_GT(png.at(0, 0, 0), png.at(0, png.height - 1, 0)) << "gradient backdrop";
+        }
+        // Follow framing fits the head and hair to the frame with a margin of
+        // 0.04 of the half-frame on each side: along one axis at least, the
+        // drawn bounds span most of the frame (1 - 2 x 0.04 = 0.92 when the
+        // fit is centred; 0.85 leaves room for thin, faint strand tips).
+        const double span = std::max(double(bottom - top + 1) / exr.height, double(right - left + 1) / exr.width);
+        EXPECT_GT(span, 0.85) << "rows " << top << "-" << bottom << ", columns " << left << "-" << right;
+    }
+    EXPECT_GE(count, 7u) << "default, curly_wet, stress and the Table 5.1 rows";
+}

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 using namespace hp;
 
 namespace {
@@ -263,7 +265,7 @@ TEST(SceneLists, TooManyItems) {
 TEST(ViewSettings, DisplayAndMelaninKeys) {
     const Scene s = Scene::parse(
         "render:\n  exposure: 1.5\n  background: {type: gradient, color: [0.2, 0.2, 0.2]}\n"
-        "  hair: {melanin: 0.3}\n",
+        "  hair: {melanin: 1.3, pheomelanin: 0.2}\n",
         "shot.yaml", ".");
     const DisplaySettings d = makeDisplaySettings(s);
     EXPECT_EQ(d.exposure, 1.5f);
@@ -272,8 +274,8 @@ TEST(ViewSettings, DisplayAndMelaninKeys) {
     // One key drives both renderers: the physical σa and the preview's
     // material fitted to that fibre (render.hair.shading: fitted, the default)...
     const View v = makeView(s);
-    EXPECT_TRUE(hairAbsorption(s).isApprox(hairAbsorptionFromMelanin(0.3f, 0.f)));
-    EXPECT_TRUE(hairFiber(s).sigmaA.isApprox(hairAbsorptionFromMelanin(0.3f, 0.f)));
+    EXPECT_TRUE(hairAbsorption(s).isApprox(hairAbsorptionFromMelanin(1.3f, 0.2f)));
+    EXPECT_TRUE(hairFiber(s).sigmaA.isApprox(hairAbsorptionFromMelanin(1.3f, 0.2f)));
     EXPECT_EQ(v.hair.shading, HairShading::Fitted);
     HairMaterial fitted;
     fitHairMaterial(hairFiber(s), &fitted);
@@ -281,10 +283,10 @@ TEST(ViewSettings, DisplayAndMelaninKeys) {
     EXPECT_TRUE(v.hair.tt.strength[0].isApprox(fitted.tt.strength[0]));
     EXPECT_FLOAT_EQ(v.hair.transmittance, fitted.dual.forward.dot(Vec3f(0.2126f, 0.7152f, 0.0722f)));
     // ...or, in shading kajiya-kay, the Kajiya-Kay colour through Chiang's colour fit.
-    const Scene kk = Scene::parse("render:\n  hair: {melanin: 0.3, shading: kajiya-kay}\n", "shot.yaml", ".");
+    const Scene kk = Scene::parse("render:\n  hair: {melanin: 1.3, pheomelanin: 0.2, shading: kajiya-kay}\n", "shot.yaml", ".");
     const View vk = makeView(kk);
     EXPECT_EQ(vk.hair.shading, HairShading::KajiyaKay);
-    EXPECT_TRUE(vk.hair.color.isApprox(hairColorFromAbsorption(hairAbsorptionFromMelanin(0.3f, 0.f), 0.3f)));
+    EXPECT_TRUE(vk.hair.color.isApprox(hairColorFromAbsorption(hairAbsorptionFromMelanin(1.3f, 0.2f), 0.3f)));
     EXPECT_FLOAT_EQ(vk.hair.transmittance, 0.8f);
     // A view the built-in transform does not know names the key and its line.
     const Scene bad = Scene::parse("render:\n  ocio:\n    view: nope\n", "shot.yaml", ".");
@@ -317,4 +319,85 @@ TEST(ViewSettings, MapsKeysAndChecksAcrossThem) {
     } catch (const SceneError& e) {
         EXPECT_EQ(e.key(), "render.camera.target");
     }
+}
+
+namespace {
+
+/// The render block scenes/default.yaml carried before its look became the
+/// keys' defaults (commit 2e3b0a3), written out as it was: the reference the
+/// defaults must reproduce.
+const char* kDefaultShotLook =
+    "render:\n"
+    "  camera: {mode: follow, hair: cache, fov: 38, width: 560, height: 720, margin: 0.04}\n"
+    "  ocio: {view: filmic}\n"
+    "  exposure: 0\n"
+    "  background: {type: gradient, color: [0.09, 0.09, 0.1], bottom: [0.025, 0.025, 0.028]}\n"
+    "  hair: {melanin: 0.3, pheomelanin: 0.1, ks: 0.12}\n";
+
+/// Every resolved render.* value of `s` ("key: value" lines of Scene::dump
+/// without the default marker). Without an OCIO config the empty view is the
+/// built-in filmic view (render/image/display_transform.cpp), so it is
+/// compared as such.
+std::vector<std::string> resolvedLook(const Scene& s) {
+    std::vector<std::string> lines;
+    std::istringstream in(s.dump());
+    for (std::string line; std::getline(in, line);) {
+        if (line.rfind("render.", 0) != 0) continue;
+        line = line.substr(0, line.find("    # default"));
+        if (line == "render.ocio.view: \"\"") line = "render.ocio.view: \"filmic\"";
+        lines.push_back(line);
+    }
+    return lines;
+}
+
+}  // namespace
+
+TEST(Look, SceneWithoutRenderKeysResolvesToTheDefaultShotsLook) {
+    const Scene none = Scene::parse("", "none.yaml", ".");
+    const Scene shot = Scene::parse(kDefaultShotLook, "look.yaml", ".");
+    const std::vector<std::string> a = resolvedLook(none), b = resolvedLook(shot);
+    ASSERT_GT(a.size(), 50u) << "the render keys were read";
+    EXPECT_EQ(a, b);
+    // The same through the settings the renderers get.
+    const View va = makeView(none), vb = makeView(shot);
+    EXPECT_EQ(va.camera.width, 560);
+    EXPECT_EQ(va.camera.height, 720);
+    EXPECT_EQ(va.camera.fovY, vb.camera.fovY);
+    EXPECT_TRUE(va.hair.color.isApprox(vb.hair.color));
+    EXPECT_TRUE(hairAbsorption(none).isApprox(hairAbsorptionFromMelanin(0.3f, 0.1f)));
+    const DisplaySettings da = makeDisplaySettings(none);
+    EXPECT_EQ(da.backdrop.kind, Backdrop::Kind::Gradient);
+    EXPECT_TRUE(da.backdrop.top.isApprox(Vec3f(0.09f, 0.09f, 0.1f)));
+    EXPECT_TRUE(da.backdrop.bottom.isApprox(Vec3f(0.025f, 0.025f, 0.028f)));
+    EXPECT_EQ(da.exposure, 0.f);
+}
+
+TEST(Look, DefaultSceneGivesNoRenderKey) {
+    // The demo's look is the defaults: scenes/default.yaml sets no render key,
+    // so what it shows is what any scene without render keys gets.
+    const Scene s = Scene::load(test::sourcePath("scenes/default.yaml"));
+    size_t checked = 0;
+    for (const KeySpec& k : Schema::scene().keys()) {
+        if (k.path.rfind("render.", 0) != 0 || k.path.find("[]") != std::string::npos) continue;
+        EXPECT_FALSE(s.given(k.path)) << k.path;
+        ++checked;
+    }
+    EXPECT_GT(checked, 40u) << "the render keys outside lists";
+    EXPECT_EQ(resolvedLook(s), resolvedLook(Scene::parse(kDefaultShotLook, "look.yaml", ".")));
+}
+
+TEST(Look, OtherFibreKeysAreRefusedWhileMelaninIsSet) {
+    // render.hair.melanin is set by default: the physical fibre's own pigment
+    // keys and the colour inversion would be silently ignored, so giving them
+    // is an error naming the key, unless render.hair.melanin is -1.
+    for (const char* key : {"reference.physical.melanin=8", "reference.physical.pheomelanin=1",
+                            "reference.physical.use_hair_color=true"}) {
+        const Scene s = Scene::parse("", "shot.yaml", ".", {key});
+        const SceneError e = test::sceneErrorOf([&] { makeView(s); }, key);
+        EXPECT_EQ(e.key(), std::string(key).substr(0, std::string(key).find('='))) << e.what();
+        EXPECT_NE(std::string(e.what()).find("render.hair.melanin: -1"), std::string::npos) << e.what();
+    }
+    const Scene off = Scene::parse("render:\n  hair: {melanin: -1}\nreference:\n  physical: {melanin: 8}\n",
+                                   "shot.yaml", ".");
+    EXPECT_TRUE(hairAbsorption(off).isApprox(hairAbsorptionFromMelanin(8.f, 0.f)));
 }

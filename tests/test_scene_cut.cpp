@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cfloat>
 #include <cmath>
 
 using namespace hp;
@@ -101,11 +102,21 @@ TEST(SceneCut, NoVertexInsideAnyColliderOnTheCutFrameAndAfter) {
             if (k == 10) {
                 EXPECT_EQ(depth, 0.f) << "the cut frame: every vertex outside the head and the floor";
                 EXPECT_LE(st.maxLengthError, 1e-4) << "placed outside without stretching";
+            } else if (f == GuideFormulation::Rope) {
+                // The finish pass's last projection keeps every vertex the
+                // collision radius outside (tests/test_collision_world.cpp).
+                EXPECT_EQ(depth, 0.f) << "step " << k;
             } else {
+                // Rigid: each segment body is pushed out by its deepest of
+                // three points, which bounds but does not zero the others.
                 EXPECT_LE(depth, 1e-3f) << "step " << k;
             }
             if (f == GuideFormulation::Rope) {
-                EXPECT_LE(st.maxLengthError, 1e-3) << "step " << k;
+                // Exact lengths up to float rounding (the finish pass's
+                // follow-the-leader, tests/test_collision_world.cpp says how
+                // much): coordinates below 0.8 m, segments of 0.25/23 m
+                // (3.5e-5; measured 1.4e-6).
+                EXPECT_LE(st.maxLengthError, 4.0 * 0.8 * FLT_EPSILON / (0.25 / 23)) << "step " << k;
             }
         }
     }

@@ -27,7 +27,15 @@ std::vector<std::string> sceneArguments(const RunOptions& options, const ShotSet
     return args;
 }
 
+bool framesOnCachedHair(const Scene& scene, const std::vector<StagePtr>& stages) {
+    // A sim- or vdb-only run needs no camera: it simulates only its own frames.
+    return cameraReadsStrandCache(scene) && std::any_of(stages.begin(), stages.end(), [](const StagePtr& s) {
+               return s && (s->name() == "preview" || s->name() == "reference");
+           });
+}
+
 void simulateFirst(const Scene& scene, const ShotSettings& shot, std::vector<StagePtr>& stages, RunReport& report) {
+    const bool wholeClip = framesOnCachedHair(scene, stages);
     StagePtr sim;
     std::vector<StagePtr> rest;
     for (StagePtr& s : stages) {
@@ -44,15 +52,15 @@ void simulateFirst(const Scene& scene, const ShotSettings& shot, std::vector<Sta
     ShotSettings simShot = shot;
     simShot.writesCache = true;
     simShot.requireCache = false;
-    if (cameraReadsStrandCache(scene)) {
-        // Camera auto frames the cached hair of the whole clip: simulate all of it.
+    if (wholeClip) {
+        // The camera frames the cached hair of the whole clip: simulate all of it.
         const std::vector<int>& clip = scene.frames("frames");
         simShot.frames.insert(simShot.frames.end(), clip.begin(), clip.end());
         std::sort(simShot.frames.begin(), simShot.frames.end());
         simShot.frames.erase(std::unique(simShot.frames.begin(), simShot.frames.end()), simShot.frames.end());
     }
     logInfo("simulating first (sequential), writing the strand cache",
-            simShot.frames.size() > shot.frames.size() ? " of the whole clip (camera auto frames its hair)" : "");
+            simShot.frames.size() > shot.frames.size() ? " of the whole clip (the camera frames its hair)" : "");
     std::vector<StagePtr> simStages;
     simStages.push_back(std::move(sim));
     std::unique_ptr<FrameSource> source = makeFrameSource(scene, simShot);

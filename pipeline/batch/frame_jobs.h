@@ -22,10 +22,15 @@ namespace hp {
 /// overrides (--set, the seed), so the child sees exactly this run's scene.
 std::vector<std::string> sceneArguments(const RunOptions& options, const ShotSettings& shot);
 
+/// True when a stage of `stages` renders (preview, reference) with a camera
+/// that frames the cached hair of the whole clip (cameraReadsStrandCache, the
+/// default camera): the clip must then be simulated before the first frame.
+bool framesOnCachedHair(const Scene& scene, const std::vector<StagePtr>& stages);
+
 /// @brief Runs the simulation before the frame stages: moves the sim stage
 /// out of `stages` (or, when the other stages need strands and the run may
 /// simulate, makes one) and runs it over the run's frames, plus the whole
-/// clip when camera auto frames the cached hair (cameraReadsStrandCache).
+/// clip when a rendering stage frames the cached hair (framesOnCachedHair).
 /// Its failures go into `report`.
 void simulateFirst(const Scene& scene, const ShotSettings& shot, std::vector<StagePtr>& stages, RunReport& report);
 

@@ -134,7 +134,7 @@ int runShotCommand(const CommandContext& ctx, const std::set<std::string>& only)
         report = runShotInJobs(ctx.scene, ctx.options, only);
     } else {
         RunReport simulation;
-        if (cameraReadsStrandCache(ctx.scene)) simulateFirst(ctx.scene, shot, stages, simulation);
+        if (framesOnCachedHair(ctx.scene, stages)) simulateFirst(ctx.scene, shot, stages, simulation);
         std::unique_ptr<FrameSource> source = makeFrameSource(ctx.scene, shot);
         report = runFrames(*source, stages, shot);
         report.outputsSkipped += simulation.outputsSkipped;
@@ -182,17 +182,25 @@ CommandSpec runCommandSpec() {
 CommandSpec renderCommandSpec() {
     CommandSpec c{"render", "[--preview] [--reference] [options] scene.yaml",
                   "render preview (GL) and/or reference (Embree) frames"};
-    c.details = "Without --preview or --reference, renders whichever of the two the scene enables.";
+    c.details = "Without --preview or --reference, renders whichever of the two the scene enables;\n"
+                "--preview and --reference render theirs even where the scene leaves it disabled.";
     c.options = {{"--preview", "", "render the GL preview"}, {"--reference", "", "render the Embree reference"}};
     for (const OptionSpec& o : jobOptions("render N frames at once in child processes (simulating missing cache frames first)"))
         c.options.push_back(o);
-    c.run = runStages([](const CommandContext&, const CommandLine& cl) {
+    const auto run = runStages([](const CommandContext&, const CommandLine& cl) {
         std::set<std::string> only;
         if (cl.has("--preview")) only.insert("preview");
         if (cl.has("--reference")) only.insert("reference");
         if (only.empty()) only = {"preview", "reference"};
         return only;
     });
+    c.run = [run](const CommandLine& given) {
+        // As an override, so --jobs children (which get the run's --set list) see it too.
+        CommandLine cl = given;
+        for (const std::string stage : {"preview", "reference"})
+            if (cl.has("--" + stage)) cl.values["--set"].push_back(stage + ".enabled=true");
+        return run(cl);
+    };
     return c;
 }
 

@@ -113,7 +113,9 @@ FarmPlan makeFarmPlan(const Scene& scene, const RunOptions& options, const FarmO
     p.cacheOnly = p.simulate;
     if (sceneHasHair(scene) && !p.simulate)
         scene.fail("cache.enabled", "a farm run shares the simulation through the strand cache; enable it");
-    for (const StagePtr& s : makeStages(scene, p.shot, {})) {
+    std::vector<StagePtr> stages = makeStages(scene, p.shot, {});
+    p.simulateClip = p.simulate && framesOnCachedHair(scene, stages);
+    for (const StagePtr& s : stages) {
         if (s->name() == "sim") continue;
         p.frameStages.push_back(s->name());
         if (s->name() == "compare") p.report = true;
@@ -161,8 +163,14 @@ void writeFarmScripts(const FarmPlan& p) {
     if (p.chunks.empty()) fs::remove(p.script("frames"), ec);
     if (!p.report) fs::remove(p.script("report"), ec);
 
-    if (p.simulate)
-        writeTextAtomically(p.script("sim"), taskScript(p, "sim", "sim", "sim.log", "", exe + " sim " + joinQuoted(common)), true);
+    if (p.simulate) {
+        // Each frame task's camera may frame the cached hair of every clip
+        // frame (framesOnCachedHair): the sim job then writes the whole clip.
+        std::vector<std::string> sim = common;
+        if (p.simulateClip && p.options.frames) sim = sceneArguments(p.options, p.shot);
+        if (p.simulateClip && p.options.frames && p.options.force) sim.push_back("--force");
+        writeTextAtomically(p.script("sim"), taskScript(p, "sim", "sim", "sim.log", "", exe + " sim " + joinQuoted(sim)), true);
+    }
     if (!p.chunks.empty()) {
         std::ostringstream pre;
         pre << "task=\"${SLURM_ARRAY_TASK_ID:-${1:-}}\"\n"

@@ -42,6 +42,7 @@ struct FarmPlan {
     FarmOptions farm;
     bool simulate = false;              ///< the scene has hair: a sim job
     bool cacheOnly = false;             ///< frame tasks read strands only from the cache
+    bool simulateClip = false;          ///< the sim job runs the whole clip: the camera frames its cached hair
     std::vector<std::string> frameStages;  ///< stages the array runs (preview, reference, vdb, compare)
     std::vector<std::vector<int>> chunks;  ///< array task k (1-based) = chunks[k-1]
     bool report = false;                ///< a final compare-report job

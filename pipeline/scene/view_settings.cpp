@@ -111,9 +111,19 @@ HairFiberParams hairFiber(const Scene& s) {
 float hairRoughness(const Scene& s) { return float(s.number("reference.physical.azimuthal_roughness")); }
 
 Vec3f hairAbsorption(const Scene& s) {
-    if (s.number("render.hair.melanin") >= 0)
+    if (s.number("render.hair.melanin") >= 0) {
+        // render.hair.melanin is set by default (the default shot's blond):
+        // the other descriptions of the fibre would be silently ignored.
+        for (const char* key : {"reference.physical.melanin", "reference.physical.pheomelanin"})
+            if (s.given(key))
+                s.fail(key, "is not used while render.hair.melanin is set (0.3 by default), which sets the fibre of "
+                            "both renderers: set render.hair.melanin instead, or render.hair.melanin: -1");
+        if (s.flag("reference.physical.use_hair_color"))
+            s.fail("reference.physical.use_hair_color",
+                   "needs render.hair.melanin: -1 (it is 0.3 by default, and sets the fibre itself)");
         return hairAbsorptionFromMelanin(float(s.number("render.hair.melanin")),
                                          float(s.number("render.hair.pheomelanin")));
+    }
     if (s.flag("reference.physical.use_hair_color"))
         return hairAbsorptionFromColor(s.vec3f("render.hair.color"), hairRoughness(s));
     return hairAbsorptionFromMelanin(float(s.number("reference.physical.melanin")),

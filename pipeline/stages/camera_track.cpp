@@ -76,8 +76,20 @@ FramingSettings framingSettings(const Scene& scene) {
     return f;
 }
 
+namespace {
+
+/// render.camera.hair, or without the key: cache, unless the scene writes no
+/// strand cache (cache.enabled false), where the default falls back to reach
+/// rather than making a scene that gives neither key fail.
+std::string cameraHair(const Scene& scene) {
+    if (!scene.given("render.camera.hair") && !scene.flag("cache.enabled")) return "reach";
+    return scene.text("render.camera.hair");
+}
+
+}  // namespace
+
 bool cameraReadsStrandCache(const Scene& scene) {
-    return sceneHasHair(scene) && scene.text("render.camera.hair") == "cache" && cameraMode(scene) != "fixed";
+    return sceneHasHair(scene) && cameraHair(scene) == "cache" && cameraMode(scene) != "fixed";
 }
 
 void checkCameraKeys(const Scene& scene) {
@@ -87,7 +99,7 @@ void checkCameraKeys(const Scene& scene) {
         if (scene.given(key))
             scene.fail(key, "is not used by render.camera.mode: " + mode +
                                 " (the camera frames the head); remove it, or set render.camera.mode: fixed");
-    if (scene.text("render.camera.hair") == "cache" && sceneHasHair(scene) && !scene.flag("cache.enabled"))
+    if (cameraHair(scene) == "cache" && sceneHasHair(scene) && !scene.flag("cache.enabled"))
         scene.fail("render.camera.hair", "cache reads the strand cache, but cache.enabled is false");
     framingSettings(scene);
 }

@@ -52,7 +52,7 @@ struct GeneratedHairSettings {
     float maxLength() const;
 };
 
-/// The seed's force vector at `time` for a strand rooted at `root`:
+/// Dehlin and Styngberg 2017's force vector at `time` for a strand rooted at `root`:
 /// gravity + wind * (1 + gust * sin(2 pi (f t - (root . wind_dir) / wavelength))).
 /// shaders/fur.geom evaluates the same expression.
 Vec3f hairForce(const GeneratedHairSettings& s, double time, const Vec3f& root);

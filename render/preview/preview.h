@@ -57,11 +57,11 @@
 namespace hp {
 
 enum class CurveType { CatmullRom, BSpline };
-/// Seed 004's voxel update: occupancy (set to 1) or density (add 1 per fragment).
+/// Dehlin and Styngberg 2017's voxel update: occupancy (set to 1) or density (add 1 per fragment).
 enum class VoxelMode { Binary, Additive };
 /// How semi-transparent hair is composited (see the file comment).
 enum class HairBlend { Sorted, Weighted };
-/// Seed 004's splatting of a fragment into the grid: its voxel, or trilinear
+/// Dehlin and Styngberg 2017's splatting of a fragment into the grid: its voxel, or trilinear
 /// weights over the 8 nearest voxel centres (additive only).
 enum class VoxelSplat { Nearest, Trilinear };
 /// What a voxel counts: expected strand crossings of a light ray (each

@@ -203,7 +203,7 @@ void HeadBuffers::upload(const TriangleMesh& mesh, const std::vector<uint8_t>& t
         types = triangleTypes;
     }
     if (!hairTypes || !sameTypes(hairTypeList, hairTypeRows)) {
-        // The seed reads hair types from a texture: one column per type.
+        // Hair types are read from a texture (as Dehlin and Styngberg 2017 do): one column per type.
         const int columns = std::max<int>(1, int(hairTypeList.size()));
         std::vector<float> texels(size_t(columns) * 2 * 4, 0.f);
         for (size_t i = 0; i < hairTypeList.size(); ++i) {

@@ -1,6 +1,6 @@
 // Head-contact kernels every strand model shares: the head as one Bullet
 // step (or substep) sees it, projection out of its signed distance
-// (Bridson et al. 2002's collision handling, which both seeds use), placing a
+// (Bridson et al. 2002's collision handling; Kim 2023 handles the head so too), placing a
 // vertex at its length outside the head, and Coulomb friction on the
 // velocity a contact left. Pure functions on plain vectors.
 //
