@@ -44,15 +44,24 @@ void simulateFirst(const Scene& scene, const ShotSettings& shot, std::vector<Sta
     ShotSettings simShot = shot;
     simShot.writesCache = true;
     simShot.requireCache = false;
-    if (cameraReadsStrandCache(scene)) {
-        // Camera auto frames the cached hair of the whole clip: simulate all of it.
-        const std::vector<int>& clip = scene.frames("frames");
-        simShot.frames.insert(simShot.frames.end(), clip.begin(), clip.end());
+    // Camera auto/follow frames the cached hair: the frames the cameras of the
+    // rendered frames read must be simulated too (follow: the frames
+    // themselves; auto: their whole cut-free segments). A sim or vdb run
+    // frames nothing and simulates only its frames.
+    const bool renders = std::any_of(stages.begin(), stages.end(),
+                                     [](const StagePtr& s) { return s->name() == "preview" || s->name() == "reference"; });
+    if (renders && cameraReadsStrandCache(scene)) {
+        const std::vector<int> framing = cameraCacheFrames(scene, shot.frames);
+        simShot.frames.insert(simShot.frames.end(), framing.begin(), framing.end());
         std::sort(simShot.frames.begin(), simShot.frames.end());
         simShot.frames.erase(std::unique(simShot.frames.begin(), simShot.frames.end()), simShot.frames.end());
+        if (simShot.frames.size() > shot.frames.size())
+            logVerbose("camera ", scene.text("render.camera.mode"), " frames whole segments of the clip: simulating ",
+                       simShot.frames.size() - shot.frames.size(), " more frames (", formatFrameRange(simShot.frames),
+                       ") than asked (", formatFrameRange(shot.frames), ")");
     }
     logInfo("simulating first (sequential), writing the strand cache",
-            simShot.frames.size() > shot.frames.size() ? " of the whole clip (camera auto frames its hair)" : "");
+            simShot.frames.size() > shot.frames.size() ? " of the frames the camera frames (camera auto)" : "");
     std::vector<StagePtr> simStages;
     simStages.push_back(std::move(sim));
     std::unique_ptr<FrameSource> source = makeFrameSource(scene, simShot);

@@ -24,8 +24,10 @@ std::vector<std::string> sceneArguments(const RunOptions& options, const ShotSet
 
 /// @brief Runs the simulation before the frame stages: moves the sim stage
 /// out of `stages` (or, when the other stages need strands and the run may
-/// simulate, makes one) and runs it over the run's frames, plus the whole
-/// clip when camera auto frames the cached hair (cameraReadsStrandCache).
+/// simulate, makes one) and runs it over the run's frames, plus, when a
+/// render stage's camera auto frames the cached hair, the frames its
+/// cameras read (cameraCacheFrames: none more in follow mode, the whole
+/// cut-free segments in auto mode).
 /// Its failures go into `report`.
 void simulateFirst(const Scene& scene, const ShotSettings& shot, std::vector<StagePtr>& stages, RunReport& report);
 

@@ -285,6 +285,17 @@ size_t ShotSimulation::followerCount() const { return followers_->followerCount(
 const StrandFrame& ShotSimulation::advanceTo(int frame) {
     if (frame < frame_) throw std::logic_error(cat("simulation cannot go back from frame ", frame_, " to ", frame));
     if (frame == frame_) return strands_;
+    // The followers carry state from the frame produced before (velocities
+    // by difference, pinned vertices held toward their previous place), so
+    // every clip frame on the way is produced: a frame's strands are the
+    // same bits whichever frames a run asks for.
+    for (int f : scene_.frames("frames"))
+        if (f > frame_ && f < frame) stepTo(f);
+    stepTo(frame);
+    return strands_;
+}
+
+void ShotSimulation::stepTo(int frame) {
     const double target = frame / fps_;
     // Steps are frame-aligned, so the frame is a step's end; the tolerance
     // absorbs the rounding of a float step accumulated over the shot.
@@ -306,7 +317,6 @@ const StrandFrame& ShotSimulation::advanceTo(int frame) {
     }
     frame_ = frame;
     produceFrame(std::min(target, model_->solver.time()));
-    return strands_;
 }
 
 void ShotSimulation::produceFrame(double time) {

@@ -69,7 +69,8 @@ class ShotSimulation {
     ~ShotSimulation();
 
     /// Advances to `frame` (>= frame()) and returns all strands there (guides
-    /// first). Throws FrameError if the simulation produced non-finite values.
+    /// first). Every clip frame between is produced on the way (the
+    /// followers carry state from frame to frame). Throws FrameError if the simulation produced non-finite values.
     const StrandFrame& advanceTo(int frame);
 
     int frame() const { return frame_; }
@@ -91,6 +92,8 @@ class ShotSimulation {
     void restoreCheckpoint(const std::filesystem::path& file, const StrandFrame& strands);
 
   private:
+    /// Steps the guides to `frame` and produces its strands (advanceTo's one frame).
+    void stepTo(int frame);
     void produceFrame(double time);
     /// The guides' rest shape at t0: imported, combed or straight, settled.
     void initializeGuides(const GuideSettings& settings, const struct ImportedGroom* imported,
