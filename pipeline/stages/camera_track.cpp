@@ -8,8 +8,8 @@
 #include "pipeline/head/head_setup.h"
 #include "pipeline/stages/shot_simulation.h"
 #include "pipeline/batch/strand_cache.h"
+#include "pipeline/stages/cached_strands.h"
 
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -171,7 +171,7 @@ std::pair<size_t, size_t> segmentOf(const std::vector<size_t>& starts, size_t i)
 class CameraFraming {
   public:
     CameraFraming(const Scene& scene, const Camera& lens, const std::filesystem::path& outputDir, bool cached)
-        : mode_(cameraMode(scene)), lens_(lens), cached_(cached) {
+        : scene_(scene), mode_(cameraMode(scene)), lens_(lens), cached_(cached) {
         settings_ = framingSettings(scene);
         settings_.follow = mode_ == "follow";
         head_ = frameHead(scene, cached);
@@ -181,23 +181,23 @@ class CameraFraming {
                 logVerbose("camera ", mode_, ": cut before frame ", head_.samples[i].frame, ", framed anew");
         }
         directions_ = viewDirections(head_.samples, head_.starts, settings_);
-        ShotSettings shot;
-        shot.outputDir = outputDir;
+        shot_.outputDir = outputDir;
+        shot_.fps = scene.number("fps");
         for (const FramingSample& sample : head_.samples)
-            files_.push_back(cachePath(scene, shot, "cache.strands", sample.frame));
+            files_.push_back(cachePath(scene, shot_, "cache.strands", sample.frame));
         if (!cached_) {  // the hair bounded by its reach: every camera now, from the head alone
             const std::vector<Camera> cameras = frameSamples(head_.samples, head_.starts, lens_, settings_);
             for (size_t i = 0; i < cameras.size(); ++i) cameras_.emplace(head_.samples[i].frame, cameras[i]);
         }
     }
 
-    const Camera* at(int frame) const {
+    const Camera* at(int frame, const StrandFrame* hair) const {
         const auto it = index_.find(frame);
         if (it == index_.end()) return nullptr;
         const std::lock_guard<std::mutex> lock(mutex_);
         const auto done = cameras_.find(frame);
         if (done != cameras_.end()) return &done->second;
-        frameWithCachedHair(it->second);
+        frameWithCachedHair(it->second, hair && hair->frame == frame ? hair : nullptr);
         return &cameras_.at(frame);
     }
 
@@ -215,9 +215,10 @@ class CameraFraming {
     /// Frames sample i (follow: alone; auto: its whole segment) with the
     /// cached hair's extreme points added to the head's spheres. The same
     /// spheres in the same order as a whole-clip framing, so the same bits.
-    void frameWithCachedHair(size_t i) const {
+    void frameWithCachedHair(size_t i, const StrandFrame* hair) const {
         const auto [begin, end] = settings_.follow ? std::pair<size_t, size_t>{i, i + 1} : segmentOf(head_.starts, i);
-        for (size_t k = begin; k < end; ++k) {  // fail before reading anything
+        const bool given = settings_.follow && hair;  // the frame's own strands, from the caller
+        for (size_t k = begin; k < end && !given; ++k) {  // fail before reading anything
             std::error_code ec;
             if (!std::filesystem::is_regular_file(files_[k], ec))
                 throw FrameError(cat("camera ", mode_, " frames the cached hair (render.camera.hair: cache), but frame ",
@@ -227,11 +228,13 @@ class CameraFraming {
         }
         const auto start = std::chrono::steady_clock::now();
         std::vector<FramingSample> samples(head_.samples.begin() + long(begin), head_.samples.begin() + long(end));
-        // Frames are independent: read them in parallel (each sample is written by one task).
-        tbb::parallel_for(size_t(0), samples.size(), [&](size_t k) {
-            addCachedHair(samples[k], readStrandCache(files_[begin + k]),
+        // In order: a version 2 cache rebuilds each frame's followers on the
+        // frame before's (cached_strands.h), once per frame.
+        for (size_t k = 0; k < samples.size(); ++k) {
+            if (!reader_) reader_ = std::make_unique<CachedStrands>(scene_, shot_);
+            addCachedHair(samples[k], given ? *hair : reader_->read(files_[begin + k]),
                           framingNormals(lens_, directions_[begin + k], settings_.up, settings_.margin));
-        });
+        }
         // As frameSamples frames the clip (render/view/camera_framing.cpp):
         // follow, each sample alone from its segment's direction; auto, the
         // segment's spheres in sample order, from its first sample's direction.
@@ -252,6 +255,8 @@ class CameraFraming {
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), " s");
     }
 
+    Scene scene_;  ///< a copy, for reader_
+    ShotSettings shot_;
     std::string mode_;
     Camera lens_;
     bool cached_;
@@ -262,11 +267,12 @@ class CameraFraming {
     std::map<int, size_t> index_;               ///< frame -> sample
     mutable std::mutex mutex_;
     mutable std::map<int, Camera> cameras_;     ///< framed so far (references stay valid)
+    mutable std::unique_ptr<CachedStrands> reader_;  ///< the cached hair, made on first use
 };
 
-const Camera& CameraTrack::at(int frame) const {
+const Camera& CameraTrack::at(int frame, const StrandFrame* hair) const {
     if (!framing_) return fallback_;
-    const Camera* c = framing_->at(frame);
+    const Camera* c = framing_->at(frame, hair);
     return c ? *c : fallback_;
 }
 

@@ -33,7 +33,11 @@ class CameraTrack {
     /// The camera of `frame`. With render.camera.hair: cache it reads the
     /// strand cache of only the frames cacheFramesFor(frame) names, on first
     /// use; a missing cache file throws FrameError naming it.
-    const Camera& at(int frame) const;
+    const Camera& at(int frame) const { return at(frame, nullptr); }
+    /// The same, given the frame's own strands when the caller has them
+    /// (the stages' frame data): camera follow then frames them instead of
+    /// reading (and rebuilding) the cache file again. Equal bits either way.
+    const Camera& at(int frame, const StrandFrame* hair) const;
     /// True when the camera moves with the head (auto or follow).
     bool framed() const { return framing_ != nullptr; }
     /// The strand cache frames at(frame) reads: follow, the frame itself;
