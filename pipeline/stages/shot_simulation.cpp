@@ -168,7 +168,7 @@ std::string SimFrameStats::json() const {
 
 ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame, const SettleCache& settleCache,
                                bool rebuildOnly)
-    : scene_(scene), fps_(fps), frame_(startFrame) {
+    : scene_(scene), fps_(fps), frame_(startFrame), clip_(scene.frames("frames")) {
     if (!sceneHasHead(scene)) scene.fail("head.file", "the shot has hair but no head: set head.file");
     head_ = loadHead(scene);
     std::unique_ptr<ImportedGroom> imported;
@@ -294,7 +294,7 @@ const StrandFrame& ShotSimulation::advanceTo(int frame) {
     // by difference, pinned vertices held toward their previous place), so
     // every clip frame on the way is produced: a frame's strands are the
     // same bits whichever frames a run asks for.
-    for (int f : scene_.frames("frames"))
+    for (int f : clip_)
         if (f > frame_ && f < frame) stepTo(f);
     stepTo(frame);
     return strands_;

@@ -124,6 +124,7 @@ class ShotSimulation {
     const Scene& scene_;
     double fps_;
     int frame_;
+    std::vector<int> clip_;  ///< the scene's frames (a copy: callers may pass a temporary scene)
     HeadSetup head_;
     GroomRoots roots_;
     std::unique_ptr<GuideModel> model_;
