@@ -310,6 +310,53 @@ TEST(Batch, FrameSubsetRenderedFromTheCacheEqualsTheFullRun) {
     }
 }
 
+/// The small scene with camera follow framing the cached hair (the default
+/// scene's camera) instead of its fixed camera.
+fs::path writeFollowScene(const fs::path& dir, const std::string& frames) {
+    const fs::path scene = writeSmallScene(dir, frames);
+    std::string yaml = readFile(scene);
+    const std::string fixed = "position: [0.42, 0.08, 0.62], target: [0, -0.04, -0.02], ";
+    const size_t at = yaml.find(fixed);
+    EXPECT_NE(at, std::string::npos) << "the small scene's camera moved; update this test";
+    yaml.replace(at, fixed.size(), "mode: follow, hair: cache, ");
+    writeFile(scene, yaml);
+    return scene;
+}
+
+/// Strand cache frames written under `out`, sorted.
+std::vector<std::string> cacheFrames(const fs::path& out) {
+    std::vector<std::string> files;
+    if (!fs::is_directory(out / "cache")) return files;
+    for (const auto& e : fs::directory_iterator(out / "cache"))
+        if (e.path().extension() == ".hpc") files.push_back(e.path().filename().string());
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+TEST(Batch, FollowCameraSimulatesOnlyTheFramesAskedAndFramesThemAlike) {
+    TempDir dir;
+    const fs::path scene = writeFollowScene(dir.path(), "1-12");
+    // sim of frames 1-5 writes those 5 cache frames, not the clip's 12.
+    ASSERT_TRUE(hairpipeSucceeds("sim -q " + q(scene) + " --out " + q(dir / "s") + " --frames 1-5"));
+    EXPECT_EQ(cacheFrames(dir / "s"), (std::vector<std::string>{"strands.0001.hpc", "strands.0002.hpc", "strands.0003.hpc",
+                                                                "strands.0004.hpc", "strands.0005.hpc"}));
+    // A preview of frame 3 alone simulates (and caches) only frame 3 ...
+    const std::string stages = " --stages sim,preview";
+    ASSERT_TRUE(hairpipeSucceeds("run -q " + q(scene) + " --out " + q(dir / "one") + " --frames 3" + stages));
+    EXPECT_EQ(cacheFrames(dir / "one"), (std::vector<std::string>{"strands.0003.hpc"}));
+    // ... and gets the same camera, strands and pixels as frames 1-5 do.
+    ASSERT_TRUE(hairpipeSucceeds("run -q " + q(scene) + " --out " + q(dir / "five") + " --frames 1-5" + stages));
+    EXPECT_EQ(cacheFrames(dir / "five").size(), 5u);
+    for (const char* f : {"cache/strands.0003.hpc", "preview/preview.0003.png"})
+        EXPECT_TRUE(readFile(dir / "one" / f) == readFile(dir / "five" / f)) << f << " differs";
+    expectSameFile(dir / "one", dir / "five", "preview/preview.0003.exr");
+    // render --force of frame 4 re-simulates frame 4 only, and the camera
+    // still reads that frame's hair (the picture matches the 1-5 run).
+    ASSERT_TRUE(hairpipeSucceeds("render -q --preview " + q(scene) + " --out " + q(dir / "one") + " --frames 4 --force"));
+    EXPECT_EQ(cacheFrames(dir / "one"), (std::vector<std::string>{"strands.0003.hpc", "strands.0004.hpc"}));
+    EXPECT_TRUE(readFile(dir / "one/preview/preview.0004.png") == readFile(dir / "five/preview/preview.0004.png"));
+}
+
 TEST(Batch, JobsOutputsEqualOneProcessAndTheReportCoversEveryFrame) {
     TempDir dir;
     const fs::path scene = writeSmallScene(dir.path());

@@ -119,21 +119,29 @@ TEST(Farm, LocalEngineEqualsAPlainRunAndStatusCountsFrames) {
     EXPECT_NE(failed.output.find("\nincomplete\n"), std::string::npos) << failed.output;
 }
 
-TEST(Farm, PartOfAShotFramedOnItsCachedHairSimulatesTheWholeClip) {
-    // The default camera frames the cached hair of every clip frame: a farm
-    // run of frame 2 alone must still simulate frames 1-4 in its sim job, or
-    // the frame task (which may only read the cache) fails on frame 3's.
+TEST(Farm, PartOfAShotSimulatesTheFramesItsCamerasRead) {
+    // The default camera (follow) frames each frame from its own cached hair:
+    // a farm run of frame 2 simulates up to frame 2 and no further. Camera
+    // auto frames the cached hair of the frame's whole cut-free segment (here
+    // the clip 1-4): its sim job must write frame 4 too, or the frame task
+    // (which may only read the cache) fails on it.
     TempDir dir;
     const fs::path scene = writeSmallScene(dir.path(), "1-4");
     std::string yaml = readFile(scene);
     const std::string fixed = "position: [0.42, 0.08, 0.62], target: [0, -0.04, -0.02], ";
     ASSERT_NE(yaml.find(fixed), std::string::npos);
     writeFile(scene, yaml.erase(yaml.find(fixed), fixed.size()));
-    const ProcessResult r = runHairpipe("farm submit --engine local " + q(scene) + " --out " + q(dir / "b") +
-                                        " --frames 2 --chunk 1 --set vdb.enabled=false --set reference.enabled=false --set compare.enabled=false");
-    ASSERT_EQ(r.exitCode, 0) << r.output;
-    EXPECT_TRUE(fs::exists(dir / "b/cache/strands.0004.hpc")) << "the clip's last frame is cached";
-    EXPECT_TRUE(fs::exists(dir / "b/preview/preview.0002.png"));
+    const std::string only = " --frames 2 --chunk 1 --set vdb.enabled=false --set reference.enabled=false --set compare.enabled=false";
+    const ProcessResult follow =
+        runHairpipe("farm submit --engine local " + q(scene) + " --out " + q(dir / "f") + only);
+    ASSERT_EQ(follow.exitCode, 0) << follow.output;
+    EXPECT_TRUE(fs::exists(dir / "f/preview/preview.0002.png"));
+    EXPECT_FALSE(fs::exists(dir / "f/cache/strands.0004.hpc")) << "follow reads frame 2's hair alone";
+    const ProcessResult aut = runHairpipe("farm submit --engine local " + q(scene) + " --out " + q(dir / "a") + only +
+                                          " --set render.camera.mode=auto");
+    ASSERT_EQ(aut.exitCode, 0) << aut.output;
+    EXPECT_TRUE(fs::exists(dir / "a/cache/strands.0004.hpc")) << "auto frames the whole segment: the clip is cached";
+    EXPECT_TRUE(fs::exists(dir / "a/preview/preview.0002.png"));
 }
 
 TEST(Farm, StatusRejectsSubmitOptions) {

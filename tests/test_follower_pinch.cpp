@@ -193,6 +193,33 @@ TEST(FollowerPinch, FollowersSqueezedUnderALidStayOutsideAtTheirLengths) {
                 inside, deepest * 1e3, stretch);
 }
 
+TEST(FollowerPinch, PinsRebuildAFrameWithoutTheFrameBefore) {
+    // The strand cache keeps a frame's guides and its pins, not the frame
+    // before: a fresh Followers whose buffer holds anything but the pins'
+    // places must give the pinned frame's positions again, bit for bit.
+    const hp::test::SphereScene scene(94, 2000, 0.7);
+    const HeadUnderLid head(0.095f);
+    const FollowerStep first{scene.guides, scene.guideRoots, scene.followerRoots, &head};
+    const FollowerStep second{scene.guides, scene.guideRoots, scene.followerRoots, &head, 0.04};
+    Followers simulated(scene.groom, {});
+    StrandFrame out;
+    simulated.update(first, out);
+    const FollowerStats stats = simulated.update(second, out);
+    ASSERT_GT(stats.pinned, 0u) << "the lid pins vertices";
+    EXPECT_EQ(stats.pins.size(), stats.pinned) << "every pinned vertex held toward its last place is listed";
+    for (size_t i = 1; i < stats.pins.size(); ++i) EXPECT_LT(stats.pins[i - 1].vertex, stats.pins[i].vertex);
+
+    Followers rebuilt(scene.groom, {});
+    StrandFrame again;
+    rebuilt.update(first, again);
+    const size_t guideVertices = again.offsets[again.guideCount];
+    for (size_t v = guideVertices; v < again.positions.size(); ++v) again.positions[v] = Vec3f(1.f, 2.f, 3.f);
+    rebuilt.adoptPins(again, stats.pins);
+    const FollowerStats stats2 = rebuilt.update(second, again);
+    EXPECT_TRUE(again.positions == out.positions) << "the pinned frame comes back bit for bit";
+    EXPECT_EQ(stats2.pins.size(), stats.pins.size());
+}
+
 TEST(FollowerPinch, FrameStatisticsReportBentAndPinnedFollowerVertices) {
     SimFrameStats s;
     s.guides.pinnedCount = 2;

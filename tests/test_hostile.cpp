@@ -270,7 +270,8 @@ TEST(Hostile, ZeroLengthClip) {
                               "hair:\n  guides: {count: 6, segments: 4}\n  followers: {count: 10}\n");
     const ProcessResult info = runHairpipe("info s.yaml", dir.path());
     EXPECT_NE(info.output.find("0: still, 0.00 s"), std::string::npos) << info.output;
-    const ProcessResult r = runHairpipe("sim s.yaml --out out", dir.path());
+    // Whole strands in the cache (version 1), to read them back here.
+    const ProcessResult r = runHairpipe("sim s.yaml --out out --set cache.followers=store", dir.path());
     EXPECT_EQ(r.exitCode, 0) << r.output;
     // readStrandCache validates (finite positions, consistent sizes).
     const hp::StrandFrame f = hp::readStrandCache(dir / "out/cache/strands.0003.hpc");

@@ -1,5 +1,8 @@
+#include "batch_support.h"
 #include "core/errors.h"
 #include "pipeline/batch/strand_cache.h"
+#include "pipeline/stages/cached_strands.h"
+#include "pipeline/stages/shot.h"
 #include "pipeline/stages/usd_export.h"
 #include "sim/strands/synthetic.h"
 #include "test_support.h"
@@ -150,4 +153,104 @@ TEST(UsdExport, TopologyChangeIsRejected) {
     g.positions.pop_back();
     g.radii.pop_back();
     EXPECT_THROW(writeUsdCurves(dir / "x.usda", {&f, &g}, UsdExportSettings{}), Error);
+}
+
+namespace {
+
+/// Bytes of every strand cache frame under `out`.
+uintmax_t cacheBytes(const fs::path& out, int frames) {
+    uintmax_t bytes = 0;
+    for (int f = 1; f <= frames; ++f) {
+        char name[64];
+        std::snprintf(name, sizeof name, "cache/strands.%04d.hpc", f);
+        bytes += fs::file_size(out / name);
+    }
+    return bytes;
+}
+
+}  // namespace
+
+TEST(StrandCache, GuideRecordsRoundTripAndOldVersionsStillRead) {
+    test::TempDir dir;
+    CachedGuides g;
+    g.strands = 50;
+    g.vertices = 350;
+    g.current.guides = sample(true);
+    g.current.guides.offsets.resize(6);  // the 5 guides only
+    g.current.guides.ids.resize(5);
+    g.current.guides.positions.resize(35);
+    g.current.guides.radii.resize(35);
+    g.current.guides.velocities.resize(35);
+    g.current.dt = 1.0 / 24;
+    g.current.pins = {{3, Vec3f(0.1f, -0.2f, 0.3f)}, {290, Vec3f(1e-7f, 2.f, -3.f)}};
+    g.previous = g.current;
+    g.previous->guides.frame = 11;
+    g.previous->dt = 0.0;
+    g.previous->pins.clear();
+    writeGuideCache(dir / "g.hpc", g);
+    const StrandCacheFile f = readStrandCacheFile(dir / "g.hpc");
+    EXPECT_EQ(f.version, kGuideCacheVersion);
+    ASSERT_TRUE(f.guides && f.guides->previous);
+    EXPECT_EQ(f.guides->strands, 50u);
+    EXPECT_EQ(f.guides->vertices, 350u);
+    expectIdentical(f.guides->current.guides, g.current.guides);
+    expectIdentical(f.guides->previous->guides, g.previous->guides);
+    EXPECT_EQ(f.guides->current.dt, g.current.dt);
+    ASSERT_EQ(f.guides->current.pins.size(), 2u);
+    EXPECT_EQ(f.guides->current.pins[1].vertex, 290u);
+    EXPECT_EQ(f.guides->current.pins[1].last, g.current.pins[1].last);
+    // A version 1 file (whole strands) reads through the same function.
+    writeStrandCache(dir / "w.hpc", sample(true));
+    const StrandCacheFile w = readStrandCacheFile(dir / "w.hpc");
+    EXPECT_EQ(w.version, kStrandCacheVersion);
+    EXPECT_FALSE(w.guides);
+    expectIdentical(w.strands, sample(true));
+    // readStrandCache (whole frames only) says why it refuses version 2.
+    EXPECT_NE(errorOf(dir / "g.hpc").find("rebuilds the followers"), std::string::npos) << errorOf(dir / "g.hpc");
+    // A pin outside the follower block is refused.
+    g.current.pins[1].vertex = 400;
+    writeGuideCache(dir / "bad.hpc", g);
+    EXPECT_THROW(readStrandCacheFile(dir / "bad.hpc"), AssetError);
+}
+
+TEST(StrandCache, GuideCacheRebuildsTheWholeFramesAndTheSameOutputs) {
+    // The same small shot cached whole (cache.followers: store, version 1)
+    // and as guides (rebuild, version 2): the rebuilt frames are the whole
+    // frames bit for bit, in any reading order, and the preview, reference
+    // and VDB (density and velocity) rendered from either cache are identical.
+    test::TempDir dir;
+    const fs::path scene = test::writeSmallScene(dir.path());
+    ASSERT_EQ(test::runHairpipe("sim -q " + test::q(scene) + " --out " + test::q(dir / "whole") +
+                                " --set cache.followers=store")
+                  .exitCode,
+              0);
+    ASSERT_EQ(test::runHairpipe("sim -q " + test::q(scene) + " --out " + test::q(dir / "guides")).exitCode, 0);
+    const uintmax_t whole = cacheBytes(dir / "whole", 6), guides = cacheBytes(dir / "guides", 6);
+    EXPECT_LT(guides * 5, whole) << "the guide cache is a fraction of the whole strands";
+    std::printf("strand cache of 6 frames: whole %ju bytes, guides %ju bytes\n", whole, guides);
+
+    const Scene s = Scene::load(scene);
+    RunOptions options;
+    options.outputDir = dir / "guides";
+    const ShotSettings shot = resolveShot(s, options);
+    CachedStrands cached(s, shot);
+    for (int frame : {4, 2, 3, 1, 6, 5, 6}) {  // from scratch, in order, and again
+        char name[64];
+        std::snprintf(name, sizeof name, "whole/cache/strands.%04d.hpc", frame);
+        const StrandFrame expected = readStrandCache(dir / name);
+        expectIdentical(cached.read(frame), expected);
+    }
+    for (const char* out : {"whole", "guides"}) {
+        const test::ProcessResult r = test::runHairpipe("run -q " + test::q(scene) + " --out " + test::q(dir / out) +
+                                                  " --cache-only --stages preview,reference,vdb");
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+    }
+    std::vector<std::string> compared;
+    for (const std::string& f : test::outputFiles(dir / "whole")) {
+        if (f.rfind("cache/", 0) == 0) continue;
+        test::expectSameFile(dir / "whole", dir / "guides", f);
+        compared.push_back(f);
+    }
+    for (const char* f : {"preview/preview.0006.exr", "reference/reference.0005.exr", "vdb/hair.0006.vdb"})
+        EXPECT_NE(std::find(compared.begin(), compared.end(), f), compared.end()) << f << " was not compared";
 }

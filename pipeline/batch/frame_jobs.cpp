@@ -35,7 +35,7 @@ bool framesOnCachedHair(const Scene& scene, const std::vector<StagePtr>& stages)
 }
 
 void simulateFirst(const Scene& scene, const ShotSettings& shot, std::vector<StagePtr>& stages, RunReport& report) {
-    const bool wholeClip = framesOnCachedHair(scene, stages);
+    const bool framing = framesOnCachedHair(scene, stages);
     StagePtr sim;
     std::vector<StagePtr> rest;
     for (StagePtr& s : stages) {
@@ -52,15 +52,22 @@ void simulateFirst(const Scene& scene, const ShotSettings& shot, std::vector<Sta
     ShotSettings simShot = shot;
     simShot.writesCache = true;
     simShot.requireCache = false;
-    if (wholeClip) {
-        // The camera frames the cached hair of the whole clip: simulate all of it.
-        const std::vector<int>& clip = scene.frames("frames");
-        simShot.frames.insert(simShot.frames.end(), clip.begin(), clip.end());
+    // Camera auto/follow frames the cached hair: the frames the cameras of the
+    // rendered frames read must be simulated too (follow: the frames
+    // themselves; auto: their whole cut-free segments). A sim or vdb run
+    // frames nothing and simulates only its frames.
+    if (framing) {
+        const std::vector<int> read = cameraCacheFrames(scene, shot.frames);
+        simShot.frames.insert(simShot.frames.end(), read.begin(), read.end());
         std::sort(simShot.frames.begin(), simShot.frames.end());
         simShot.frames.erase(std::unique(simShot.frames.begin(), simShot.frames.end()), simShot.frames.end());
+        if (simShot.frames.size() > shot.frames.size())
+            logVerbose("camera ", scene.text("render.camera.mode"), " frames whole segments of the clip: simulating ",
+                       simShot.frames.size() - shot.frames.size(), " more frames (", formatFrameRange(simShot.frames),
+                       ") than asked (", formatFrameRange(shot.frames), ")");
     }
     logInfo("simulating first (sequential), writing the strand cache",
-            simShot.frames.size() > shot.frames.size() ? " of the whole clip (the camera frames its hair)" : "");
+            simShot.frames.size() > shot.frames.size() ? " of the frames the camera frames (camera auto)" : "");
     std::vector<StagePtr> simStages;
     simStages.push_back(std::move(sim));
     std::unique_ptr<FrameSource> source = makeFrameSource(scene, simShot);

@@ -23,14 +23,17 @@ namespace hp {
 std::vector<std::string> sceneArguments(const RunOptions& options, const ShotSettings& shot);
 
 /// True when a stage of `stages` renders (preview, reference) with a camera
-/// that frames the cached hair of the whole clip (cameraReadsStrandCache, the
-/// default camera): the clip must then be simulated before the first frame.
+/// that frames the cached hair (cameraReadsStrandCache, the default camera):
+/// the frames its cameras read (cameraCacheFrames) must then be simulated
+/// before the first frame is rendered.
 bool framesOnCachedHair(const Scene& scene, const std::vector<StagePtr>& stages);
 
 /// @brief Runs the simulation before the frame stages: moves the sim stage
 /// out of `stages` (or, when the other stages need strands and the run may
-/// simulate, makes one) and runs it over the run's frames, plus the whole
-/// clip when a rendering stage frames the cached hair (framesOnCachedHair).
+/// simulate, makes one) and runs it over the run's frames, plus, when a
+/// render stage's camera auto frames the cached hair, the frames its
+/// cameras read (cameraCacheFrames: none more in follow mode, the whole
+/// cut-free segments in auto mode).
 /// Its failures go into `report`.
 void simulateFirst(const Scene& scene, const ShotSettings& shot, std::vector<StagePtr>& stages, RunReport& report);
 

@@ -6,7 +6,7 @@
 #include "pipeline/batch/frame_range.h"
 #include "pipeline/stages/hair_source.h"
 #include "pipeline/batch/output.h"
-#include "pipeline/batch/strand_cache.h"
+#include "pipeline/stages/cached_strands.h"
 #include "pipeline/stages/usd_export.h"
 
 #include <iostream>
@@ -43,10 +43,9 @@ CommandSpec exportUsdCommandSpec() {
         }
         UsdExportSettings usd;
         usd.fps = shot.fps;
+        CachedStrands cached(ctx.scene, shot);  // rebuilds followers from cached guides (version 2)
         writeAtomically(output, [&](const fs::path& tmp) {
-            writeUsdCurves(tmp, shot.frames,
-                           [&](int frame) { return readStrandCache(cachePath(ctx.scene, shot, "cache.strands", frame)); },
-                           usd);
+            writeUsdCurves(tmp, shot.frames, [&](int frame) { return cached.read(frame); }, usd);
         });
         std::cout << output.string() << ": frames " << formatFrameRange(shot.frames) << " as time samples\n";
         return int(kExitOk);

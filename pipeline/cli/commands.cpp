@@ -2,6 +2,7 @@
 
 #include "core/log.h"
 #include "pipeline/stages/camera_track.h"
+#include "pipeline/stages/cached_strands.h"
 #include "pipeline/head/clip_cuts.h"
 #include "pipeline/scene/curly_settings.h"
 #include "pipeline/batch/frame_jobs.h"
@@ -137,6 +138,7 @@ int runShotCommand(const CommandContext& ctx, const std::set<std::string>& only)
         if (framesOnCachedHair(ctx.scene, stages)) simulateFirst(ctx.scene, shot, stages, simulation);
         std::unique_ptr<FrameSource> source = makeFrameSource(ctx.scene, shot);
         report = runFrames(*source, stages, shot);
+        lendToCachedStrands(ctx.scene, shot, nullptr);  // free the simulation the frame stages rebuilt on
         report.outputsSkipped += simulation.outputsSkipped;
         report.failures.insert(report.failures.begin(), simulation.failures.begin(), simulation.failures.end());
     }

@@ -3,11 +3,13 @@
 #include "pipeline/batch/child_process.h"
 #include "pipeline/batch/frame_jobs.h"
 #include "pipeline/batch/frame_range.h"
+#include "pipeline/stages/camera_track.h"
 #include "pipeline/stages/hair_source.h"
 #include "pipeline/batch/output.h"
 #include "pipeline/stages/shot_outputs.h"
 #include "pipeline/stages/stages.h"
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -114,7 +116,14 @@ FarmPlan makeFarmPlan(const Scene& scene, const RunOptions& options, const FarmO
     if (sceneHasHair(scene) && !p.simulate)
         scene.fail("cache.enabled", "a farm run shares the simulation through the strand cache; enable it");
     std::vector<StagePtr> stages = makeStages(scene, p.shot, {});
-    p.simulateClip = p.simulate && framesOnCachedHair(scene, stages);
+    // Camera auto frames whole cut-free segments of the cached hair: the sim
+    // job then writes the clip (follow reads only each task's own frames).
+    if (p.simulate && framesOnCachedHair(scene, stages)) {
+        const std::vector<int> read = cameraCacheFrames(scene, p.shot.frames);
+        p.simulateClip = std::any_of(read.begin(), read.end(), [&](int f) {
+            return std::find(p.shot.frames.begin(), p.shot.frames.end(), f) == p.shot.frames.end();
+        });
+    }
     for (const StagePtr& s : stages) {
         if (s->name() == "sim") continue;
         p.frameStages.push_back(s->name());
@@ -164,8 +173,8 @@ void writeFarmScripts(const FarmPlan& p) {
     if (!p.report) fs::remove(p.script("report"), ec);
 
     if (p.simulate) {
-        // Each frame task's camera may frame the cached hair of every clip
-        // frame (framesOnCachedHair): the sim job then writes the whole clip.
+        // Each frame task's camera may frame the cached hair of frames beyond
+        // its own (camera auto): the sim job then writes the whole clip.
         std::vector<std::string> sim = common;
         if (p.simulateClip && p.options.frames) sim = sceneArguments(p.options, p.shot);
         if (p.simulateClip && p.options.frames && p.options.force) sim.push_back("--force");

@@ -1,36 +1,52 @@
 // The shot's camera at each frame: the scene's fixed camera, or camera auto
 // (render.camera.mode: auto / follow), which frames the head and its hair
-// over the whole clip (render/view/camera_framing.h). The track depends only on
-// the scene, never on the frames a run renders, so every chunk of a
-// parallel or farm run sees the same camera.
+// over the whole clip (render/view/camera_framing.h). A frame's camera depends
+// only on the scene and (render.camera.hair: cache) on the cached hair of that
+// frame (follow) or of its cut-free segment (auto), never on the frames a run
+// renders, so a one-frame run, every chunk of a parallel or farm run and a
+// whole-clip run see the same camera, bit for bit. The head is sampled over
+// the whole clip (cheap: posed meshes), but the strand cache is read only for
+// the frames a camera needs, so rendering frame 3 needs frame 3 simulated, not
+// the clip.
 #pragma once
 
 #include "pipeline/scene/scene.h"
 #include "render/view/camera_framing.h"
 #include "sim/strands/head.h"
 
-#include <map>
+#include <memory>
+#include <vector>
 
 namespace hp {
+
+class CameraFraming;  // camera auto/follow's state (camera_track.cpp)
 
 class CameraTrack {
   public:
     /// The same camera on every frame.
     explicit CameraTrack(Camera fixed) : fallback_(std::move(fixed)) {}
-    /// One camera per listed frame; other frames get `fallback`.
-    CameraTrack(std::map<int, Camera> perFrame, Camera fallback)
-        : perFrame_(std::move(perFrame)), fallback_(std::move(fallback)) {}
+    /// Camera auto/follow: frames are framed on first use (at()); frames
+    /// outside the scene's clip get `fallback`.
+    CameraTrack(std::shared_ptr<const CameraFraming> framing, Camera fallback)
+        : framing_(std::move(framing)), fallback_(std::move(fallback)) {}
 
-    /// The camera of `frame`.
-    const Camera& at(int frame) const {
-        const auto it = perFrame_.find(frame);
-        return it == perFrame_.end() ? fallback_ : it->second;
-    }
+    /// The camera of `frame`. With render.camera.hair: cache it reads the
+    /// strand cache of only the frames cacheFramesFor(frame) names, on first
+    /// use; a missing cache file throws FrameError naming it.
+    const Camera& at(int frame) const { return at(frame, nullptr); }
+    /// The same, given the frame's own strands when the caller has them
+    /// (the stages' frame data): camera follow then frames them instead of
+    /// reading (and rebuilding) the cache file again. Equal bits either way.
+    const Camera& at(int frame, const StrandFrame* hair) const;
     /// True when the camera moves with the head (auto or follow).
-    bool framed() const { return !perFrame_.empty(); }
+    bool framed() const { return framing_ != nullptr; }
+    /// The strand cache frames at(frame) reads: follow, the frame itself;
+    /// auto, every frame of its cut-free segment (framed as a whole); none
+    /// when the hair is bounded by its reach or the camera is fixed.
+    std::vector<int> cacheFramesFor(int frame) const;
 
   private:
-    std::map<int, Camera> perFrame_;
+    std::shared_ptr<const CameraFraming> framing_;
     Camera fallback_;
 };
 
@@ -53,9 +69,15 @@ float hairReach(const Scene& scene);
 FramingSettings framingSettings(const Scene& scene);
 
 /// True when camera auto/follow frames the hair read from the strand cache
-/// (render.camera.hair: cache), so the whole clip must be simulated before
-/// the first frame is rendered.
+/// (render.camera.hair: cache), so a frame's strands must be simulated (and
+/// cached) before it is rendered.
 bool cameraReadsStrandCache(const Scene& scene);
+
+/// @brief The strand cache frames the cameras of `frames` read (sorted,
+/// unique): `frames` themselves in follow mode, the whole cut-free segments
+/// holding them in auto mode, none unless cameraReadsStrandCache. What a
+/// run must simulate before it renders `frames`.
+std::vector<int> cameraCacheFrames(const Scene& scene, const std::vector<int>& frames);
 
 /// @brief Checks the camera keys across each other (render.camera.position
 /// or .target given with auto/follow, where they would be ignored), at the
@@ -66,9 +88,9 @@ void checkCameraKeys(const Scene& scene);
 /// is render.camera.mode, or when not given: `fixed` if the scene gives
 /// render.camera.position, else `auto`. Auto without a head (nothing to
 /// frame) keeps the fixed camera. With render.camera.hair: cache (and
-/// `allowCache`), the hair of every clip frame is read from the strand cache
-/// under `outputDir`; a missing cache file throws FrameError naming it.
-/// Without, the hair is bounded by its reach (hairReach).
+/// `allowCache`), the hair is read from the strand cache under `outputDir`,
+/// lazily: at(frame) reads cacheFramesFor(frame) and throws FrameError naming
+/// a missing file. Without, the hair is bounded by its reach (hairReach).
 CameraTrack makeCameraTrack(const Scene& scene, const Camera& lens, const std::filesystem::path& outputDir,
                             bool allowCache = true);
 

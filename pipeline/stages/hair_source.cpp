@@ -5,6 +5,7 @@
 #include "pipeline/batch/path_template.h"
 #include "pipeline/stages/shot_simulation.h"
 #include "pipeline/batch/strand_cache.h"
+#include "pipeline/stages/cached_strands.h"
 
 namespace fs = std::filesystem;
 
@@ -32,6 +33,12 @@ class HairFrameSource final : public FrameSource {
                                  " (the simulation starts there)"));
     }
 
+    ~HairFrameSource() override {
+        // The cache readers after this source (the frame stages of a run that
+        // simulated first) rebuild followers on this simulation's groom.
+        if (sim_ && scene_.flag("cache.enabled")) lendToCachedStrands(scene_, shot_, std::move(sim_));
+    }
+
     FrameData get(int frame) override {
         FrameData data;
         data.frame = frame;
@@ -43,13 +50,13 @@ class HairFrameSource final : public FrameSource {
                                  " is missing (run `hairpipe sim` for this frame first)"));
         if ((shot_.requireCache || (!shot_.force && scene_.flag("cache.enabled"))) && fs::is_regular_file(cache, ec)) {
             try {
-                cached_ = readStrandCache(cache);
+                data.strands = &cached().read(cache);
             } catch (const AssetError& e) {
                 throw FrameError(std::string(e.what()) + " (delete it, or rerun with --force to re-simulate)");
             }
+            data.guides = cached().guides() ? &*cached().guides() : nullptr;
             if (!head_) head_ = std::make_unique<HeadSetup>(loadHead(scene_));
             pose_ = head_->motion->sample(data.time);
-            data.strands = &cached_;
             data.head = &pose_;
             return data;
         }
@@ -57,6 +64,8 @@ class HairFrameSource final : public FrameSource {
         data.strands = &sim_->advanceTo(frame);
         data.head = &sim_->pose();
         data.simulation = &sim_->stats();
+        guides_ = sim_->cachedGuides();
+        data.guides = guides_ ? &*guides_ : nullptr;
         if (shot_.writesCache && scene_.flag("cache.checkpoints") && !sim_->canCheckpoint() && !warned_) {
             logWarning("no checkpoints: the ", scene_.text("simulation.formulation"),
                        " formulation cannot be restored exactly, so a stopped simulation restarts from frame ",
@@ -100,9 +109,14 @@ class HairFrameSource final : public FrameSource {
                 std::error_code ec;
                 if (!fs::is_regular_file(checkpoint, ec) || !fs::is_regular_file(strands, ec)) continue;
                 try {
-                    const StrandFrame cached = readStrandCache(strands);
+                    const StrandFrame& whole = cached().read(strands);
+                    std::optional<FollowerSource> source;
+                    if (cached().guides()) source = cached().guides()->current;
+                    else if (scene_.text("cache.followers") == "rebuild")
+                        throw AssetError(strands.string(), "is a whole-strand cache (version 1): the frames after it "
+                                                           "need its guide record (cache.followers: rebuild)");
                     if (!sim_) sim_ = start();
-                    sim_->restoreCheckpoint(checkpoint, cached);
+                    sim_->restoreCheckpoint(checkpoint, whole, source);
                     logInfo("simulation: resumed from the checkpoint of frame ", c);
                     return;
                 } catch (const AssetError& e) {
@@ -118,8 +132,15 @@ class HairFrameSource final : public FrameSource {
     ShotSettings shot_;
     int first_;
     std::unique_ptr<ShotSimulation> sim_;
+    /// Reads cached frames (rebuilding followers from cached guides): made on first use.
+    CachedStrands& cached() {
+        if (!cached_) cached_ = std::make_unique<CachedStrands>(scene_, shot_);
+        return *cached_;
+    }
+
     std::unique_ptr<HeadSetup> head_;  ///< for cached frames, loaded on first use
-    StrandFrame cached_;
+    std::unique_ptr<CachedStrands> cached_;
+    std::optional<CachedGuides> guides_;  ///< the simulated frame's, for the sim stage
     HeadPose pose_;
     bool warned_ = false;
 };

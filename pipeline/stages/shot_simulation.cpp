@@ -166,8 +166,9 @@ std::string SimFrameStats::json() const {
     return o.str();
 }
 
-ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame, const SettleCache& settleCache)
-    : scene_(scene), fps_(fps), frame_(startFrame) {
+ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame, const SettleCache& settleCache,
+                               bool rebuildOnly)
+    : scene_(scene), fps_(fps), frame_(startFrame), clip_(scene.frames("frames")) {
     if (!sceneHasHead(scene)) scene.fail("head.file", "the shot has hair but no head: set head.file");
     head_ = loadHead(scene);
     std::unique_ptr<ImportedGroom> imported;
@@ -220,8 +221,12 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame, c
         followerOptions.tipRadius = curly.tipRadius;
     }
     followers_ = std::make_unique<Followers>(groom, followerOptions);
-    logInfo("simulation: ", model_->solver.guideCount(), " guides (", model_->name(), "), ",
-            followers_->followerCount(), " followers, from frame ", startFrame);
+    if (rebuildOnly)
+        logVerbose("strand cache: rebuilding followers from the cached guides: ", model_->solver.guideCount(),
+                   " guides, ", followers_->followerCount(), " followers");
+    else
+        logInfo("simulation: ", model_->solver.guideCount(), " guides (", model_->name(), "), ",
+                followers_->followerCount(), " followers, from frame ", startFrame);
     produceFrame(t0);
     stats_.settleSeconds = settleRan_ ? settled_.seconds : -1;
     stats_.settleEnergy = settled_.kineticEnergy;
@@ -285,6 +290,18 @@ size_t ShotSimulation::followerCount() const { return followers_->followerCount(
 const StrandFrame& ShotSimulation::advanceTo(int frame) {
     if (frame < frame_) throw std::logic_error(cat("simulation cannot go back from frame ", frame_, " to ", frame));
     if (frame == frame_) return strands_;
+    // The followers carry state from the frame produced before (velocities
+    // by difference, pinned vertices held toward their previous place), so
+    // every clip frame on the way is produced: a frame's strands are the
+    // same bits whichever frames a run asks for.
+    for (int f : clip_)
+        if (f > frame_ && f < frame) stepTo(f);
+    stepTo(frame);
+    return strands_;
+}
+
+void ShotSimulation::stepTo(int frame) {
+    rebuilt_.reset();
     const double target = frame / fps_;
     // Steps are frame-aligned, so the frame is a step's end; the tolerance
     // absorbs the rounding of a float step accumulated over the shot.
@@ -306,7 +323,6 @@ const StrandFrame& ShotSimulation::advanceTo(int frame) {
     }
     frame_ = frame;
     produceFrame(std::min(target, model_->solver.time()));
-    return strands_;
 }
 
 void ShotSimulation::produceFrame(double time) {
@@ -324,9 +340,18 @@ void ShotSimulation::produceFrame(double time) {
     StrandFrame guides;
     model_->solver.write(guides, time);
     const auto followerStart = std::chrono::steady_clock::now();
-    const FollowerStats fs = followers_->update({guides, guideFrames_, followerFrames_, pose_.collider.get(), dt}, strands_);
+    FollowerStats fs = followers_->update({guides, guideFrames_, followerFrames_, pose_.collider.get(), dt}, strands_);
     strands_.frame = frame_;
     strands_.time = time;
+    // What rebuilds this frame's followers (strand cache version 2): the
+    // guides, the step's dt when velocities came by difference, the pins.
+    previousSource_ = std::move(source_);
+    source_ = FollowerSource{};
+    source_->guides = std::move(guides);
+    source_->guides.frame = frame_;
+    source_->guides.time = time;
+    source_->dt = fs.differenceVelocities ? dt : 0.0;
+    source_->pins = std::move(fs.pins);
 
     stats_ = SimFrameStats{};
     stats_.frame = frame_;
@@ -345,6 +370,62 @@ void ShotSimulation::produceFrame(double time) {
     pending_ = StepStats{};
     pendingSteps_ = 0;
     pendingHeadMs_ = 0;
+}
+
+// ---- followers rebuilt from cached guides ----------------------------------
+
+std::optional<CachedGuides> ShotSimulation::cachedGuides() const {
+    if (!source_) return std::nullopt;
+    CachedGuides g;
+    g.strands = strands_.strandCount();
+    g.vertices = strands_.vertexCount();
+    g.current = *source_;
+    if (source_->dt > 0.0) {
+        if (!previousSource_) return std::nullopt;  // resumed from a version 1 cache: no record of the frame before
+        g.previous = *previousSource_;
+    }
+    return g;
+}
+
+void ShotSimulation::rebuildOne(const FollowerSource& source, bool previousInBuffer, const std::string& file) {
+    pose_ = head_.motion->sample(source.guides.time);
+    evaluateRoots(pose_.mesh, roots_.guides, guideFrames_);
+    evaluateRoots(pose_.mesh, roots_.followers, followerFrames_);
+    if (source.dt > 0.0 && !previousInBuffer) followers_->adoptPins(strands_, source.pins);
+    const FollowerStats fs = followers_->update(
+        {source.guides, guideFrames_, followerFrames_, pose_.collider.get(), source.dt}, strands_);
+    strands_.frame = source.guides.frame;
+    strands_.time = source.guides.time;
+    // The simulation's pins come back only when every input is the same: a
+    // scene edited since (hair keys, head) or another build would rebuild
+    // other hair silently.
+    bool same = fs.pins.size() == source.pins.size();
+    for (size_t i = 0; same && i < fs.pins.size(); ++i)
+        same = fs.pins[i].vertex == source.pins[i].vertex &&
+               std::memcmp(fs.pins[i].last.data(), source.pins[i].last.data(), sizeof(Vec3f)) == 0;
+    if (!same || (source.dt > 0.0) != fs.differenceVelocities)
+        throw AssetError(file, cat("the followers of frame ", source.guides.frame,
+                                   " rebuild differently from the simulation that cached them (the scene's hair or "
+                                   "head changed since, or another build): re-simulate with --force"));
+    rebuilt_ = {source.guides.frame, source.guides.time};
+}
+
+const StrandFrame& ShotSimulation::rebuild(const CachedGuides& cached, const std::string& file) {
+    if (cached.strands != guideCount() + followerCount() || cached.current.guides.guideCount != guideCount())
+        throw AssetError(file, cat("holds ", cached.current.guides.guideCount, " guides of ", cached.strands,
+                                   " strands; the scene grows ", guideCount(), " guides and ", followerCount(),
+                                   " followers (re-simulate with --force)"));
+    const FollowerSource& now = cached.current;
+    const bool chained = now.dt > 0.0;
+    if (chained && !cached.previous)
+        throw AssetError(file, "strand cache lacks the frame before, which its follower velocities need");
+    // Frames read in order rebuild once each: the buffer already holds the one before.
+    const bool inBuffer = chained && rebuilt_ && rebuilt_->first == cached.previous->guides.frame &&
+                          rebuilt_->second == cached.previous->guides.time;
+    rebuilt_.reset();
+    if (chained && !inBuffer) rebuildOne(*cached.previous, false, file);
+    rebuildOne(now, chained, file);
+    return strands_;
 }
 
 // ---- checkpoints -------------------------------------------------------------
@@ -376,7 +457,8 @@ void ShotSimulation::saveCheckpoint(const fs::path& file) const {
     if (!out) throw IoError(file.string(), "write failed (disk full?)");
 }
 
-void ShotSimulation::restoreCheckpoint(const fs::path& file, const StrandFrame& strands) {
+void ShotSimulation::restoreCheckpoint(const fs::path& file, const StrandFrame& strands,
+                                       const std::optional<FollowerSource>& source) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw AssetError(file.string(), "cannot open checkpoint");
     char magic[8];
@@ -405,6 +487,8 @@ void ShotSimulation::restoreCheckpoint(const fs::path& file, const StrandFrame& 
     model_->restoreState(state);
     frame_ = frame;
     strands_ = strands;
+    previousSource_.reset();
+    source_ = source;
     // The restored buffer is what the followers wrote last (velocities by difference).
     followers_->adoptPrevious(strands_);
     pose_ = head_.motion->sample(frame / fps_);

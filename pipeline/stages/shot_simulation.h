@@ -14,13 +14,16 @@
 
 #include "pipeline/groom/groom_settle.h"
 #include "pipeline/head/head_setup.h"
+#include "pipeline/batch/strand_cache.h"
 #include "pipeline/scene/scene.h"
 #include "sim/guides/guides.h"
 #include "sim/strands/strand.h"
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 
 namespace hp {
 
@@ -65,11 +68,14 @@ class ShotSimulation {
     /// procedural groom (hair.groom.settle, through `settleCache`), builds
     /// the guide model and the followers, and initialises everything at
     /// `startFrame`. Throws SceneError/AssetError for bad scene settings or assets.
-    ShotSimulation(const Scene& scene, double fps, int startFrame, const SettleCache& settleCache = {});
+    /// `rebuildOnly`: set up only to rebuild cached frames (rebuild()); says so in the log.
+    ShotSimulation(const Scene& scene, double fps, int startFrame, const SettleCache& settleCache = {},
+                   bool rebuildOnly = false);
     ~ShotSimulation();
 
     /// Advances to `frame` (>= frame()) and returns all strands there (guides
-    /// first). Throws FrameError if the simulation produced non-finite values.
+    /// first). Every clip frame between is produced on the way (the
+    /// followers carry state from frame to frame). Throws FrameError if the simulation produced non-finite values.
     const StrandFrame& advanceTo(int frame);
 
     int frame() const { return frame_; }
@@ -86,11 +92,30 @@ class ShotSimulation {
     /// frame's strands themselves are the strand cache's job).
     void saveCheckpoint(const std::filesystem::path& file) const;
     /// Restores the state saved by saveCheckpoint at the frame whose strands
-    /// are `strands` (read back from the strand cache). Afterwards the
-    /// simulation continues exactly as the run that saved it.
-    void restoreCheckpoint(const std::filesystem::path& file, const StrandFrame& strands);
+    /// are `strands` (read back from the strand cache, followers rebuilt) and
+    /// whose cached guide record is `source` (none from a version 1 cache).
+    /// Afterwards the simulation continues exactly as the run that saved it.
+    void restoreCheckpoint(const std::filesystem::path& file, const StrandFrame& strands,
+                           const std::optional<FollowerSource>& source = std::nullopt);
+
+    /// The current frame as strand cache version 2 stores it: its guides and
+    /// follower pins, and the frame before's when its velocities need it.
+    /// None when the frame before is unknown (resumed from a version 1 cache).
+    std::optional<CachedGuides> cachedGuides() const;
+
+    /// @brief The whole strands of a frame cached as guides (version 2): the
+    /// followers rebuilt on this simulation's groom from the cached guides,
+    /// pins and the head's pose at the cached time, bit for bit what the
+    /// simulation wrote (the frame before first, when the velocities need it,
+    /// unless the previous call rebuilt it). Use a simulation that is not
+    /// stepped. Throws AssetError naming `file` when the cache does not fit
+    /// the scene (counts, or pins that come back differently).
+    const StrandFrame& rebuild(const CachedGuides& cached, const std::string& file);
 
   private:
+    void rebuildOne(const FollowerSource& source, bool previousInBuffer, const std::string& file);
+    /// Steps the guides to `frame` and produces its strands (advanceTo's one frame).
+    void stepTo(int frame);
     void produceFrame(double time);
     /// The guides' rest shape at t0: imported, combed or straight, settled.
     void initializeGuides(const GuideSettings& settings, const struct ImportedGroom* imported,
@@ -99,6 +124,7 @@ class ShotSimulation {
     const Scene& scene_;
     double fps_;
     int frame_;
+    std::vector<int> clip_;  ///< the scene's frames (a copy: callers may pass a temporary scene)
     HeadSetup head_;
     GroomRoots roots_;
     std::unique_ptr<GuideModel> model_;
@@ -112,6 +138,8 @@ class ShotSimulation {
     size_t pendingSteps_ = 0;
     SettledGroom settled_;  ///< the settling's report (strands moved into the model)
     bool settleRan_ = false;
+    std::optional<FollowerSource> source_, previousSource_;  ///< cachedGuides()
+    std::optional<std::pair<int, double>> rebuilt_;          ///< frame and time strands_ was rebuilt at
 };
 
 }  // namespace hp

@@ -19,6 +19,7 @@ namespace hp {
 
 class Scene;
 struct SimFrameStats;
+struct CachedGuides;
 
 /// What the stages of one frame read. Pointers are null for parts the shot
 /// does not have (e.g. no head, no hair).
@@ -30,6 +31,9 @@ struct FrameData {
     /// Set when the strands were simulated for this frame (not read from the
     /// strand cache): what the simulation measured.
     const SimFrameStats* simulation = nullptr;
+    /// The frame's guides and follower pins (strand cache version 2): what the
+    /// sim stage writes with cache.followers: rebuild. Null when unknown.
+    const CachedGuides* guides = nullptr;
     /// Side outputs of the source that could not be written (a checkpoint on
     /// a full disk). The frame counts as failed, but its data is sound, so
     /// the stages still run.

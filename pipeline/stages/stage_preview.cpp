@@ -62,7 +62,7 @@ class PreviewStage final : public FrameStage {
             frame.headTransform = data.head->transform;
         }
         View view = view_;
-        view.camera = cameraAt(data.frame);
+        view.camera = cameraAt(data.frame, data.strands);
         const Image image = renderer_->render(view, frame);
         ImageWriteOptions options;
         options.metadata = {{"hairpipe:scene", sceneName_},
@@ -96,9 +96,9 @@ class PreviewStage final : public FrameStage {
     std::optional<CameraTrack> track_;  ///< made on the first frame: it may read the strand cache
 
     /// The camera of `frame` (camera auto reads the clip once, on first use).
-    const Camera& cameraAt(int frame) {
+    const Camera& cameraAt(int frame, const StrandFrame* hair) {
         if (!track_) track_ = makeCameraTrack(scene_, view_.camera, outputDir_);
-        return track_->at(frame);
+        return track_->at(frame, hair);
     }
     DisplaySettings display_;  // PNG frames only; EXRs stay linear
     PreviewSettings settings_;

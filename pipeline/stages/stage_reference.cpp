@@ -132,7 +132,7 @@ class ReferenceStage final : public FrameStage {
                                  " has neither strands nor a head to render (no hair or head stage produced them)"));
         if (!data.strands) logVerbose("reference: frame ", data.frame, " has no strands; rendering the head alone");
         View view = view_;
-        view.camera = cameraAt(data.frame);
+        view.camera = cameraAt(data.frame, data.strands);
         view.camera.width = std::max(1, int(std::lround(view.camera.width * scale_)));
         view.camera.height = std::max(1, int(std::lround(view.camera.height * scale_)));
         for (const ReferenceOutput& s : sequences_) render(view, s, data, head);
@@ -189,9 +189,9 @@ class ReferenceStage final : public FrameStage {
     std::optional<CameraTrack> track_;  ///< made on the first frame: it may read the strand cache
 
     /// The camera of `frame` (camera auto reads the clip once, on first use).
-    const Camera& cameraAt(int frame) {
+    const Camera& cameraAt(int frame, const StrandFrame* hair) {
         if (!track_) track_ = makeCameraTrack(scene_, view_.camera, shot_.outputDir);
-        return track_->at(frame);
+        return track_->at(frame, hair);
     }
     DisplaySettings display_;  // PNG frames only; EXRs stay linear
     double scale_;

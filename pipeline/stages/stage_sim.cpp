@@ -1,5 +1,6 @@
 // The "sim" stage: writes each frame's strands to the strand cache, the
 // simulation's statistics beside them, and (cache.usd) a USD export.
+#include "core/log.h"
 #include "pipeline/stages/hair_source.h"
 #include "pipeline/batch/output.h"
 #include "pipeline/batch/path_template.h"
@@ -18,7 +19,8 @@ namespace {
 
 class SimStage final : public FrameStage {
   public:
-    SimStage(const Scene& scene, const ShotSettings& shot) : scene_(scene), shot_(shot) {
+    SimStage(const Scene& scene, const ShotSettings& shot)
+        : scene_(scene), shot_(shot), rebuild_(scene.text("cache.followers") == "rebuild") {
         for (const char* key : {"cache.strands", "cache.stats"})
             if (!hasFrameToken(scene.text(key))) scene.fail(key, "needs a frame number (#### or %04d)");
         if (!scene.text("cache.usd").empty() && !hasFrameToken(scene.text("cache.usd")))
@@ -34,7 +36,16 @@ class SimStage final : public FrameStage {
     void run(const FrameData& data) override {
         if (!data.strands) throw FrameError(cat("frame ", data.frame, " has no strands to cache"));
         const std::vector<fs::path> paths = outputs(data.frame);
-        writeAtomically(paths[0], [&](const fs::path& tmp) { writeStrandCache(tmp, *data.strands); });
+        // cache.followers: rebuild writes the guides and pins (version 2); a
+        // frame without its guide record (resumed from a version 1 cache)
+        // falls back to whole strands, which every reader still reads.
+        if (rebuild_ && data.guides) {
+            writeAtomically(paths[0], [&](const fs::path& tmp) { writeGuideCache(tmp, *data.guides); });
+        } else {
+            if (rebuild_) logWarning("frame ", data.frame, ": no guide record (resumed from a whole-strand cache): ",
+                                     "caching its strands whole");
+            writeAtomically(paths[0], [&](const fs::path& tmp) { writeStrandCache(tmp, *data.strands); });
+        }
         // Statistics exist only for simulated frames; a frame read back from
         // the cache (e.g. only the stats file was lost) records that.
         const std::string json = data.simulation ? data.simulation->json()
@@ -50,6 +61,7 @@ class SimStage final : public FrameStage {
   private:
     const Scene& scene_;
     ShotSettings shot_;
+    bool rebuild_;  ///< cache.followers: rebuild
 };
 
 }  // namespace

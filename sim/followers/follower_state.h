@@ -210,6 +210,7 @@ struct Counters {
     size_t pinned = 0;      ///< vertices with no place outside at their length, held (follower_pinch.h)
     size_t inside = 0;      ///< projected vertices left inside (signed distance < 0)
     float maxDepth = 0.f;   ///< deepest of those, m
+    std::vector<FollowerPin> pins;  ///< pinned vertices that read their previous place
 };
 
 /// Rebuilds the pair records [begin, end) of class `c` from its guide rows.

@@ -153,6 +153,10 @@ void collideLane(const StepContext& ctx, const FollowerClass& c, uint32_t guide1
             p = place.position;
             after = place.distance;
             ++(place.pinned ? counters.pinned : counters.bent);
+            // The one state a frame carries to the next: where a pinned vertex
+            // was held from (its place in the previous frame), so a frame can
+            // be rebuilt from its guides alone (FollowerStats::pins).
+            if (place.pinned && last) counters.pins.push_back({uint32_t(last + v - ctx.positions), last[v]});
         }
         if (after < 0.f) {
             ++counters.inside;

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <vector>
 
 namespace hp {
@@ -207,9 +208,14 @@ FollowerStats Followers::update(const FollowerStep& step, StrandFrame& out) {
                               step.dt > 0.0 ? float(1.0 / step.dt) : 0.f};
     std::atomic<size_t> projected{0}, queries{0}, inside{0}, bent{0}, pinned{0};
     std::atomic<uint32_t> depthBits{0};  // a non-negative float's bits order like the float
+    std::mutex pinsMutex;
     auto packetsLoop = [&](const tbb::blocked_range<size_t>& r) {
         follower::Counters counters;
         follower::processPackets(ctx, r.begin(), r.end(), counters);
+        if (!counters.pins.empty()) {
+            const std::lock_guard<std::mutex> lock(pinsMutex);
+            stats.pins.insert(stats.pins.end(), counters.pins.begin(), counters.pins.end());
+        }
         projected += counters.projected;
         queries += counters.queries;
         inside += counters.inside;
@@ -239,6 +245,9 @@ FollowerStats Followers::update(const FollowerStep& step, StrandFrame& out) {
     stats.penetrationCount = inside;
     stats.bent = bent;
     stats.pinned = pinned;
+    // Ranges finish in any order; sorted, the list is the same for any thread count.
+    std::sort(stats.pins.begin(), stats.pins.end(),
+              [](const FollowerPin& a, const FollowerPin& b) { return a.vertex < b.vertex; });
     const uint32_t bits = depthBits.load();
     std::memcpy(&stats.maxPenetration, &bits, sizeof bits);
     im.lastPositions = out.positions.data();
@@ -263,6 +272,16 @@ void Followers::adoptPrevious(const StrandFrame& out) {
         throw Error("followers: the frame to adopt does not have this groom's follower layout");
     im.lastPositions = out.positions.data();
     im.lastVertexCount = total;
+}
+
+void Followers::adoptPins(StrandFrame& out, const std::vector<FollowerPin>& pins) {
+    adoptPrevious(out);
+    const size_t guideVertices = out.offsets[impl_->guides];
+    for (const FollowerPin& pin : pins) {
+        if (pin.vertex >= impl_->vertexOffset[impl_->followers])
+            throw Error(cat("followers: pinned vertex ", pin.vertex, " lies outside the follower block"));
+        out.positions[guideVertices + pin.vertex] = pin.last;
+    }
 }
 
 }  // namespace hp

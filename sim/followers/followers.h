@@ -157,6 +157,15 @@ struct FollowerStep {
     double dt = 0.0;
 };
 
+/// A follower vertex pinned in a pinch (sim/followers/follower_pinch.h)
+/// and the place it was held toward: its position in the previous frame.
+/// The only thing a frame of followers reads from the frame before, besides
+/// the velocities by difference.
+struct FollowerPin {
+    uint32_t vertex = 0;  ///< index in the follower block (0 = first follower's root)
+    Vec3f last = Vec3f::Zero();
+};
+
 struct FollowerStats {
     size_t projected = 0;         ///< follower vertices pushed out of the head
     /// Projected vertices that sliding along the surface left inside, placed
@@ -174,6 +183,11 @@ struct FollowerStats {
     size_t collisionQueries = 0;  ///< collider queries the guide-distance bound could not skip
     bool differenceVelocities = false;  ///< velocities are (x - x_prev) / dt
     bool layoutWritten = false;   ///< offsets, ids and radii were (re)written this update
+    /// The pinned vertices that were held toward their previous place
+    /// (velocities by difference only), sorted by vertex: with the guides,
+    /// the root frames and the collider of this frame, what update() needs to
+    /// give this frame's positions again bit for bit (Followers::rebuild).
+    std::vector<FollowerPin> pins;
 };
 
 class Followers {
@@ -213,6 +227,14 @@ class Followers {
     /// update() had written it. Throws hp::Error when its layout does not
     /// match the groom.
     void adoptPrevious(const StrandFrame& out);
+
+    /// Makes `out` (this groom's layout, e.g. an earlier output) the previous
+    /// output whose pinned vertices hold `pins` (an earlier update's
+    /// FollowerStats::pins): the next update() with the same step as that
+    /// one's gives its positions again, bit for bit, without the frame before
+    /// it (its other previous positions only feed velocities). Throws
+    /// hp::Error when a pin lies outside the follower block.
+    void adoptPins(StrandFrame& out, const std::vector<FollowerPin>& pins);
 
     /// Segment length errors |length / rest - 1| of the followers in `out`
     /// (this object's last output, or any frame with its layout): max and

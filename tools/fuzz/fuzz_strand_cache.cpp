@@ -26,8 +26,14 @@ HP_FUZZ_TARGET(strand_cache)(const uint8_t* data, size_t size) {
         std::memcpy(bytes.data() + body, &c, 4);
     }
     try {
-        const hp::StrandFrame frame = hp::parseStrandCache(bytes, "fuzz.hpc");
-        frame.validate();  // parseStrandCache promises a consistent frame
+        const hp::StrandCacheFile file = hp::parseStrandCacheFile(bytes, "fuzz.hpc");
+        // parseStrandCacheFile promises a consistent frame (version 1) or guide records (version 2).
+        if (file.guides) {
+            file.guides->current.guides.validate();
+            if (file.guides->previous) file.guides->previous->guides.validate();
+        } else {
+            file.strands.validate();
+        }
     } catch (const hp::Error&) {
     }
     return 0;
