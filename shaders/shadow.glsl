@@ -10,11 +10,14 @@
 layout(binding = 4) uniform sampler3D uDensity[4];       // slot k's C (or V when the sum is off), trilinear
 layout(binding = 1) uniform sampler2DArrayShadow uShadowMap; // head depth from each slot's light (layer k)
 
+// The first slot (the key) takes the PCF kernel; the others one bilinear
+// comparison (2 x 2 texels): each tap costs per shaded vertex and light,
+// and the fill's and rim's head shadows are soft and faint on the hair.
 float shadowMapVisibility(int s, vec3 world) {
     vec4 c = uSlotClip[s] * vec4(world, 1.0);
     vec3 p = c.xyz / c.w * 0.5 + 0.5;
     if (any(lessThan(p.xy, vec2(0.0))) || any(greaterThan(p.xy, vec2(1.0)))) return 1.0;
-    int r = int(uShadow.y);
+    int r = s == 0 ? int(uShadow.y) : 0;
     float lit = 0.0;
     // Seed eq. 8: the fraction of shadow-map texels around p that are not closer to the light.
     for (int y = -r; y <= r; ++y)
@@ -30,10 +33,14 @@ float shadowMapVisibility(int s, vec3 world) {
 // its shadow, the voxel method's "acne". With kFlagVoxelFilter four lookups
 // average C over 2 x 2 voxels across the beam (a tent over ~3 x 3): regularly
 // spaced hair otherwise casts moire rings, since one-voxel-wide lines fill
-// neighbouring columns unevenly. (The slot index is dynamically uniform, as
-// GLSL 4 requires for indexing sampler arrays: it comes from a uniform.)
+// neighbouring columns unevenly. Only the first slot (the key, on the
+// finest grid) is filtered: the other grids are coarser, their voxels span
+// more hair, and four lookups per light cost the camera pass most of the
+// other lights' shadows on llvmpipe (docs/rendering.md). (The slot index is
+// dynamically uniform, as GLSL 4 requires for indexing sampler arrays: it
+// comes from a uniform.)
 float voxelDensityAt(int s, vec3 g) {
-    if ((uCounts.z & kFlagVoxelFilter) == 0) return texture(uDensity[s], g).r;
+    if ((uCounts.z & kFlagVoxelFilter) == 0 || s > 0) return texture(uDensity[s], g).r;
     float h = 0.75 / uSlotDepth[s].w;
     return 0.25 * (texture(uDensity[s], g + vec3(-h, -h, 0.0)).r + texture(uDensity[s], g + vec3(h, -h, 0.0)).r +
                    texture(uDensity[s], g + vec3(-h, h, 0.0)).r + texture(uDensity[s], g + vec3(h, h, 0.0)).r);

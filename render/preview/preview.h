@@ -90,7 +90,8 @@ struct PreviewShadowSettings {
     bool sumAlongLight = true;
     int resolution = 256;         ///< voxels along each axis of the first shadowed light's box
     /// The same for the other shadowed lights (fill, rim); 0 = `resolution`.
-    int otherResolution = 0;
+    /// Coarser: their grids cost an eighth to clear and sum (docs/rendering.md).
+    int otherResolution = 128;
     /// Average C over 2 x 2 voxels across the beam at lookup: hides the moire
     /// rings regularly spaced hair casts through one-voxel-wide lines.
     bool filter = true;

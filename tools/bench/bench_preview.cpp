@@ -8,14 +8,15 @@
 //
 //   bench_preview [--strands 10000,100000] [--frames 3] [--warmup 1]
 //                 [--profile] [--png out.png] [--shading kajiya-kay|fitted]
-//                 [--lights one|rig]
+//                 [--lights one|rig] [--other-resolution N]
 // --shading fitted shades with the hair material fitted to the physical
 // fibre (render/reference/hair_fit.h, melanin 1.3) and dual scattering; the
 // default keeps the plain Kajiya-Kay material the benchmark always had.
 // --lights rig replaces B-render's one light by the default three-point rig
 // (render/view/view.h threePointRig, camera-relative): the preview then
 // shadows each of its lights that casts shadows (each costs a voxelization,
-// a sum and a shadow map).
+// a sum and a shadow map); --other-resolution sets the voxel resolution of
+// the shadowed lights after the first (PreviewShadowSettings::otherResolution).
 // Per strand count: median, min and max of the timed frames (draw + glFinish,
 // wall and process CPU time, llvmpipe's threads included), readback time,
 // peak resident memory; --profile adds a per-pass breakdown of one extra frame.
@@ -60,6 +61,7 @@ int main(int argc, char** argv) {
     int frames = 3, warmup = 1;
     bool profile = false;
     bool fitted = false, rig = false;
+    int otherResolution = -1;
     std::string png;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -78,10 +80,12 @@ int main(int argc, char** argv) {
             fitted = std::string(argv[++i]) == "fitted";
         } else if (a == "--lights" && more) {
             rig = std::string(argv[++i]) == "rig";
+        } else if (a == "--other-resolution" && more) {
+            otherResolution = std::atoi(argv[++i]);
         } else if (a == "--png" && more) {
             png = argv[++i];
         } else {
-            std::cerr << "usage: bench_preview [--strands N,M] [--frames N] [--warmup N] [--profile] [--png FILE] [--shading kajiya-kay|fitted] [--lights one|rig]\n";
+            std::cerr << "usage: bench_preview [--strands N,M] [--frames N] [--warmup N] [--profile] [--png FILE] [--shading kajiya-kay|fitted] [--lights one|rig] [--other-resolution N]\n";
             return 1;
         }
     }
@@ -91,6 +95,7 @@ int main(int argc, char** argv) {
         if (fitted) fitHairMaterial(HairFiberParams{}, &view.hair);
         if (rig) view.lights = threePointRig();
         PreviewSettings settings;  // 4x MSAA, voxels (additive, nearest, 256^3) + 2048^2 PCF shadow map
+        if (otherResolution >= 0) settings.shadow.otherResolution = otherResolution;
         const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 32, 64);
         std::printf("bench_preview: %s\n", context->description().c_str());
         std::printf("hair shading: %s\n", fitted ? "fitted (dual scattering)" : "kajiya-kay");
