@@ -4,14 +4,13 @@
 layout(std140, binding = 0) uniform Frame {
     mat4 uViewProj;     // world -> clip of this pass (camera, or the light for shadow passes)
     mat4 uView;         // world -> camera view
-    mat4 uLightClip;    // world -> clip of the shadowed light (shadow map lookups)
-    mat4 uLightView;    // world -> light view (voxel grid mapping)
+    mat4 uLightView;    // light passes: world -> light view of the grid this pass voxelizes
     vec4 uEye;          // xyz camera position; w: focal length in target pixels (ribbon widths)
     vec4 uViewport;     // target width, height, 1/width, 1/height
-    vec4 uGridMap;      // light grid: scale.xy, offset.xy
-    vec4 uGridDepth;    // near depth, far depth, perspective (0/1), voxel resolution
+    vec4 uGridMap;      // light passes: that grid's scale.xy, offset.xy
+    vec4 uGridDepth;    // light passes: near depth, far depth, perspective (0/1), voxel resolution
     vec4 uLightVec[16]; // xyz: unit direction to a directional light, or a point light's position; w: 0 / 1
-    vec4 uLightRad[16]; // rgb radiance (directional) or intensity (point, / distance^2)
+    vec4 uLightRad[16]; // rgb radiance (directional) or intensity (point, / distance^2); w: shadow slot, -1 none
     vec4 uHairColor;    // rgb albedo, kd
     vec4 uSpecColor;    // rgb, ks
     vec4 uSecondColor;  // rgb, secondary ks
@@ -29,12 +28,17 @@ layout(std140, binding = 0) uniform Frame {
                         // azimuth power m, azimuth sign * norm w(m)
     vec4 uLobeStrength[36]; // lobe k's strength table: [9k + node], rgb, at |thetaO| = node * 11.25 deg
     vec4 uShadowColor;  // rgb optical depth per unit of C (1 - T, or 1 - a_f fitted), w: beta_f^2 per unit of C
-    ivec4 uCounts;      // light count, shadowed light (-1 none), flags (kFlag*), hair model (kHair*)
+    mat4 uSlotClip[4];  // per shadow slot (a shadowed light, render/preview/light_grid.h): world -> light clip
+    mat4 uSlotView[4];  // world -> light view
+    vec4 uSlotMap[4];   // scale.xy, offset.xy
+    vec4 uSlotDepth[4]; // near depth, far depth, perspective (0/1), voxel resolution
+    ivec4 uCounts;      // light count, shadow slots, flags (kFlag*), hair model (kHair*)
 };
 
 const int kFlagVoxels = 1;
 const int kFlagShadowMap = 2;
 const int kFlagVoxelFilter = 4;
+const int kFlagUnshadowedLights = 8;  // some light has no shadow slot
 
 // uCounts.w: Kajiya-Kay with one or two lobes, or the fitted model with dual scattering.
 const int kHairKajiyaKay = 0;
@@ -46,13 +50,22 @@ const int kHairFitted = 2;
 // render/preview/preview_gpu.h.
 const float kVoxelUnit = 4096.0;
 
-// Grid coordinates of a world point in the light's box (render/preview/light_grid.h).
-vec3 lightGrid(vec3 world) {
-    vec4 v = uLightView * vec4(world, 1.0);
+// Grid coordinates of a world point in a light's box (render/preview/light_grid.h).
+vec3 gridCoordinates(mat4 view, vec4 map, vec4 range, vec3 world) {
+    vec4 v = view * vec4(world, 1.0);
     float depth = -v.z;
-    vec2 q = uGridDepth.z > 0.5 ? v.xy / depth : v.xy;
-    return vec3(q * uGridMap.xy + uGridMap.zw, (depth - uGridDepth.x) / (uGridDepth.y - uGridDepth.x));
+    vec2 q = range.z > 0.5 ? v.xy / depth : v.xy;
+    return vec3(q * map.xy + map.zw, (depth - range.x) / (range.y - range.x));
 }
+
+// ... in the grid this light pass voxelizes.
+vec3 lightGrid(vec3 world) { return gridCoordinates(uLightView, uGridMap, uGridDepth, world); }
+
+// ... in shadow slot s's grid.
+vec3 slotGrid(int s, vec3 world) { return gridCoordinates(uSlotView[s], uSlotMap[s], uSlotDepth[s], world); }
+
+// Light i's shadow slot, -1 for an unshadowed light.
+int shadowSlot(int i) { return int(uLightRad[i].w); }
 
 // Unit direction from p toward light i, and its radiance there (render/view/view.cpp Light::toLight).
 vec3 toLight(int i, vec3 p, out vec3 radiance) {

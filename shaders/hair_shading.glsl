@@ -1,8 +1,9 @@
 // Radiance leaving a hair point toward the camera, under every light.
-// Kajiya-Kay: the model times the light's visibility (voxel grid, shadow map).
+// Kajiya-Kay: the model times the light's visibility (its slot's voxel grid
+// and shadow map; 1 for a light without a slot).
 // Fitted (render/reference/hair_fit.h): the dual-scattering approximation of
 // Zinke, Yuksel, Weber and Keyser 2008. Behind C expected fibre crossings
-// toward the light (the voxel grid) the light arriving is the forward-
+// toward each shadowed light (its slot's voxel grid) the light arriving is the forward-
 // scattered T_f = exp(-(1 - a_f) C) (coloured: each fibre keeps what it
 // scatters forward, a_f per channel), spread along the fibre by
 // sigma_f^2 = C beta_f^2, which widens every lobe; the fibres around the point
@@ -26,15 +27,12 @@ vec3 shadeHair(vec3 world, vec3 tangent, vec3 albedo) {
     vec3 n = v - dot(v, t) * t;
     n = dot(n, n) > 1e-12 ? normalize(n) : vec3(0.0);
     vec3 color = vec3(0.0);
-    // Fitted: the shadowed light's voxel column through the point, C in front
-    // and the column's whole C, once for all lights.
     bool fitted = uCounts.w == kHairFitted;
-    float front = 0.0, column = -1.0;
-    if (fitted && uCounts.y >= 0) {
-        front = hairCrossings(uCounts.y, world);
-        float behind = hairCrossingsBehind(uCounts.y, world, front);
-        column = behind < 0.0 ? -1.0 : front + behind;
-    }
+    // Lights without a shadow slot take the hair's thickness from slot 0's
+    // column through the point (once for all of them).
+    float firstColumn = -1.0;
+    if (fitted && (uCounts.z & kFlagUnshadowedLights) != 0 && voxelsOn(uCounts.y > 0 ? 0 : -1))
+        firstColumn = hairColumn(0, world).y;
     vec3 af = vec3(1.0) - uShadowColor.rgb;
     for (int i = 0; i < uCounts.x; ++i) {
         vec3 radiance;
@@ -43,16 +41,17 @@ vec3 shadeHair(vec3 world, vec3 tangent, vec3 albedo) {
             color += kajiyaKay(albedo, t, n, l, v) * radiance * lightVisibility(i, world);
             continue;
         }
-        if (i != uCounts.y || column < 0.0) {
+        int s = shadowSlot(i);
+        if (!voxelsOn(s)) {
             // A light without a grid (unshadowed: it reaches every fibre, as
             // in the reference). The fibres toward it are lit too and pass on
             // what they scatter forward: n fibres deep a_f^n, spread n beta_f^2.
-            // Summed over n = 1..N with N Poisson of mean C_h, half the
-            // shadowed light's column here (the hair's half thickness, the
-            // grid's one measure of it; without a grid the infinite sum),
-            // times Zinke's d_f:
+            // Summed over n = 1..N with N Poisson of mean C_h, half of slot
+            // 0's column here (the hair's half thickness, the grid's one
+            // measure of it; without a grid the infinite sum), times Zinke's d_f:
             //   d_f a_f (1 - exp(-(1 - a_f) C_h)) / (1 - a_f),
             // spread at the series' mean depth 1 / (1 - a_f), capped by C_h.
+            float column = firstColumn;
             vec3 deep = af / max(vec3(1.0) - af, vec3(0.05));
             float meanDepth = 1.0 / max(1.0 - dot(af, vec3(0.2126, 0.7152, 0.0722)), 0.05);
             vec3 chain = kForwardDensity * deep;
@@ -68,15 +67,16 @@ vec3 shadeHair(vec3 world, vec3 tangent, vec3 albedo) {
             color += f * radiance * headVisibility(i, world);
             continue;
         }
-        // The shadowed light: forward transmittance and spread through the
+        // A shadowed light: forward transmittance and spread through the
         // C fibres in front, back-scatter from the C_b = column - C behind.
         // Zinke's A_b sums paths into a half-space of hair; through C_b
         // fibres the round trips a_f^2k stop after about C_b, the factor
         // 1 - exp(-(1 - a_f^2) C_b) (Poisson mean of 1 - a_f^(2n)).
-        float spread = uShadowColor.w * front;
-        vec3 depthFactor = vec3(1.0) - exp(-(vec3(1.0) - af * af) * (column - front));
+        vec2 c = hairColumn(s, world);
+        float spread = uShadowColor.w * c.x;
+        vec3 depthFactor = vec3(1.0) - exp(-(vec3(1.0) - af * af) * (c.y - c.x));
         vec3 f = fittedHair(albedo, t, l, v, spread) + hairLobe(3, t, l, v, spread) * depthFactor;
-        color += f * radiance * exp(-uShadowColor.rgb * front) * headVisibility(i, world);
+        color += f * radiance * exp(-uShadowColor.rgb * c.x) * headVisibility(i, world);
     }
     return color;
 }

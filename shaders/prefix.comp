@@ -8,9 +8,10 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(r32ui, binding = 0) readonly uniform uimage3D uVoxels;
 layout(r32f, binding = 1) writeonly uniform image3D uDensity;
 uniform int uSum;
+uniform int uResolution;  // this light's grid: a corner of the shared voxel image
 
 void main() {
-    ivec3 size = imageSize(uVoxels);
+    ivec3 size = ivec3(uResolution);
     ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
     if (xy.x >= size.x || xy.y >= size.y) return;
     float sum = 0.0;

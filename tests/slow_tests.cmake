@@ -13,6 +13,9 @@ set(_hp_slow_tests
   test_hair_bsdf:HairBsdf.SampledWhiteFurnaceConservesEnergy
   test_compare:CompareReport.IsSelfContainedAndRendersInHeadlessChromium  # Chromium start-up
   test_preview:Preview.VoxelShadowsDarkenStrandBehindSlab      # llvmpipe raster
+  test_preview_shadows:PreviewShadows.SecondLightThroughHairIsBeerLambert  # four renders with shadows
+  test_preview_shadows:PreviewShadows.ShadowingTheFillDarkensTheHair  # five renders under the rig
+  test_preview_shadows:PreviewShadows.CapAndOrderOfShadowedLights  # three renderers' programs
   test_preview_stage:PreviewStage.ViewerRendersUnderXvfb       # Xvfb start-up
   test_guides:Guides.StableOverTenThousandStepsWithATeleport   # 10^4 solver steps
   test_vdb:VdbFile.BytesAreIdenticalForOneAndTwoThreadsAndRepeatedWrites

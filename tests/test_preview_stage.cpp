@@ -71,7 +71,7 @@ TEST(PreviewStage, CrossKeyErrorsNameTheKey) {
     };
     EXPECT_NE(message("preview: {shadow: {voxel_mode: binary, splat: trilinear}}").find("preview.shadow.splat"),
               std::string::npos);
-    EXPECT_NE(message("preview: {shadow: {light: 3}}").find("preview.shadow.light"), std::string::npos);
+    EXPECT_NE(message("preview: {shadow: {max_lights: 5}}").find("preview.shadow.max_lights"), std::string::npos);
     EXPECT_NE(message("preview: {generated: {regions: [{type: 2}]}}").find("preview.generated.regions[0].type"),
               std::string::npos);
     try {

@@ -213,8 +213,7 @@ TEST(SceneLists, DefaultListAndItemDefaults) {
     ASSERT_EQ(s.count("render.lights"), 3u);
     EXPECT_EQ(s.text("render.lights[0].type"), "directional");
     EXPECT_EQ(s.text("render.lights[0].space"), "camera");
-    EXPECT_TRUE(s.flag("render.lights[0].shadows"));
-    EXPECT_FALSE(s.flag("render.lights[2].shadows"));
+    for (size_t i = 0; i < 3; ++i) EXPECT_TRUE(s.flag(cat("render.lights[", i, "].shadows"))) << i;
     const View v = makeView(s);
     const std::vector<Light> rig = threePointRig();
     ASSERT_EQ(v.lights.size(), rig.size());
@@ -224,6 +223,23 @@ TEST(SceneLists, DefaultListAndItemDefaults) {
         EXPECT_EQ(v.lights[i].castsShadows, rig[i].castsShadows) << i;
         EXPECT_TRUE(v.lights[i].cameraRelative) << i;
     }
+}
+
+// The preview shadows at most preview.shadow.max_lights lights; the view
+// both renderers get marks the rest unshadowed, so the Kajiya-Kay reference
+// shadows exactly the preview's lights.
+TEST(SceneLists, ShadowedLightsAreCappedByThePreview) {
+    const std::string lights = "render:\n  lights:\n    - {shadows: false}\n    - {}\n    - {}\n    - {}\n"
+                               "    - {}\n    - {}\n";
+    auto shadowed = [&](const std::string& more) {
+        std::vector<bool> out;
+        for (const Light& l : makeView(Scene::parse(lights + more, "shot.yaml", ".")).lights)
+            out.push_back(l.castsShadows);
+        return out;
+    };
+    EXPECT_EQ(shadowed(""), (std::vector<bool>{false, true, true, true, true, false}));
+    EXPECT_EQ(shadowed("preview: {shadow: {max_lights: 2}}"), (std::vector<bool>{false, true, true, false, false, false}));
+    EXPECT_EQ(shadowed("preview: {shadow: {max_lights: 0}}"), (std::vector<bool>(6, false)));
 }
 
 TEST(SceneLists, ItemsFromFileGetDefaultsAndLocations) {

@@ -20,20 +20,17 @@ PreviewSettings makePreviewSettings(const Scene& s) {
 
     PreviewShadowSettings& sh = p.shadow;
     readKeys(s, sh, {
-        {"preview.shadow.light", &PreviewShadowSettings::light},
+        {"preview.shadow.max_lights", &PreviewShadowSettings::maxLights},
         {"preview.shadow.voxels", &PreviewShadowSettings::voxels},
         {"preview.shadow.sum", &PreviewShadowSettings::sumAlongLight},
         {"preview.shadow.resolution", &PreviewShadowSettings::resolution},
+        {"preview.shadow.other_resolution", &PreviewShadowSettings::otherResolution},
         {"preview.shadow.filter", &PreviewShadowSettings::filter},
         {"preview.shadow.alpha", &PreviewShadowSettings::alpha},
         {"preview.shadow.map", &PreviewShadowSettings::shadowMap},
         {"preview.shadow.map_size", &PreviewShadowSettings::shadowMapSize},
         {"preview.shadow.pcf_radius", &PreviewShadowSettings::pcfRadius},
     });
-    const size_t lights = s.count("render.lights");
-    if (sh.light >= 0 && size_t(sh.light) >= lights)
-        s.fail("preview.shadow.light",
-               cat("names light ", sh.light, " but render.lights has ", lights, " (use -1 for no shadows)"));
     sh.mode = s.text("preview.shadow.voxel_mode") == "binary" ? VoxelMode::Binary : VoxelMode::Additive;
     sh.splat = s.text("preview.shadow.splat") == "trilinear" ? VoxelSplat::Trilinear : VoxelSplat::Nearest;
     if (sh.mode == VoxelMode::Binary && sh.splat == VoxelSplat::Trilinear)

@@ -9,7 +9,7 @@ namespace hp {
 
 /// The preview settings of the scene. Throws SceneError for combinations a
 /// single key cannot check (trilinear binary splatting, a region naming a
-/// missing hair type, a shadowed light that does not exist).
+/// missing hair type).
 PreviewSettings makePreviewSettings(const Scene& scene);
 
 }  // namespace hp

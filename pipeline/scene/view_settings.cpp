@@ -2,6 +2,7 @@
 #include "pipeline/scene/key_fields.h"
 
 #include "core/errors.h"
+#include "core/log.h"
 #include "render/reference/environment_light.h"
 #include "render/reference/hair_bsdf.h"
 #include "render/reference/hair_fit.h"
@@ -50,6 +51,12 @@ View makeView(const Scene& s) {
             s.fail(k + "direction", cat("a ", type, " light needs a non-zero direction"));
         v.lights.push_back(l);
     }
+    // The preview shadows at most preview.shadow.max_lights lights; the
+    // Kajiya-Kay reference, the preview's diagnostic twin, shadows the same.
+    for (int i : limitShadowedLights(v.lights, int(s.integer("preview.shadow.max_lights"))))
+        logWarning(s.where(cat("render.lights[", i, "].shadows")).str(), ": render.lights[", i,
+                   "] is unshadowed in the preview and the Kajiya-Kay reference: preview.shadow.max_lights is ",
+                   s.integer("preview.shadow.max_lights"));
     v.environment = s.vec3f("render.environment");
     const std::filesystem::path map = s.file("render.environment_map");
     if (!map.empty()) {

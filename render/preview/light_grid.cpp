@@ -86,4 +86,18 @@ Mat4f LightGrid::clip() const {
     return p * view;
 }
 
+std::vector<ShadowSlot> fitShadowSlots(const std::vector<Light>& lights, int maxLights,
+                                       const Eigen::AlignedBox3f& bounds, std::vector<int>* unfitted) {
+    std::vector<ShadowSlot> slots;
+    int considered = 0;
+    for (size_t i = 0; i < lights.size() && considered < maxLights; ++i) {
+        if (!lights[i].castsShadows) continue;
+        ++considered;
+        ShadowSlot slot{int(i), LightGrid::fit(lights[i], bounds)};
+        if (slot.grid.valid) slots.push_back(slot);
+        else if (unfitted) unfitted->push_back(int(i));
+    }
+    return slots;
+}
+
 }  // namespace hp

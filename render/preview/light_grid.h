@@ -1,12 +1,14 @@
-// The shadowed light's view of the scene: one mapping from world space to a
+// A shadowed light's view of the scene: one mapping from world space to a
 // unit cube used by both the voxel grid (Dehlin and Styngberg's self-shadowing) and the
-// shadow map. Plain CPU code, so tests can voxelize on the CPU with exactly
+// shadow map, and which lights get one (fitShadowSlots). Plain CPU code, so tests can voxelize on the CPU with exactly
 // the mapping the GPU used.
 #pragma once
 
 #include "render/view/view.h"
 
 #include <Eigen/Geometry>
+
+#include <vector>
 
 namespace hp {
 
@@ -33,5 +35,18 @@ struct LightGrid {
     /// depth increasing with w (linear for directional lights).
     Mat4f clip() const;
 };
+
+/// A light the preview shadows and its grid.
+struct ShadowSlot {
+    int light = -1;  ///< index into the lights
+    LightGrid grid;
+};
+
+/// The preview's shadowed lights: those with Light::castsShadows, in order,
+/// at most `maxLights` (limitShadowedLights in render/view/view.h is the same
+/// rule), each fitted around `bounds`. A light whose grid cannot be fitted (a
+/// point light inside the bounds) gets no slot and is listed in `unfitted`.
+std::vector<ShadowSlot> fitShadowSlots(const std::vector<Light>& lights, int maxLights,
+                                       const Eigen::AlignedBox3f& bounds, std::vector<int>* unfitted = nullptr);
 
 }  // namespace hp

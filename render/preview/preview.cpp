@@ -27,10 +27,6 @@ using Files = std::vector<std::pair<ShaderStage, std::string>>;
 /// per-patch cost of software rasterizers down.
 constexpr int kSortedPatchSegments = 4;
 
-void copyMatrix(float* dst, const Mat4f& m) { std::memcpy(dst, m.data(), 16 * sizeof(float)); }
-void set4(float* dst, float a, float b, float c, float d) { dst[0] = a, dst[1] = b, dst[2] = c, dst[3] = d; }
-void set3(float* dst, const Vec3f& v, float w) { set4(dst, v.x(), v.y(), v.z(), w); }
-
 double cpuMilliseconds() {
     timespec t{};
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);  // all threads, llvmpipe's rasterizers included
@@ -51,16 +47,18 @@ struct PreviewRenderer::Impl {
     HeadBuffers headBuffers;
     RenderTargets targets;
     ShadowTargets shadows;
-    GLuint cameraUbo = 0, lightUbo = 0, emptyVao = 0, query = 0;
+    GLuint cameraUbo = 0, emptyVao = 0, query = 0;
+    GLuint lightUbo[kMaxShadowedLights] = {};  ///< one per shadowed light: its passes' grid
     GLsync fence = nullptr;
     int maxSamples = 1;
     bool pipelineStatistics = false;
     bool voxelsDrawn = false;
-    bool warnedUnshadowed = false;
+    std::vector<int> warnedUnfitted;  ///< lights already warned about
     int strandPatchSize = 0;
     bool strandsVisible = false, headVisible = false, furVisible = false;  // what this frame draws
     bool shadedPerFragment = false;
-    LightGrid grid;
+    std::vector<ShadowSlot> slots;   ///< this frame's shadowed lights
+    int slotResolution[kMaxShadowedLights] = {};
 
     explicit Impl(const PreviewSettings& s) : settings(s) {
         if (!epoxy_has_gl_extension("GL_ARB_shader_image_load_store") && epoxy_gl_version() < 42)
@@ -90,8 +88,8 @@ struct PreviewRenderer::Impl {
         headBuffers.create();
         glCreateBuffers(1, &cameraUbo);
         glNamedBufferStorage(cameraUbo, sizeof(FrameUniforms), nullptr, GL_DYNAMIC_STORAGE_BIT);
-        glCreateBuffers(1, &lightUbo);
-        glNamedBufferStorage(lightUbo, sizeof(FrameUniforms), nullptr, GL_DYNAMIC_STORAGE_BIT);
+        glCreateBuffers(kMaxShadowedLights, lightUbo);
+        for (GLuint ubo : lightUbo) glNamedBufferStorage(ubo, sizeof(FrameUniforms), nullptr, GL_DYNAMIC_STORAGE_BIT);
         glCreateVertexArrays(1, &emptyVao);
         GLint samples = 1, colorSamples = 1, depthSamples = 1;
         glGetIntegerv(GL_MAX_SAMPLES, &samples);
@@ -109,8 +107,8 @@ struct PreviewRenderer::Impl {
         headBuffers.destroy();
         targets.destroy();
         shadows.destroy();
-        GLuint buffers[] = {cameraUbo, lightUbo};
-        glDeleteBuffers(2, buffers);
+        glDeleteBuffers(1, &cameraUbo);
+        glDeleteBuffers(kMaxShadowedLights, lightUbo);
         glDeleteVertexArrays(1, &emptyVao);
         if (query) glDeleteQueries(1, &query);
     }
@@ -164,68 +162,6 @@ struct PreviewRenderer::Impl {
     int samples() const { return std::clamp(settings.msaa, 1, maxSamples); }
     int supersample() const { return std::clamp(settings.supersample, 1, 4); }
 
-    void fillUniforms(FrameUniforms& u, const View& view, const PreviewFrame& frame, float blendReference) const {
-        std::memset(&u, 0, sizeof(u));
-        const Camera& cam = view.camera;
-        const Mat4f proj = cam.projection(), viewM = cam.view();
-        const int ss = supersample();
-        const float tw = float(cam.width * ss), th = float(cam.height * ss);
-        copyMatrix(u.viewProj, proj * viewM);
-        copyMatrix(u.view, viewM);
-        copyMatrix(u.lightClip, grid.clip());
-        copyMatrix(u.lightView, grid.view);
-        set3(u.eye, cam.position, proj(1, 1) * 0.5f * th);
-        set4(u.viewport, tw, th, 1.f / tw, 1.f / th);
-        set4(u.gridMap, grid.scale.x(), grid.scale.y(), grid.offset.x(), grid.offset.y());
-        set4(u.gridDepth, grid.nearDepth, grid.farDepth, grid.perspective ? 1.f : 0.f, float(settings.shadow.resolution));
-        const size_t lights = std::min<size_t>(view.lights.size(), 16);
-        for (size_t i = 0; i < lights; ++i) {
-            const Light& l = view.lights[i];
-            if (l.type == LightType::Directional) set3(u.lightVec[i], -l.direction.normalized(), 0.f);
-            else set3(u.lightVec[i], l.position, 1.f);
-            set3(u.lightRad[i], l.color * l.intensity, 0.f);
-        }
-        const HairMaterial& h = view.hair;
-        set3(u.hairColor, h.color, h.kd);
-        set3(u.specColor, h.specularColor, h.ks);
-        set3(u.secondColor, h.secondaryColor, h.secondaryKs);
-        set4(u.hairShape, h.shininess, h.secondaryShininess, h.primaryShift, h.secondaryShift);
-        set3(u.headColor, view.head.color, view.head.ambient);
-        set4(u.headSkin, view.head.wrap, view.head.specular, view.head.shininess, 0.f);
-        const PreviewShadowSettings& sh = settings.shadow;
-        // Optical depth of one unit of C (shaders/shadow.glsl).
-        const float depthPerUnit = sh.weight == VoxelWeight::Crossings
-                                       ? 1.f - std::clamp(h.transmittance, 0.f, 1.f)
-                                       : -std::log(std::clamp(sh.alpha, 1e-6f, 1.f));
-        set4(u.shadow, depthPerUnit, float(std::max(0, sh.pcfRadius)), 1.f / float(std::max(1, sh.shadowMapSize)),
-             0.002f);
-        // Fitted hair: each crossing keeps the light the fibre scatters
-        // forward, a_f per colour, and spreads it by β_f² (Zinke 2008).
-        const bool fittedHair = h.shading == HairShading::Fitted;
-        if (fittedHair && sh.weight == VoxelWeight::Crossings)
-            set3(u.shadowColor, Vec3f::Ones() - h.dual.forward.cwiseMin(Vec3f::Ones()), h.dual.forwardVariance);
-        else
-            set4(u.shadowColor, depthPerUnit, depthPerUnit, depthPerUnit, fittedHair ? h.dual.forwardVariance : 0.f);
-        const HairLobe* lobes[4] = {&h.r, &h.trt, &h.tt, &h.dual.back};
-        for (int k = 0; k < 4; ++k) {
-            const HairLobe& lobe = *lobes[k];
-            set4(u.lobeShape[k], lobe.exponent, lobe.shift, lobe.azimuthPower, lobe.azimuthSign * lobe.azimuthNorm);
-            for (int node = 0; node < kHairLobeNodes; ++node)
-                set3(u.lobeStrength[k * kHairLobeNodes + node], lobe.strength[size_t(node)], 0.f);
-        }
-        set4(u.tess, float(std::clamp(settings.tessellationLevel, 1, 64)), settings.tessellationPixels * float(ss),
-             settings.curve == CurveType::BSpline ? 1.f : 0.f, settings.minPixelWidth * float(ss));
-        set4(u.blend, blendReference, std::max(settings.blendDepthScale, 1e-5f), 0.f, 0.f);
-        const GeneratedHairSettings& g = settings.generated;
-        set3(u.gravity, g.gravity, 0.f);
-        set3(u.wind, g.wind, g.gust);
-        set4(u.furTime, float(frame.time), g.gustFrequency, std::max(g.gustWavelength, 1e-4f),
-             float(std::clamp(g.innerLevel, 1, 64)));
-        set4(u.furLevels, float(std::clamp(g.outerLevel, 1, 64)), 0.f, 0.f, 0.f);
-        u.counts[0] = int(lights);
-        u.counts[3] = h.shading == HairShading::Fitted ? kHairFitted : h.twoLobes ? kHairKajiyaKayTwoLobes : kHairKajiyaKay;
-    }
-
     void drawStrands(const GlProgram& program) {
         if (!strandsVisible || !strands.indexCount) return;
         program.use();
@@ -253,31 +189,38 @@ struct PreviewRenderer::Impl {
         glDrawElements(GL_TRIANGLES, GLsizei(headBuffers.indexCount), GL_UNSIGNED_INT, nullptr);
     }
 
-    void shadowPasses(bool headDrawn, bool mapOn, bool voxelsOn) {
+    /// Each shadowed light in turn (the last slot first, so the shared r32ui
+    /// grid ends with slot 0's voxels for readVoxels): its head shadow map
+    /// layer, then the hair voxelized from it and summed along it into the
+    /// slot's density grid.
+    void shadowPasses(bool mapOn, bool voxelsOn) {
         const PreviewShadowSettings& sh = settings.shadow;
-        shadows.ensure(std::clamp(sh.shadowMapSize, 16, 16384), std::clamp(sh.resolution, 4, 1024));
-        glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightUbo);
+        const int n = int(slots.size());
+        shadows.ensure(std::clamp(sh.shadowMapSize, 16, 16384), n, slotResolution);
         glDisable(GL_BLEND);
-        if (mapOn && headDrawn) {
-            glBindFramebuffer(GL_FRAMEBUFFER, shadows.mapFbo);
-            glViewport(0, 0, shadows.mapSize, shadows.mapSize);
-            glEnable(GL_DEPTH_TEST);
-            glDepthFunc(GL_LESS);
-            glDepthMask(GL_TRUE);
-            const float one = 1.f;
-            glClearNamedFramebufferfv(shadows.mapFbo, GL_DEPTH, 0, &one);
-            glEnable(GL_POLYGON_OFFSET_FILL);
-            glPolygonOffset(2.f, 4.f);
-            drawHead(headDepth);
-            glDisable(GL_POLYGON_OFFSET_FILL);
-            mark("shadow map");
-        }
-        if (voxelsOn) {
+        for (int k = n - 1; k >= 0; --k) {
+            glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightUbo[k]);
+            if (mapOn) {
+                glBindFramebuffer(GL_FRAMEBUFFER, shadows.mapFbo[k]);
+                glViewport(0, 0, shadows.mapSize, shadows.mapSize);
+                glEnable(GL_DEPTH_TEST);
+                glDepthFunc(GL_LESS);
+                glDepthMask(GL_TRUE);
+                const float one = 1.f;
+                glClearNamedFramebufferfv(shadows.mapFbo[k], GL_DEPTH, 0, &one);
+                glEnable(GL_POLYGON_OFFSET_FILL);
+                glPolygonOffset(2.f, 4.f);
+                drawHead(headDepth);
+                glDisable(GL_POLYGON_OFFSET_FILL);
+                mark("shadow map");
+            }
+            if (!voxelsOn) continue;
+            const int res = slotResolution[k];
             const GLuint zero = 0;
-            glClearTexImage(shadows.voxels, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+            glClearTexSubImage(shadows.voxels, 0, 0, 0, 0, res, res, res, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
             mark("voxel clear");
             glBindFramebuffer(GL_FRAMEBUFFER, shadows.voxelFbo);
-            glViewport(0, 0, shadows.resolution, shadows.resolution);
+            glViewport(0, 0, res, res);
             glDisable(GL_DEPTH_TEST);
             glDepthMask(GL_FALSE);
             glBindImageTexture(0, shadows.voxels, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
@@ -292,11 +235,13 @@ struct PreviewRenderer::Impl {
             mark("voxelize");
             prefix.use();
             glProgramUniform1i(prefix.id(), prefix.uniform("uSum"), sh.sumAlongLight ? 1 : 0);
+            glProgramUniform1i(prefix.id(), prefix.uniform("uResolution"), res);
             glBindImageTexture(0, shadows.voxels, 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32UI);
-            glBindImageTexture(1, shadows.density, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
-            const GLuint groups = GLuint((shadows.resolution + 7) / 8);
+            glBindImageTexture(1, shadows.density[k], 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+            const GLuint groups = GLuint((res + 7) / 8);
             glDispatchCompute(groups, groups, 1);
-            glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+            glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
+                            GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
             mark("voxel sum");
         }
     }
@@ -317,7 +262,9 @@ struct PreviewRenderer::Impl {
         glClearBufferfv(GL_COLOR, 3, inf);
         glClearBufferfv(GL_DEPTH, 0, one);
         mark("camera clear");
-        glBindTextureUnit(0, voxelsOn ? shadows.density : shadows.dummyDensity);
+        // Units 4.. : each slot's density (uDensity[] in shaders/shadow.glsl); 1: the shadow maps.
+        for (int k = 0; k < kMaxShadowedLights; ++k)
+            glBindTextureUnit(GLuint(4 + k), voxelsOn && k < int(slots.size()) ? shadows.density[k] : shadows.dummyDensity);
         glBindTextureUnit(1, mapOn ? shadows.map : shadows.dummyMap);
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_LESS);
@@ -472,37 +419,40 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
     }
 
     const PreviewShadowSettings& sh = settings.shadow;
-    grid = LightGrid();
-    const bool lightExists =
-        sh.light >= 0 && size_t(sh.light) < view.lights.size() && view.lights[size_t(sh.light)].castsShadows;
-    if (lightExists && (sh.voxels || sh.shadowMap) && !bounds.isEmpty()) {
-        grid = LightGrid::fit(view.lights[size_t(sh.light)], bounds);
-        if (!grid.valid && !warnedUnshadowed) {
-            logWarning("preview: the shadowed light (render.lights[", sh.light,
-                       "]) is a point light inside the scene's bounds; it casts no shadows");
-            warnedUnshadowed = true;
+    slots.clear();
+    if ((sh.voxels || sh.shadowMap) && !bounds.isEmpty()) {
+        std::vector<int> unfitted;
+        slots = fitShadowSlots(view.lights, std::clamp(sh.maxLights, 0, kMaxShadowedLights), bounds, &unfitted);
+        for (int light : unfitted) {
+            if (std::find(warnedUnfitted.begin(), warnedUnfitted.end(), light) != warnedUnfitted.end()) continue;
+            logWarning("preview: render.lights[", light,
+                       "] is a point light inside the scene's bounds; it casts no shadows in the preview");
+            warnedUnfitted.push_back(light);
         }
     }
-    stats.shadowed = grid.valid;
-    const bool voxelsOn = grid.valid && sh.voxels;
-    const bool mapOn = grid.valid && sh.shadowMap && headDrawn;
+    for (size_t k = 0; k < slots.size(); ++k) {
+        const int res = k == 0 || sh.otherResolution <= 0 ? sh.resolution : sh.otherResolution;
+        slotResolution[k] = std::clamp(res, 4, 1024);
+    }
+    stats.shadowed = !slots.empty();
+    stats.shadowedLights = int(slots.size());
+    const bool voxelsOn = !slots.empty() && sh.voxels;
+    const bool mapOn = !slots.empty() && sh.shadowMap && headDrawn;
     voxelsDrawn = voxelsOn;
 
     FrameUniforms u;
-    fillUniforms(u, view, frame, blendReference);
+    fillFrameUniforms(u, UniformInputs{view, settings, frame, blendReference, supersample(), slots, slotResolution,
+                                       voxelsOn, mapOn});
     const float lineWidth = linePathWidth();
     u.blend[2] = lineWidth > 0.f ? 1.f : 0.f;
-    u.counts[1] = grid.valid ? sh.light : -1;
-    u.counts[2] = (voxelsOn ? kFlagVoxels : 0) | (mapOn ? kFlagShadowMap : 0) |
-                  (voxelsOn && sh.filter ? kFlagVoxelFilter : 0);
     glNamedBufferSubData(cameraUbo, 0, sizeof(u), &u);
     if (voxelsOn || mapOn) {
-        FrameUniforms l = u;
-        copyMatrix(l.viewProj, grid.clip());
-        const float res = float(std::clamp(sh.resolution, 4, 1024));
-        set4(l.viewport, res, res, 1.f / res, 1.f / res);
-        glNamedBufferSubData(lightUbo, 0, sizeof(l), &l);
-        shadowPasses(headDrawn, mapOn, voxelsOn);
+        for (size_t k = 0; k < slots.size(); ++k) {
+            FrameUniforms l = u;
+            setPassGrid(l, slots[k].grid, slotResolution[k]);
+            glNamedBufferSubData(lightUbo[k], 0, sizeof(l), &l);
+        }
+        shadowPasses(mapOn, voxelsOn);
     }
     targets.ensure(cam.width, cam.height, samples(), supersample());
     cameraPass(voxelsOn, mapOn, lineWidth);
@@ -565,20 +515,26 @@ void PreviewRenderer::present(int x, int y, int width, int height) const {
     glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
-VoxelSnapshot PreviewRenderer::readVoxels() const {
+VoxelSnapshot PreviewRenderer::readVoxels(int slot) const {
     const Impl& m = *impl_;
     VoxelSnapshot snap;
-    if (!m.voxelsDrawn) return snap;
-    const int r = m.shadows.resolution;
+    if (!m.voxelsDrawn || slot < 0 || size_t(slot) >= m.slots.size()) return snap;
+    const int r = m.slotResolution[slot];
     const size_t n = size_t(r) * r * r;
     snap.resolution = r;
-    snap.grid = m.grid;
-    std::vector<uint32_t> raw(n);
-    glGetTextureImage(m.shadows.voxels, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(n * 4), raw.data());
-    snap.raw.resize(n);
-    for (size_t i = 0; i < n; ++i) snap.raw[i] = float(raw[i]) / kVoxelUnit;
+    snap.grid = m.slots[size_t(slot)].grid;
+    if (slot == 0) {  // the shared r32ui grid holds slot 0's voxels, in a corner of its largest resolution
+        const int full = m.shadows.voxelResolution;
+        std::vector<uint32_t> raw(size_t(full) * full * full);
+        glGetTextureImage(m.shadows.voxels, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(raw.size() * 4), raw.data());
+        snap.raw.resize(n);
+        for (int z = 0; z < r; ++z)
+            for (int y = 0; y < r; ++y)
+                for (int x = 0; x < r; ++x)
+                    snap.raw[(size_t(z) * r + y) * r + x] = float(raw[(size_t(z) * full + y) * full + x]) / kVoxelUnit;
+    }
     snap.summed.resize(n);
-    glGetTextureImage(m.shadows.density, 0, GL_RED, GL_FLOAT, GLsizei(n * 4), snap.summed.data());
+    glGetTextureImage(m.shadows.density[slot], 0, GL_RED, GL_FLOAT, GLsizei(n * 4), snap.summed.data());
     return snap;
 }
 

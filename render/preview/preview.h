@@ -33,10 +33,12 @@
 //   fragments nearer than the scene's front by `blendDepthScale` metres,
 //   which lets hair deep in the volume tint the front (unsorted, cheaper).
 //   Opaque head fragments hide the hair behind them through the depth test.
-// - Shadows of one light: the hair voxelized from the light into an r32ui 3D
-//   texture with image atomics (Dehlin and Styngberg's binary/additive, nearest/trilinear),
-//   summed along the light in a compute pass, transmittance alpha^C; times a
-//   PCF shadow map of the head. Point lights use a perspective frustum.
+// - Shadows of up to kMaxShadowedLights lights, each on its own: the hair
+//   voxelized from that light into an r32ui 3D texture with image atomics
+//   (Dehlin and Styngberg's binary/additive, nearest/trilinear), summed along
+//   the light in a compute pass into the light's density grid, transmittance
+//   alpha^C; times a PCF shadow map of the head from that light. Point lights
+//   use a perspective frustum.
 // - Output: R, G, B premultiplied linear radiance (the environment colour
 //   fills what coverage leaves), A the coverage of hair and head, Z the
 //   camera-space depth in metres (distance along the view axis, not along
@@ -69,16 +71,27 @@ enum class VoxelSplat { Nearest, Trilinear };
 /// or fragments (Dehlin and Styngberg 2017: each fragment adds 1, whatever the hair's width).
 enum class VoxelWeight { Crossings, Fragments };
 
-/// Shadows of the one shadowed light (other lights are unshadowed).
+/// Most lights the preview shadows: each costs a voxelization of the hair, a
+/// sum along its light, a shadow map and a density grid (render/preview/
+/// preview_gpu.h); the default three-point rig needs three.
+inline constexpr int kMaxShadowedLights = 4;
+
+/// Shadows of the shadowed lights: the lights with Light::castsShadows, the
+/// first `maxLights` of them in View::lights order (others are unshadowed,
+/// and the pipeline marks them so, for the Kajiya-Kay reference to agree).
+/// Each gets its own LightGrid, voxel density and head shadow map.
 struct PreviewShadowSettings {
-    int light = 0;                ///< index of the shadowed light in View::lights; -1 = none
+    int maxLights = kMaxShadowedLights;  ///< 0..kMaxShadowedLights; 0 = no shadows
     bool voxels = true;           ///< hair self-shadowing through the voxel grid
     VoxelMode mode = VoxelMode::Additive;
     VoxelSplat splat = VoxelSplat::Nearest;
     /// Sum the grid along the light (Dehlin and Styngberg's C); false shades with the raw
     /// voxel value V, Dehlin and Styngberg's visualisation of the voxelization itself.
     bool sumAlongLight = true;
-    int resolution = 256;         ///< voxels along each axis of the light's box
+    int resolution = 256;         ///< voxels along each axis of the first shadowed light's box
+    /// The same for the other shadowed lights (fill, rim); 0 = `resolution`.
+    /// Coarser: their grids cost an eighth to clear and sum (docs/rendering.md).
+    int otherResolution = 128;
     /// Average C over 2 x 2 voxels across the beam at lookup: hides the moire
     /// rings regularly spaced hair casts through one-voxel-wide lines.
     bool filter = true;
@@ -134,7 +147,8 @@ struct PreviewStats {
     size_t strandSegments = 0;     ///< simulated strand segments uploaded
     size_t furTriangles = 0;       ///< head triangles in generated-hair regions
     size_t generatedStrands = 0;   ///< strands grown by the geometry shader (camera pass)
-    bool shadowed = false;         ///< the shadowed light could be fitted
+    bool shadowed = false;         ///< at least one light is shadowed
+    int shadowedLights = 0;        ///< lights with a light grid this frame
     std::string renderer;          ///< GL_RENDERER
     /// With PreviewSettings::profile: (pass, wall ms, process CPU ms) in order.
     struct Pass {
@@ -182,8 +196,10 @@ class PreviewRenderer {
     /// Draws the last frame, sRGB-encoded, into the bound framebuffer's
     /// viewport (x, y, width, height) — the viewer's window.
     void present(int x, int y, int width, int height) const;
-    /// Reads the shadow grid of the last draw (empty when voxels were off).
-    VoxelSnapshot readVoxels() const;
+    /// Reads the shadow grid of the last draw of the `slot`-th shadowed light
+    /// (empty when voxels were off or there is no such light). `raw` is
+    /// filled for slot 0 only (the slots share one voxel grid, slot 0 last).
+    VoxelSnapshot readVoxels(int slot = 0) const;
     const PreviewStats& stats() const;
 
   private:

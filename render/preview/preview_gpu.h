@@ -14,8 +14,7 @@ namespace hp {
 struct FrameUniforms {
     float viewProj[16];
     float view[16];
-    float lightClip[16];
-    float lightView[16];
+    float lightView[16];  ///< the grid this pass voxelizes (light passes)
     float eye[4];
     float viewport[4];
     float gridMap[4];
@@ -38,18 +37,43 @@ struct FrameUniforms {
     float lobeShape[4][4];
     float lobeStrength[4 * kHairLobeNodes][4];
     float shadowColor[4];
+    float slotClip[kMaxShadowedLights][16];  ///< each shadowed light's grid (LightGrid), for shading
+    float slotView[kMaxShadowedLights][16];
+    float slotMap[kMaxShadowedLights][4];
+    float slotDepth[kMaxShadowedLights][4];
     int counts[4];
 };
 
 inline constexpr int kFlagVoxels = 1;
 inline constexpr int kFlagShadowMap = 2;
 inline constexpr int kFlagVoxelFilter = 4;
+/// Some light has no shadow slot: the fitted hair needs slot 0's column for it.
+inline constexpr int kFlagUnshadowedLights = 8;
 /// FrameUniforms::counts[3], the hair model (kHair* in shaders/common.glsl).
 inline constexpr int kHairKajiyaKay = 0;
 inline constexpr int kHairKajiyaKayTwoLobes = 1;
 inline constexpr int kHairFitted = 2;
 /// Fixed point of the r32ui voxel grid (kVoxelUnit in shaders/common.glsl).
 inline constexpr float kVoxelUnit = 4096.f;
+
+/// What fillFrameUniforms needs besides the uniform block.
+struct UniformInputs {
+    const View& view;
+    const PreviewSettings& settings;
+    const PreviewFrame& frame;
+    float blendReference = 0.f;            ///< reference depth of the blend weights (m)
+    int supersample = 1;
+    const std::vector<ShadowSlot>& slots;  ///< the shadowed lights, slot k = slots[k]
+    const int* resolutions = nullptr;      ///< voxel resolution of each slot
+    bool voxels = false, shadowMap = false;
+};
+
+/// The camera pass's uniforms: camera, lights (lightRad[i].w = light i's
+/// shadow slot, -1 none), materials, each slot's grid, counts and flags.
+void fillFrameUniforms(FrameUniforms& u, const UniformInputs& in);
+/// Points the pass fields (viewProj, lightView, gridMap, gridDepth,
+/// viewport) at one slot's grid, for its shadow map and voxelization.
+void setPassGrid(FrameUniforms& u, const LightGrid& grid, int resolution);
 
 /// A buffer mapped once for writing and kept mapped (GL 4.4 persistent,
 /// coherent mapping): per-frame uploads are a memcpy, and the storage is only
@@ -133,16 +157,25 @@ struct RenderTargets {
     void destroy();
 };
 
-/// Shadow resources: the head's shadow map, the r32ui voxel grid, the summed
-/// R32F grid the shading samples, and an attachment-less framebuffer for
-/// voxelization.
+static_assert(kMaxShadowedLights == 4, "ShadowTargets::ensure/destroy and shaders/common.glsl spell out 4 slots");
+
+/// Shadow resources of up to kMaxShadowedLights lights (slots): the head's
+/// shadow maps (one layer each of a depth array texture), one r32ui voxel
+/// grid that every slot's voxelization reuses in turn (its largest
+/// resolution), the summed R32F grid of each slot that the shading samples,
+/// and an attachment-less framebuffer for voxelization.
 struct ShadowTargets {
-    int mapSize = 0, resolution = 0;
-    unsigned mapFbo = 0, map = 0;
-    unsigned voxelFbo = 0, voxels = 0, density = 0;
+    int mapSize = 0, mapLayers = 0, voxelResolution = 0;
+    unsigned map = 0;
+    unsigned mapFbo[kMaxShadowedLights] = {};
+    unsigned voxelFbo = 0, voxels = 0;
+    unsigned density[kMaxShadowedLights] = {};
+    int resolution[kMaxShadowedLights] = {};  ///< of density[k]
     unsigned dummyDensity = 0, dummyMap = 0;  ///< bound when a shadow kind is off
 
-    void ensure(int mapSize, int resolution);
+    /// Makes `slots` shadow-map layers of mapSize² and a density grid of
+    /// resolutions[k]³ per slot.
+    void ensure(int mapSize, int slots, const int* resolutions);
     void destroy();
 };
 

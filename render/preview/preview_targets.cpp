@@ -6,6 +6,8 @@
 
 #include <epoxy/gl.h>
 
+#include <algorithm>
+
 namespace hp {
 
 namespace {
@@ -82,60 +84,74 @@ void RenderTargets::destroy() {
     width = height = samples = supersample = 0;
 }
 
-void ShadowTargets::ensure(int size, int res) {
+void ShadowTargets::ensure(int size, int slots, const int* resolutions) {
     if (!dummyDensity) {
         // Bound when a shadow kind is off, so every sampler always sees a complete texture.
         const float zero = 0.f, one = 1.f;
         glCreateTextures(GL_TEXTURE_3D, 1, &dummyDensity);
         glTextureStorage3D(dummyDensity, 1, GL_R32F, 1, 1, 1);
         glTextureSubImage3D(dummyDensity, 0, 0, 0, 0, 1, 1, 1, GL_RED, GL_FLOAT, &zero);
-        glCreateTextures(GL_TEXTURE_2D, 1, &dummyMap);
-        glTextureStorage2D(dummyMap, 1, GL_DEPTH_COMPONENT32F, 1, 1);
-        glTextureSubImage2D(dummyMap, 0, 0, 0, 1, 1, GL_DEPTH_COMPONENT, GL_FLOAT, &one);
+        glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &dummyMap);
+        glTextureStorage3D(dummyMap, 1, GL_DEPTH_COMPONENT32F, 1, 1, 1);
+        glTextureSubImage3D(dummyMap, 0, 0, 0, 0, 1, 1, 1, GL_DEPTH_COMPONENT, GL_FLOAT, &one);
         glTextureParameteri(dummyMap, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
     }
-    if (size != mapSize) {
-        deleteFramebuffers({&mapFbo});
+    slots = std::clamp(slots, 1, kMaxShadowedLights);
+    if (size != mapSize || slots > mapLayers) {
+        deleteFramebuffers({&mapFbo[0], &mapFbo[1], &mapFbo[2], &mapFbo[3]});
         deleteTextures({&map});
         mapSize = size;
-        glCreateTextures(GL_TEXTURE_2D, 1, &map);
-        glTextureStorage2D(map, 1, GL_DEPTH_COMPONENT32F, size, size);
+        mapLayers = slots;
+        glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &map);
+        glTextureStorage3D(map, 1, GL_DEPTH_COMPONENT32F, size, size, slots);
         glTextureParameteri(map, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
         glTextureParameteri(map, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
         glTextureParameteri(map, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
         glTextureParameteri(map, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
         glTextureParameteri(map, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
         glTextureParameteri(map, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
-        glCreateFramebuffers(1, &mapFbo);
-        glNamedFramebufferTexture(mapFbo, GL_DEPTH_ATTACHMENT, map, 0);
-        glNamedFramebufferDrawBuffer(mapFbo, GL_NONE);
-        checkComplete(mapFbo, "shadow map");
+        for (int k = 0; k < slots; ++k) {
+            glCreateFramebuffers(1, &mapFbo[k]);
+            glNamedFramebufferTextureLayer(mapFbo[k], GL_DEPTH_ATTACHMENT, map, 0, k);
+            glNamedFramebufferDrawBuffer(mapFbo[k], GL_NONE);
+            checkComplete(mapFbo[k], "shadow map");
+        }
     }
-    if (res != resolution) {
+    int largest = 0;
+    for (int k = 0; k < slots; ++k) largest = std::max(largest, resolutions[k]);
+    if (largest > voxelResolution) {
         deleteFramebuffers({&voxelFbo});
-        deleteTextures({&voxels, &density});
-        resolution = res;
+        deleteTextures({&voxels});
+        voxelResolution = largest;
         glCreateTextures(GL_TEXTURE_3D, 1, &voxels);
-        glTextureStorage3D(voxels, 1, GL_R32UI, res, res, res);
-        glCreateTextures(GL_TEXTURE_3D, 1, &density);
-        glTextureStorage3D(density, 1, GL_R32F, res, res, res);
-        glTextureParameteri(density, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTextureParameteri(density, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
-            glTextureParameteri(density, wrap, GL_CLAMP_TO_EDGE);
+        glTextureStorage3D(voxels, 1, GL_R32UI, largest, largest, largest);
         // Voxelization writes through image atomics only: a framebuffer with
-        // no attachments gives the rasterizer its res x res viewport.
+        // no attachments gives the rasterizer its viewport (each slot's
+        // resolution, at most this).
         glCreateFramebuffers(1, &voxelFbo);
-        glNamedFramebufferParameteri(voxelFbo, GL_FRAMEBUFFER_DEFAULT_WIDTH, res);
-        glNamedFramebufferParameteri(voxelFbo, GL_FRAMEBUFFER_DEFAULT_HEIGHT, res);
+        glNamedFramebufferParameteri(voxelFbo, GL_FRAMEBUFFER_DEFAULT_WIDTH, largest);
+        glNamedFramebufferParameteri(voxelFbo, GL_FRAMEBUFFER_DEFAULT_HEIGHT, largest);
         checkComplete(voxelFbo, "voxelization");
+    }
+    for (int k = 0; k < slots; ++k) {
+        const int res = resolutions[k];
+        if (res == resolution[k] && density[k]) continue;
+        deleteTextures({&density[k]});
+        resolution[k] = res;
+        glCreateTextures(GL_TEXTURE_3D, 1, &density[k]);
+        glTextureStorage3D(density[k], 1, GL_R32F, res, res, res);
+        glTextureParameteri(density[k], GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTextureParameteri(density[k], GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
+            glTextureParameteri(density[k], wrap, GL_CLAMP_TO_EDGE);
     }
 }
 
 void ShadowTargets::destroy() {
-    deleteFramebuffers({&mapFbo, &voxelFbo});
-    deleteTextures({&map, &voxels, &density, &dummyDensity, &dummyMap});
-    mapSize = resolution = 0;
+    deleteFramebuffers({&mapFbo[0], &mapFbo[1], &mapFbo[2], &mapFbo[3], &voxelFbo});
+    deleteTextures({&map, &voxels, &density[0], &density[1], &density[2], &density[3], &dummyDensity, &dummyMap});
+    mapSize = mapLayers = voxelResolution = 0;
+    for (int& r : resolution) r = 0;
 }
 
 }  // namespace hp

@@ -83,8 +83,23 @@ std::vector<Light> threePointRig() {
         return l;
     };
     return {light({0.85f, -0.5f, -0.3f}, {1.f, 0.95f, 0.88f}, 1.6f, true),
-            light({-0.8f, -0.1f, -0.55f}, {0.85f, 0.9f, 1.f}, 0.25f, false),
-            light({-0.25f, -0.6f, 0.8f}, {1.f, 1.f, 1.f}, 1.f, false)};
+            light({-0.8f, -0.1f, -0.55f}, {0.85f, 0.9f, 1.f}, 0.25f, true),
+            light({-0.25f, -0.6f, 0.8f}, {1.f, 1.f, 1.f}, 1.f, true)};
+}
+
+std::vector<int> limitShadowedLights(std::vector<Light>& lights, int maxLights) {
+    std::vector<int> cleared;
+    int kept = 0;
+    for (size_t i = 0; i < lights.size(); ++i) {
+        if (!lights[i].castsShadows) continue;
+        if (kept < maxLights) {
+            ++kept;
+            continue;
+        }
+        lights[i].castsShadows = false;
+        cleared.push_back(int(i));
+    }
+    return cleared;
 }
 
 Vec3f skinShade(const SurfaceMaterial& m, const Vec3f& n, const Vec3f& l, const Vec3f& v) {

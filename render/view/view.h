@@ -84,10 +84,13 @@ struct Light {
     /// Quad: the edge of height size.y() lies in the plane of `up` and the
     /// normal (its width is horizontal for up = +y).
     Vec3f up{0.f, 1.f, 0.f};
-    /// Whether the light is blocked by hair and head. The preview shadows one
-    /// light (PreviewShadowSettings::light); the rig's fill and rim lights are
-    /// unshadowed in the preview and the Kajiya-Kay reference, so the two stay
-    /// the same picture. The physical reference shadows every light unless
+    /// Whether the light is blocked by hair and head in the preview and the
+    /// Kajiya-Kay reference. The preview shadows the first
+    /// PreviewShadowSettings::maxLights (at most 4) such lights, each with its
+    /// own voxel grid and head shadow map; limitShadowedLights() clears the
+    /// flag of the lights past that cap, so the Kajiya-Kay reference shadows
+    /// exactly the lights the preview does. The default rig shadows all three
+    /// of its lights. The physical reference shadows every light unless
     /// ReferenceSettings::unshadowedLights says otherwise.
     bool castsShadows = true;
     /// Direction, up and position are given in the camera's frame (x right, y
@@ -240,10 +243,15 @@ struct View {
 };
 
 /// The default three-point rig (camera-relative, so it follows the camera):
-/// a warm key from the upper left in front (the one shadowed light), a cool,
-/// weak fill from the right and a rim light from behind and above. The
-/// scene's default render.lights spells the same rig out.
+/// a warm key from the upper left in front, a cool, weak fill from the right
+/// and a rim light from behind and above, all three shadowed. The scene's
+/// default render.lights spells the same rig out.
 std::vector<Light> threePointRig();
+
+/// Keeps castsShadows on the first `maxLights` lights that have it and
+/// clears it on the rest (the preview's cap, PreviewShadowSettings::maxLights);
+/// returns the indices of the lights it cleared.
+std::vector<int> limitShadowedLights(std::vector<Light>& lights, int maxLights);
 
 /// Reflected radiance factor of Kajiya-Kay for tangent `t`, normal `n` (the
 /// shading normal used only to shift tangents), unit direction to the light

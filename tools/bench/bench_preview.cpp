@@ -8,9 +8,15 @@
 //
 //   bench_preview [--strands 10000,100000] [--frames 3] [--warmup 1]
 //                 [--profile] [--png out.png] [--shading kajiya-kay|fitted]
+//                 [--lights one|rig] [--other-resolution N]
 // --shading fitted shades with the hair material fitted to the physical
 // fibre (render/reference/hair_fit.h, melanin 1.3) and dual scattering; the
 // default keeps the plain Kajiya-Kay material the benchmark always had.
+// --lights rig replaces B-render's one light by the default three-point rig
+// (render/view/view.h threePointRig, camera-relative): the preview then
+// shadows each of its lights that casts shadows (each costs a voxelization,
+// a sum and a shadow map); --other-resolution sets the voxel resolution of
+// the shadowed lights after the first (PreviewShadowSettings::otherResolution).
 // Per strand count: median, min and max of the timed frames (draw + glFinish,
 // wall and process CPU time, llvmpipe's threads included), readback time,
 // peak resident memory; --profile adds a per-pass breakdown of one extra frame.
@@ -54,7 +60,8 @@ int main(int argc, char** argv) {
     std::vector<size_t> counts = {10000, 100000};
     int frames = 3, warmup = 1;
     bool profile = false;
-    bool fitted = false;
+    bool fitted = false, rig = false;
+    int otherResolution = -1;
     std::string png;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -71,10 +78,14 @@ int main(int argc, char** argv) {
             profile = true;
         } else if (a == "--shading" && more) {
             fitted = std::string(argv[++i]) == "fitted";
+        } else if (a == "--lights" && more) {
+            rig = std::string(argv[++i]) == "rig";
+        } else if (a == "--other-resolution" && more) {
+            otherResolution = std::atoi(argv[++i]);
         } else if (a == "--png" && more) {
             png = argv[++i];
         } else {
-            std::cerr << "usage: bench_preview [--strands N,M] [--frames N] [--warmup N] [--profile] [--png FILE] [--shading kajiya-kay|fitted]\n";
+            std::cerr << "usage: bench_preview [--strands N,M] [--frames N] [--warmup N] [--profile] [--png FILE] [--shading kajiya-kay|fitted] [--lights one|rig] [--other-resolution N]\n";
             return 1;
         }
     }
@@ -82,10 +93,15 @@ int main(int argc, char** argv) {
         auto context = GlContext::createHeadless();
         View view = bench::bRenderView(1920, 1080);
         if (fitted) fitHairMaterial(HairFiberParams{}, &view.hair);
+        if (rig) view.lights = threePointRig();
         PreviewSettings settings;  // 4x MSAA, voxels (additive, nearest, 256^3) + 2048^2 PCF shadow map
+        if (otherResolution >= 0) settings.shadow.otherResolution = otherResolution;
         const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 32, 64);
         std::printf("bench_preview: %s\n", context->description().c_str());
         std::printf("hair shading: %s\n", fitted ? "fitted (dual scattering)" : "kajiya-kay");
+        int shadowing = 0;
+        for (const Light& l : view.lights) shadowing += l.castsShadows;
+        std::printf("lights: %s, %d with shadows\n", rig ? "three-point rig" : "one directional", shadowing);
         std::printf("B-render preview, 1920x1080, 4x MSAA, voxel shadows %d^3 + shadow map %d^2, tessellation "
                     "%.0f px pieces, %d timed frames after %d warm-up\n",
                     settings.shadow.resolution, settings.shadow.shadowMapSize, settings.tessellationPixels, frames,
