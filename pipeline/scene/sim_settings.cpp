@@ -8,6 +8,7 @@ namespace hp {
 GuideSettings guideSettings(const Scene& scene) {
     GuideSettings s;
     s.formulation = parseFormulation(scene.text("simulation.formulation"));
+    s.rodIntegrator = parseRodIntegrator(scene.text("simulation.rod_integrator"));
     readKeys(scene, s, {
         {"hair.guides.segments", &GuideSettings::segments},
         {"hair.guides.length", &GuideSettings::length},

@@ -117,6 +117,10 @@ class GuideGroup {
     /// Vertices pinned in the last substeps (no place outside the head at
     /// their length), then cleared. Only the rod formulation pins.
     virtual size_t takePinned() { return 0; }
+    /// State a group keeps beside set.x / set.v (the rod's BDF2 history),
+    /// appended to and read back from a checkpoint; none by default.
+    virtual void save(BlobWriter&) const {}
+    virtual void restore(BlobReader&) {}
 
     size_t begin() const { return begin_; }
     size_t end() const { return end_; }

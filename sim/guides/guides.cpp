@@ -30,6 +30,14 @@ GuideFormulation parseFormulation(const std::string& name) {
     throw Error(cat("unknown guide formulation '", name, "' (choices: rod, rope, rigid)"));
 }
 
+const char* rodIntegratorName(RodIntegrator i) { return i == RodIntegrator::Euler ? "euler" : "bdf2"; }
+
+RodIntegrator parseRodIntegrator(const std::string& name) {
+    if (name == "bdf2") return RodIntegrator::Bdf2;
+    if (name == "euler") return RodIntegrator::Euler;
+    throw Error(cat("unknown rod integrator '", name, "' (choices: bdf2, euler)"));
+}
+
 double GuideSettings::guideMassPerLength() const {
     return formulation == GuideFormulation::Rod ? guides::rodMassPerLength(*this) : double(massPerLength);
 }
@@ -363,6 +371,7 @@ std::vector<char> GuideSolver::saveState() const {
     m.skeleton.saveClock(w);
     w.put(set.headTransform.matrix());
     set.save(w);
+    for (const auto& grp : m.groups) grp->save(w);
     return std::move(w.data);
 }
 
@@ -376,6 +385,7 @@ void GuideSolver::restoreState(const std::vector<char>& state) {
     m.skeleton.restoreClock(r);
     set.headTransform.matrix() = r.get<Eigen::Matrix4f>();
     set.restore(r);
+    for (auto& grp : m.groups) grp->restore(r);
     r.finish();
     // The Bullet nodes of every world reload x and v before the next step:
     // a rope node's whole state is its position and velocity.

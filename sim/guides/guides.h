@@ -50,6 +50,15 @@ namespace hp {
 
 enum class GuideFormulation { Rope, Rigid, Rod };
 
+/// The rod's time integrator (sim/guides/rod_kernels.h): `Bdf2`, the
+/// second-order backward differentiation formula (default: keeps a swing's
+/// energy, damps what the step cannot resolve), or `Euler`, implicit Euler
+/// (first order: damps every motion by ~π·ω·h per period).
+enum class RodIntegrator { Euler, Bdf2 };
+/// "euler" / "bdf2", and back (throws hp::Error naming the choices).
+const char* rodIntegratorName(RodIntegrator i);
+RodIntegrator parseRodIntegrator(const std::string& name);
+
 /// "rope" / "rigid" / "rod".
 const char* formulationName(GuideFormulation f);
 /// Inverse of formulationName; throws hp::Error naming the valid choices.
@@ -82,6 +91,7 @@ struct GuideSettings : StepSettings {
     /// out of the rod's motion: only the energies reported scale with it.
     float hairsPerGuide = 100.f;
     int rodSubsteps = 2;            ///< rod: XPBD steps per solver substep
+    RodIntegrator rodIntegrator = RodIntegrator::Bdf2;  ///< rod: the time integrator
     int preloadProbes = 3;          ///< rod: probe steps refining the pre-load (rod::preload)
     float bendDamping = 0.f;        ///< rigid only: joint spring damping, N·m·s/rad
     float damping = 1.0f;           ///< velocity decay rate, 1/s: v *= exp(-damping·t), any step size (rod: air drag)

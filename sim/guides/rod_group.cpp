@@ -56,16 +56,47 @@ class RodGroup final : public GuideGroup {
             invMass_[k] = m > 0.f ? 1.f / m : 0.f;
         }
         for (size_t g = begin; g < end; ++g) computeCurvature(g, 0.f);
+        if (bdf2()) {
+            xBack_.assign(invMass_.size(), Vec3f::Zero());  // defined bytes for a checkpoint before the first step
+            vBack_.assign(invMass_.size(), Vec3f::Zero());
+        }
     }
 
+    void reset() override {
+        GuideGroup::reset();
+        restart_ = true;  // after the solver has placed the reset guides outside the head
+    }
+    void save(BlobWriter& w) const override {
+        w.put(restart_);
+        w.array(xBack_);
+        w.array(vBack_);
+    }
+    void restore(BlobReader& r) override {
+        restart_ = r.get<bool>();
+        r.array(xBack_, xBack_.size());
+        r.array(vBack_, vBack_.size());
+    }
     void preload(const SubstepContext& ctx) override {
-        const float h = ctx.h / float(std::max(1, set_.settings.rodSubsteps));
+        // From rest a BDF2 step is the implicit Euler step of h' (rod::bdf2Step).
+        float h = ctx.h / float(std::max(1, set_.settings.rodSubsteps));
+        if (bdf2()) h = rod::bdf2Step(h);
         for (size_t g = begin_; g < end_; ++g) computeCurvature(g, set_.settings.preload ? h : 0.f);
     }
     void substep(const SubstepContext& ctx) override;
     size_t takePinned() override { return std::exchange(pinned_, size_t(0)); }
 
   private:
+    bool bdf2() const { return set_.settings.rodIntegrator == RodIntegrator::Bdf2; }
+    /// BDF2's history for the group's guides as they are now, as if they had
+    /// moved at their present velocities (rod::bdf2Start).
+    void restartHistory() {
+        restart_ = false;
+        if (!bdf2()) return;
+        const float h = set_.settings.timeStep / float(std::max(1, set_.settings.substeps)) /
+                        float(std::max(1, set_.settings.rodSubsteps));
+        const size_t first = set_.vertex(begin_, 0);
+        rod::bdf2Start(&set_.x[first], &set_.v[first], int(xBack_.size()), h, xBack_.data(), vBack_.data());
+    }
     rod::RodStrand strand(size_t g) const {
         rod::RodStrand s;
         s.vertices = set_.vertices;
@@ -93,6 +124,8 @@ class RodGroup final : public GuideGroup {
     const double bendStiffness_;  ///< EI of the settings' material (the same for every guide)
     std::vector<float> invMass_;
     std::vector<rod::Vec2f> curvature_;
+    std::vector<Vec3f> xBack_, vBack_;  ///< BDF2's history x_{n-1}, v_{n-1} per vertex (empty for Euler)
+    bool restart_ = true;               ///< the history starts afresh at the next substep (a start, a reset)
     rod::RodScratch scratch_;
     size_t pinned_ = 0;
 };
@@ -105,6 +138,7 @@ void RodGroup::substep(const SubstepContext& ctx) {
     const int k = std::max(1, s.rodSubsteps);
     const float h = ctx.h / float(k);
     const float alpha0 = ctx.alpha - ctx.h / s.timeStep;
+    if (restart_) restartHistory();
     // Guides in batches of rod::kLanes (their banded solves share SIMD
     // lanes; each guide's result is that of a lone step).
     for (size_t g0 = begin_; g0 < end_; g0 += rod::kLanes) {
@@ -117,6 +151,10 @@ void RodGroup::substep(const SubstepContext& ctx) {
             targets[l].strand = &strands[l];
             targets[l].x = &set_.x[set_.vertex(g, 0)];
             targets[l].v = &set_.v[set_.vertex(g, 0)];
+            if (bdf2()) {
+                targets[l].xBack = &xBack_[(g - begin_) * size_t(set_.vertices)];
+                targets[l].vBack = &vBack_[(g - begin_) * size_t(set_.vertices)];
+            }
         }
         for (int i = 0; i < k; ++i) {
             const float a = alpha0 + (ctx.alpha - alpha0) * float(i + 1) / float(k);

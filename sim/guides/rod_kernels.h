@@ -72,6 +72,7 @@ constexpr int kLanes = 4;
 /// (sim/guides/rod_step.cpp): entry k holds the four lanes' values.
 struct RodScratch {
     std::vector<lanes::V3<lanes::F4>> y;     ///< positions, per vertex
+    std::vector<lanes::V3<lanes::F4>> start; ///< x̄, per vertex: where the step starts (x, or BDF2's extrapolation)
     std::vector<lanes::V3<lanes::F4>> grad;  ///< constraint gradients, per row × 3 vertices
     std::vector<lanes::V3<lanes::F4>> dir;   ///< stretch pass: segment directions
     std::vector<lanes::F4> w, rest, cosine;  ///< inverse masses, rest lengths, d_j·d_{j+1}
@@ -87,7 +88,36 @@ struct RodStepTarget {
     Vec3f* v = nullptr;                      ///< velocities, likewise
     Vec3f rootPos = Vec3f::Zero();           ///< root position at the step's end
     Mat3f rootFrame = Mat3f::Identity();     ///< root frame at the step's end
+    /// BDF2's history (rodSteps): positions and velocities at the previous
+    /// step's start, x_{n-1} and v_{n-1}; they receive x_n and v_n. Null:
+    /// the first-order step (implicit Euler). Every strand of a batch has
+    /// history or none does.
+    Vec3f* xBack = nullptr;
+    Vec3f* vBack = nullptr;
 };
+
+/// The step BDF2 takes from the history (x_{n-1}, v_{n-1}) and the state
+/// (x_n, v_n): the second-order backward differentiation formula
+///   x_{n+1} - 4/3 x_n + 1/3 x_{n-1} = 2/3 h v_{n+1}
+///   v_{n+1} - 4/3 v_n + 1/3 v_{n-1} = 2/3 h a(x_{n+1})
+/// is, with x̄ = (4x_n - x_{n-1})/3, v̄ = (4v_n - v_{n-1})/3 and h' = 2h/3,
+///   x_{n+1} = x̄ + h'·v̄ + h'²·a(x_{n+1}),   v_{n+1} = (x_{n+1} - x̄)/h',
+/// an implicit Euler step of length h' from (x̄, v̄): the XPBD step below
+/// with x̄, v̄, h' in place of x, v, h. From rest (x_{n-1} = x_n, v = 0) it
+/// is exactly the implicit Euler step of h'. Returns h'.
+inline float bdf2Step(float h) { return 2.f * h / 3.f; }
+inline Vec3f bdf2Extrapolate(const Vec3f& now, const Vec3f& back) { return (4.f * now - back) / 3.f; }
+
+/// History of a strand that moved at constant velocity v (x_{n-1} = x - h·v,
+/// v_{n-1} = v; at rest, x_{n-1} = x): then x̄ = x + h·v/3 and v̄ = v, so
+/// x̄ + h'·v̄ = x + h·v, the displacement of the step h, and a start or a
+/// restart (scene cut, reset) needs no separate first-order step.
+inline void bdf2Start(const Vec3f* x, const Vec3f* v, int n, float h, Vec3f* xBack, Vec3f* vBack) {
+    for (int i = 0; i < n; ++i) {
+        xBack[i] = x[i] - h * v[i];
+        vBack[i] = v[i];
+    }
+}
 
 /// The bending constraint of joint j, in the parent's transported frame
 /// (a_j, b_j = d_{j-1} × a_j, both ⊥ d_{j-1}):
