@@ -28,6 +28,7 @@ inline GuideSettings rodSettings(float youngs, float drag, bool preload) {
     s.preload = preload;
     s.headCollision = false;
     s.maxSpeed = 0.f;
+    s.tipRadius = s.rootRadius;  // a uniform fibre: the references below assume one
     return s;
 }
 
@@ -36,6 +37,7 @@ inline rod::Material material(const GuideSettings& s) {
     rod::Material m;
     m.youngs = s.youngsModulus;
     m.radius = s.rootRadius;
+    m.tipRadius = s.tipRadius;
     m.hairsPerGuide = s.hairsPerGuide;
     m.density = s.density;
     return m;
@@ -157,6 +159,29 @@ inline Cantilever cantilever(double beta, int threads, int segments = 23) {
     c.kineticEnergy = strand.solver.lastStats().kineticEnergy;
     c.positions = f.positions;
     return c;
+}
+
+/// Small-load tip deflection of a horizontally clamped tapered strand
+/// (linear beam theory): with w(s) = μ(s)·g its weight per length,
+///   V(s) = ∫_s^L w,   M(s) = ∫_s^L V,   δ = ∫_0^L M(s)/EI(s)·(L - s) ds
+/// (the moment-area theorem), by the trapezoid rule on `n` intervals.
+inline double taperedTipDeflection(const rod::Material& m, double L, int n = 20000) {
+    const double ds = L / n;
+    std::vector<double> w(size_t(n) + 1), V(size_t(n) + 1, 0.0), M(size_t(n) + 1, 0.0);
+    for (int i = 0; i <= n; ++i) {
+        const double r = m.radiusAt(double(i) / n);
+        w[size_t(i)] = double(m.hairsPerGuide) * m.density * M_PI * r * r * kG;
+    }
+    for (int i = n - 1; i >= 0; --i) {
+        V[size_t(i)] = V[size_t(i) + 1] + 0.5 * ds * (w[size_t(i)] + w[size_t(i) + 1]);
+        M[size_t(i)] = M[size_t(i) + 1] + 0.5 * ds * (V[size_t(i)] + V[size_t(i) + 1]);
+    }
+    double delta = 0;
+    for (int i = 0; i < n; ++i) {
+        auto f = [&](int k) { return M[size_t(k)] / m.bendStiffnessAt(double(k) / n) * (L - k * ds); };
+        delta += 0.5 * ds * (f(i) + f(i + 1));
+    }
+    return delta;
 }
 
 struct Pendulum {

@@ -141,6 +141,7 @@ TEST(Guides, StrandUnderGravitySettlesIntoTheHeavyElastica) {
     GuideSettings s;  // the default formulation and material
     ASSERT_EQ(s.formulation, GuideFormulation::Rod);
     s.preload = false;
+    s.tipRadius = s.rootRadius;  // a uniform fibre, as the elastica assumes
     GuideSolver solver(s);
     SurfaceFrame root;
     root.position = Vec3f(0.1f, 0, 0);

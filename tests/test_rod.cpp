@@ -44,6 +44,35 @@ TEST(Rod, HeavyElasticaTipMatchesShootingToTheChainsDiscretisation) {
     }
 }
 
+TEST(Rod, TaperedCantileverSagsAsItsDrawnFibre) {
+    // The fibre that bends is the one drawn: 60 µm at the root tapering to
+    // 20 µm at the tip (the default scene's hair.radius), so EI falls 81×
+    // and μ 9× toward the tip. Clamped horizontally under a small load, its
+    // tip sags by the moment-area integral δ = ∫ M(s)/EI(s)·(L - s) ds
+    // (taperedTipDeflection); E is chosen for δ = 0.5% of L, where linear
+    // theory holds to (δ/L)². A fibre of the root's section all along (the
+    // model before the taper) would sag 1.8× as much, its heavier tip
+    // outweighing its stiffer one (`uniform_over_tapered`).
+    GuideSettings s = rodSettings(1.f, 4.f, false);
+    s.rootRadius = 6e-5f;
+    s.tipRadius = 2e-5f;
+    const double perPascal = taperedTipDeflection(material(s), kLength);  // δ at E = 1 Pa
+    s.youngsModulus = float(perPascal / (0.005 * kLength));
+    const double expected = taperedTipDeflection(material(s), kLength);
+    rod::Material uniform = material(s);
+    uniform.tipRadius = uniform.radius;
+    RecordProperty("uniform_over_tapered_e3", int(1000 * taperedTipDeflection(uniform, kLength) / expected));
+    Strand strand(s, straight(Vec3f::UnitX(), s.segments));
+    strand.run(6.0);
+    const StrandFrame f = strand.frame();
+    const double sag = -double(f.positions.back().y());
+    RecordProperty("tapered_sag_error_e6", int(1e6 * std::abs(sag / expected - 1)));
+    // The 23-segment chain's error is of the order (l/L)² = 1.9e-3 (as for
+    // the elastica above); bound 1%.
+    EXPECT_NEAR(sag, expected, 0.01 * expected) << "sag " << sag * 1e3 << " mm, beam theory " << expected * 1e3 << " mm";
+    EXPECT_LT(strand.solver.lastStats().kineticEnergy, 1e-12) << "not at rest";
+}
+
 TEST(Rod, HangingChainFirstModePeriodMatchesBessel) {
     const Pendulum p = pendulum();
     RecordProperty("pendulum_period_error", std::to_string(p.error));

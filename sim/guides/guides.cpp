@@ -199,10 +199,18 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
                 set.groomDir[set.segment(g, j)] = e / len;
             }
         }
-        // Lumped masses: each vertex carries half of its two segments.
+        // Lumped masses: each vertex carries half of its two segments. The
+        // rod's fibre tapers (hair.radius.root → tip), so its segments' masses
+        // do too; rope and rigid take a uniform mass per length.
         const float mu = float(s.guideMassPerLength());
+        double guideLength = 0, arc = 0;
+        for (int j = 0; j < set.segments; ++j) guideLength += set.restLength[set.segment(g, j)];
         for (int j = 0; j < set.segments; ++j) {
-            const float half = 0.5f * mu * set.restLength[set.segment(g, j)];
+            const float l = set.restLength[set.segment(g, j)];
+            const float half = s.formulation == GuideFormulation::Rod
+                                   ? float(0.5 * guides::rodSegmentMass(s, arc / guideLength, (arc + l) / guideLength, l))
+                                   : 0.5f * mu * l;
+            arc += l;
             if (j > 0) set.mass[set.vertex(g, j)] += half;
             set.mass[set.vertex(g, j + 1)] += half;
         }

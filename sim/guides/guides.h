@@ -9,8 +9,8 @@
 // interface; what Bullet computes differs in each (sim/guides/guide_group.h):
 //
 // - `Rod` (default): each guide is an inextensible elastic rod with physical
-//   parameters (E, ρ, fibre radius, hairs per guide), advanced by XPBD
-//   with a direct banded solve per strand (sim/guides/rod_kernels.h,
+//   parameters (E, ρ, the drawn tapered fibre, hairs per guide), advanced by XPBD
+//   in BDF2 steps with a direct banded solve per strand (sim/guides/rod_kernels.h,
 //   sim/guides/rod_group.cpp). Bullet integrates nothing here: it only finds
 //   strand-strand contact pairs and their closest points (broadphase and
 //   capsule narrowphase, sim/guides/strand_contacts.cpp) when
@@ -82,7 +82,8 @@ struct GuideSettings : StepSettings {
     // Material.
     float massPerLength = 0.005f;   ///< rope, rigid: kg/m (a guide stands for a clump of hairs)
     float bendStiffness = 5e-5f;    ///< rope, rigid: joint spring toward the rest pose, N·m/rad
-    // Rod material (SI): μ = N·ρ·πr², EI = N·E·πr⁴/4, r = rootRadius (sim/guides/rod_kernels.h).
+    // Rod material (SI): μ = N·ρ·πr², EI = N·E·πr⁴/4, r the drawn fibre's radius tapering
+    // from rootRadius to tipRadius (sim/guides/rod_kernels.h Material).
     // No shear modulus: the rod carries no twist (sim/guides/rod_group.cpp).
     float youngsModulus = 3.8e9f;   ///< rod: E, Pa
     float density = 1300.f;         ///< rod: ρ, kg/m³
@@ -121,7 +122,7 @@ struct GuideSettings : StepSettings {
     /// Throws hp::Error naming the first setting out of range.
     void validate() const;
     /// A guide's mass per length as its formulation has it, kg/m: rod
-    /// N·ρ·πr² (hair.material), rope and rigid massPerLength.
+    /// N·ρ·πr² (hair.material) averaged over the taper, rope and rigid massPerLength.
     double guideMassPerLength() const;
 };
 

@@ -6,9 +6,11 @@
 // the rope.
 //
 // Parameters (GuideSettings → rod::Material): mass per length μ and bending
-// stiffness EI from E, ρ, the fibre radius (hair.radius.root; the render
-// taper is not physical here: a uniform fibre) and hairs_per_guide, which
+// stiffness EI from E, ρ, the fibre radius and hairs_per_guide, which
 // cancels out of the motion (μ and EI are both N times one hair's). The
+// fibre is the one drawn: its radius tapers from hair.radius.root to
+// hair.radius.tip (rod::Material), so EI_j is taken per joint and the
+// masses per segment. The
 // shear modulus is not read: with an isotropic section (EI the same about
 // both axes) and a free tip, the quasistatic twist moment is zero along the
 // rod (Bergou et al., "Discrete Elastic Rods", 2008, §4.2: the material
@@ -40,6 +42,7 @@ rod::Material materialOf(const GuideSettings& s) {
     m.youngs = s.youngsModulus;
     m.density = s.density;
     m.radius = s.rootRadius;
+    m.tipRadius = s.tipRadius;
     m.hairsPerGuide = s.hairsPerGuide;
     return m;
 }
@@ -54,6 +57,18 @@ class RodGroup final : public GuideGroup {
         for (size_t k = 0; k < invMass_.size(); ++k) {
             const float m = set.mass[set.vertex(begin, 0) + k];
             invMass_[k] = m > 0.f ? 1.f / m : 0.f;
+        }
+        // EI_j of the tapered fibre at joint j's vertex (arc-length fraction
+        // of the rest lengths); the masses taper alike (GuideSolver::initialize).
+        const rod::Material material = materialOf(set.settings);
+        jointStiffness_.resize(n * size_t(set.segments));
+        for (size_t g = begin; g < end; ++g) {
+            double length = 0, arc = 0;
+            for (int j = 0; j < set.segments; ++j) length += set.restLength[set.segment(g, j)];
+            for (int j = 0; j < set.segments; ++j) {
+                jointStiffness_[(g - begin) * size_t(set.segments) + size_t(j)] = material.bendStiffnessAt(arc / length);
+                arc += set.restLength[set.segment(g, j)];
+            }
         }
         for (size_t g = begin; g < end; ++g) computeCurvature(g, 0.f);
         if (bdf2()) {
@@ -105,6 +120,7 @@ class RodGroup final : public GuideGroup {
         s.restCurvature = &curvature_[(g - begin_) * size_t(set_.segments)];
         s.ghostDir = set_.groomDir[set_.segment(g, 0)];
         s.bendStiffness = bendStiffness_;
+        s.jointStiffness = &jointStiffness_[(g - begin_) * size_t(set_.segments)];
         return s;
     }
     /// Rest curvatures of guide g from its rest shape at the end-of-step
@@ -121,7 +137,8 @@ class RodGroup final : public GuideGroup {
             rod::preload(s, x.data(), R, set_.settings.gravity, preloadStep, set_.settings.preloadProbes, c, scratch_);
     }
 
-    const double bendStiffness_;  ///< EI of the settings' material (the same for every guide)
+    const double bendStiffness_;  ///< EI at the root (> 0: the guides bend)
+    std::vector<double> jointStiffness_;  ///< EI_j per joint of each guide (the taper)
     std::vector<float> invMass_;
     std::vector<rod::Vec2f> curvature_;
     std::vector<Vec3f> xBack_, vBack_;  ///< BDF2's history x_{n-1}, v_{n-1} per vertex (empty for Euler)
@@ -179,6 +196,10 @@ class RodFormulation final : public Formulation {
 
 std::unique_ptr<Formulation> makeRodFormulation() { return std::make_unique<RodFormulation>(); }
 
-double rodMassPerLength(const GuideSettings& s) { return materialOf(s).massPerLength(); }
+double rodMassPerLength(const GuideSettings& s) { return materialOf(s).meanMassPerLength(); }
+
+double rodSegmentMass(const GuideSettings& s, double t0, double t1, double length) {
+    return materialOf(s).segmentMass(t0, t1, length);
+}
 
 }  // namespace hp::guides

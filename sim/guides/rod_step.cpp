@@ -95,7 +95,7 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
     // Per-lane constants: masses, rest lengths, the start of the frame, α̃.
     V3 u, a;
     F4 bendLane{};  // nonzero where the strand bends (EI > 0)
-    D4 alphaScale{};
+    const double h2 = double(h) * h;
     for (int l = 0; l < kLanes; ++l) {
         const RodStepTarget& tl = t[src[l]];
         const RodStrand& s = *tl.strand;
@@ -105,7 +105,6 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
         setLane(u, l, ul);
         setLane(a, l, frameStart(tl.rootFrame, ul));
         bendLane[l] = s.bendStiffness > 0 ? 1.f : 0.f;
-        alphaScale[l] = s.bendStiffness * double(h) * h;
         // 1. Prediction y = x + h·v + h²·g; the root at its target.
         setLane(y[0], l, tl.rootPos);
         if (tl.xBack) {
@@ -130,14 +129,13 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
         for (int l = 0; l < kLanes; ++l) {
             const RodStrand& s = *t[src[l]].strand;
             rc[l] = &s.restCurvature[j];
-            alpha[l] = double(voronoiLength(s, j));
+            alpha[l] = double(voronoiLength(s, j)) / (stiffnessAt(s, j) * h2);  // α̃ = l̄_j/(EI_j h²)
         }
         const F4 c[2] = {F4{(*rc[0])[0], (*rc[1])[0], (*rc[2])[0], (*rc[3])[0]},
                          F4{(*rc[0])[1], (*rc[1])[1], (*rc[2])[1], (*rc[3])[1]}};
         F4 C[2];
         V3 g[2][3];
         lanes::bendRows(u, ulen, e, a, c, j == 0, C, g);
-        alpha /= alphaScale;  // α̃ = l̄/(EI h²)
         for (int k = 0; k < 2; ++k) {
             const int r = 3 * j + k;
             // A strand without bending stiffness has inert bend rows
