@@ -37,7 +37,7 @@ inline rod::Material material(const GuideSettings& s) {
     rod::Material m;
     m.youngs = s.youngsModulus;
     m.radius = s.rootRadius;
-    m.tipRadius = s.tipRadius;
+    m.tipRadius = s.taperedFibre ? s.tipRadius : s.rootRadius;
     m.hairsPerGuide = s.hairsPerGuide;
     m.density = s.density;
     return m;

@@ -54,6 +54,7 @@ TEST(Rod, TaperedCantileverSagsAsItsDrawnFibre) {
     // model before the taper) would sag 1.8× as much, its heavier tip
     // outweighing its stiffer one (`uniform_over_tapered`).
     GuideSettings s = rodSettings(1.f, 4.f, false);
+    s.taperedFibre = true;
     s.rootRadius = 6e-5f;
     s.tipRadius = 2e-5f;
     const double perPascal = taperedTipDeflection(material(s), kLength);  // δ at E = 1 Pa

@@ -28,6 +28,7 @@ GuideSettings guideSettings(const Scene& scene) {
         {"hair.material.density", &GuideSettings::density},
         {"hair.material.hairs_per_guide", &GuideSettings::hairsPerGuide},
         {"simulation.rod_substeps", &GuideSettings::rodSubsteps},
+        {"hair.material.tapered", &GuideSettings::taperedFibre},
         {"simulation.preload_probes", &GuideSettings::preloadProbes},
         {"simulation.preload", &GuideSettings::preload},
         {"simulation.head_collision", &GuideSettings::headCollision},

@@ -91,6 +91,10 @@ struct GuideSettings : StepSettings {
     /// scale with N, drag is a rate and contacts are positions, so N cancels
     /// out of the rod's motion: only the energies reported scale with it.
     float hairsPerGuide = 100.f;
+    /// rod: the fibre tapers as drawn (rootRadius → tipRadius: EI per joint,
+    /// mass per segment); false: the root's section all along. Off by
+    /// default: with it the default scene's settled groom stands up (docs/physics.md).
+    bool taperedFibre = false;
     int rodSubsteps = 2;            ///< rod: XPBD steps per solver substep
     RodIntegrator rodIntegrator = RodIntegrator::Bdf2;  ///< rod: the time integrator
     int preloadProbes = 3;          ///< rod: probe steps refining the pre-load (rod::preload)

@@ -42,7 +42,7 @@ rod::Material materialOf(const GuideSettings& s) {
     m.youngs = s.youngsModulus;
     m.density = s.density;
     m.radius = s.rootRadius;
-    m.tipRadius = s.tipRadius;
+    m.tipRadius = s.taperedFibre ? s.tipRadius : s.rootRadius;
     m.hairsPerGuide = s.hairsPerGuide;
     return m;
 }
