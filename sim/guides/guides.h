@@ -51,9 +51,9 @@ namespace hp {
 enum class GuideFormulation { Rope, Rigid, Rod };
 
 /// The rod's time integrator (sim/guides/rod_kernels.h): `Bdf2`, the
-/// second-order backward differentiation formula (default: keeps a swing's
-/// energy, damps what the step cannot resolve), or `Euler`, implicit Euler
-/// (first order: damps every motion by ~π·ω·h per period).
+/// second-order backward differentiation formula (keeps a swing's energy,
+/// damps what the step cannot resolve), or `Euler`, implicit Euler (the
+/// default; first order: damps every motion by ~π·ω·h per period).
 enum class RodIntegrator { Euler, Bdf2 };
 /// "euler" / "bdf2", and back (throws hp::Error naming the choices).
 const char* rodIntegratorName(RodIntegrator i);
@@ -96,7 +96,7 @@ struct GuideSettings : StepSettings {
     /// default: with it the default scene's settled groom stands up (docs/physics.md).
     bool taperedFibre = false;
     int rodSubsteps = 2;            ///< rod: XPBD steps per solver substep
-    RodIntegrator rodIntegrator = RodIntegrator::Bdf2;  ///< rod: the time integrator
+    RodIntegrator rodIntegrator = RodIntegrator::Euler;  ///< rod: the time integrator (docs/physics.md: why Euler stays the default)
     int preloadProbes = 3;          ///< rod: probe steps refining the pre-load (rod::preload)
     float bendDamping = 0.f;        ///< rigid only: joint spring damping, N·m·s/rad
     float damping = 1.0f;           ///< velocity decay rate, 1/s: v *= exp(-damping·t), any step size (rod: air drag)
