@@ -207,7 +207,7 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
         for (int j = 0; j < set.segments; ++j) guideLength += set.restLength[set.segment(g, j)];
         for (int j = 0; j < set.segments; ++j) {
             const float l = set.restLength[set.segment(g, j)];
-            const float half = s.formulation == GuideFormulation::Rod
+            const float half = s.formulation == GuideFormulation::Rod && s.taperedFibre
                                    ? float(0.5 * guides::rodSegmentMass(s, arc / guideLength, (arc + l) / guideLength, l))
                                    : 0.5f * mu * l;
             arc += l;

@@ -196,7 +196,10 @@ class RodFormulation final : public Formulation {
 
 std::unique_ptr<Formulation> makeRodFormulation() { return std::make_unique<RodFormulation>(); }
 
-double rodMassPerLength(const GuideSettings& s) { return materialOf(s).meanMassPerLength(); }
+double rodMassPerLength(const GuideSettings& s) {
+    const rod::Material m = materialOf(s);
+    return s.taperedFibre ? m.meanMassPerLength() : m.massPerLength();  // the latter: the uniform fibre's bits
+}
 
 double rodSegmentMass(const GuideSettings& s, double t0, double t1, double length) {
     return materialOf(s).segmentMass(t0, t1, length);

@@ -95,7 +95,6 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
     // Per-lane constants: masses, rest lengths, the start of the frame, α̃.
     V3 u, a;
     F4 bendLane{};  // nonzero where the strand bends (EI > 0)
-    const double h2 = double(h) * h;
     for (int l = 0; l < kLanes; ++l) {
         const RodStepTarget& tl = t[src[l]];
         const RodStrand& s = *tl.strand;
@@ -129,7 +128,8 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
         for (int l = 0; l < kLanes; ++l) {
             const RodStrand& s = *t[src[l]].strand;
             rc[l] = &s.restCurvature[j];
-            alpha[l] = double(voronoiLength(s, j)) / (stiffnessAt(s, j) * h2);  // α̃ = l̄_j/(EI_j h²)
+            // α̃ = l̄_j/(EI_j h²), rounded as (EI_j·h)·h
+            alpha[l] = double(voronoiLength(s, j)) / (stiffnessAt(s, j) * double(h) * h);
         }
         const F4 c[2] = {F4{(*rc[0])[0], (*rc[1])[0], (*rc[2])[0], (*rc[3])[0]},
                          F4{(*rc[0])[1], (*rc[1])[1], (*rc[2])[1], (*rc[3])[1]}};
