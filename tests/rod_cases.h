@@ -28,6 +28,7 @@ inline GuideSettings rodSettings(float youngs, float drag, bool preload) {
     s.preload = preload;
     s.headCollision = false;
     s.maxSpeed = 0.f;
+    s.tipRadius = s.rootRadius;  // a uniform fibre: the references below assume one
     return s;
 }
 
@@ -36,6 +37,7 @@ inline rod::Material material(const GuideSettings& s) {
     rod::Material m;
     m.youngs = s.youngsModulus;
     m.radius = s.rootRadius;
+    m.tipRadius = s.taperedFibre ? s.tipRadius : s.rootRadius;
     m.hairsPerGuide = s.hairsPerGuide;
     m.density = s.density;
     return m;
@@ -159,6 +161,29 @@ inline Cantilever cantilever(double beta, int threads, int segments = 23) {
     return c;
 }
 
+/// Small-load tip deflection of a horizontally clamped tapered strand
+/// (linear beam theory): with w(s) = μ(s)·g its weight per length,
+///   V(s) = ∫_s^L w,   M(s) = ∫_s^L V,   δ = ∫_0^L M(s)/EI(s)·(L - s) ds
+/// (the moment-area theorem), by the trapezoid rule on `n` intervals.
+inline double taperedTipDeflection(const rod::Material& m, double L, int n = 20000) {
+    const double ds = L / n;
+    std::vector<double> w(size_t(n) + 1), V(size_t(n) + 1, 0.0), M(size_t(n) + 1, 0.0);
+    for (int i = 0; i <= n; ++i) {
+        const double r = m.radiusAt(double(i) / n);
+        w[size_t(i)] = double(m.hairsPerGuide) * m.density * M_PI * r * r * kG;
+    }
+    for (int i = n - 1; i >= 0; --i) {
+        V[size_t(i)] = V[size_t(i) + 1] + 0.5 * ds * (w[size_t(i)] + w[size_t(i) + 1]);
+        M[size_t(i)] = M[size_t(i) + 1] + 0.5 * ds * (V[size_t(i)] + V[size_t(i) + 1]);
+    }
+    double delta = 0;
+    for (int i = 0; i < n; ++i) {
+        auto f = [&](int k) { return M[size_t(k)] / m.bendStiffnessAt(double(k) / n) * (L - k * ds); };
+        delta += 0.5 * ds * (f(i) + f(i + 1));
+    }
+    return delta;
+}
+
 struct Pendulum {
     double period = 0, reference = 0, error = 0, maxStretch = 0;
     size_t crossings = 0;
@@ -194,6 +219,79 @@ inline Pendulum pendulum() {
     p.error = std::abs(p.period / p.reference - 1);
     p.maxStretch = strand.worst.maxLengthError;
     return p;
+}
+
+/// The undamped hanging chain's swing (E = 0, no drag): the first mode
+/// of pendulum() at `amplitude`·L, run for 4 s.
+///   energy in play  E(t) = Σ ½ m_i |v_i|² + Σ m_i g (y_i - y_i^rest),
+///     y^rest the chain hanging straight down at its rest lengths (its lowest
+///     energy), so E → 0 as the swing dies;
+///   energyKept2s    E(2 s) / E(0) (1 for an integrator that keeps energy);
+///   logDecrement    δ = ln(A_k / A_{k+1}) per period, from the tip's
+///                   extremes A (its horizontal offset's turning points,
+///                   alternating sign, two per period) over the run;
+///   period          from the tip's zero crossings, against
+///                   T1 = 4π/j01·sqrt(L/g) (pendulum()).
+/// For a linear mode E ∝ A², so E(t)/E(0) = exp(-2δ t/T1).
+struct Swing {
+    double energyKept2s = 0, logDecrement = 0, period = 0, reference = 0, periodError = 0, maxStretch = 0;
+    size_t extremes = 0;
+};
+
+inline Swing swing(GuideSettings s, double amplitude = 0.05) {
+    const double j01 = 2.404825557695773;
+    s.youngsModulus = 0.f;
+    s.damping = 0.f;
+    s.preload = false;
+    s.headCollision = false;
+    s.maxSpeed = 0.f;
+    std::vector<Vec3f> x(size_t(s.segments) + 1);
+    const float amp = float(amplitude) * s.length;
+    for (int i = 0; i <= s.segments; ++i) {
+        const double arc = double(s.length) * i / s.segments, z = s.length - arc;
+        x[size_t(i)] = Vec3f(amp * float(std::cyl_bessel_j(0.0, j01 * std::sqrt(z / s.length))), -float(arc), 0.f);
+    }
+    const rod::Material m = material(s);
+    std::vector<double> mass(x.size(), 0.0), restY(x.size(), 0.0);
+    for (size_t i = 1; i < x.size(); ++i) {
+        const double l = (x[i] - x[i - 1]).norm();  // the groom's rest lengths
+        mass[i - 1] += i > 1 ? 0.5 * m.massPerLength() * l : 0.0;
+        mass[i] += 0.5 * m.massPerLength() * l;
+        restY[i] = restY[i - 1] - l;
+    }
+    auto energy = [&](const StrandFrame& f) {
+        double e = 0;
+        for (size_t i = 1; i < x.size(); ++i)
+            e += 0.5 * mass[i] * double(f.velocities[i].squaredNorm()) +
+                 mass[i] * kG * (double(f.positions[i].y()) - restY[i]);
+        return e;
+    };
+    Strand strand(s, x);
+    const double e0 = energy(strand.frame());
+    Swing r;
+    r.reference = 4 * M_PI / j01 * std::sqrt(double(s.length) / kG);
+    std::vector<double> crossings, extremes;
+    double prev = x.back().x(), prevSlope = 0, t = 0;
+    strand.run(4.0, [&](const StrandFrame& f) {
+        const double now = f.positions[f.vertexCount() - 1].x();
+        t += s.timeStep;
+        if (std::abs(t - 2.0) < 0.5 * s.timeStep) r.energyKept2s = energy(f) / e0;
+        if ((prev < 0) != (now < 0)) crossings.push_back(t - s.timeStep * now / (now - prev));
+        const double slope = now - prev;
+        if (t > 1.5 * s.timeStep && (slope < 0) != (prevSlope < 0)) extremes.push_back(std::abs(prev));
+        prev = now;
+        prevSlope = slope;
+    });
+    // The start is the first extreme (released at rest at amplitude).
+    extremes.insert(extremes.begin(), std::abs(double(x.back().x())));
+    r.extremes = extremes.size();
+    if (extremes.size() >= 3)
+        r.logDecrement = 2.0 * std::log(extremes.front() / extremes.back()) / double(extremes.size() - 1);
+    if (crossings.size() >= 2)
+        r.period = 2 * (crossings.back() - crossings.front()) / double(crossings.size() - 1);
+    r.periodError = std::abs(r.period / r.reference - 1);
+    r.maxStretch = strand.worst.maxLengthError;
+    return r;
 }
 
 /// Kinetic + gravitational (root at height 0) + bending energy of strand 0,

@@ -141,6 +141,7 @@ TEST(Guides, StrandUnderGravitySettlesIntoTheHeavyElastica) {
     GuideSettings s;  // the default formulation and material
     ASSERT_EQ(s.formulation, GuideFormulation::Rod);
     s.preload = false;
+    s.tipRadius = s.rootRadius;  // a uniform fibre, as the elastica assumes
     GuideSolver solver(s);
     SurfaceFrame root;
     root.position = Vec3f(0.1f, 0, 0);
@@ -448,11 +449,16 @@ TEST(Guides, StatisticsAccumulateAndPrintAsJson) {
 TEST(SimSettings, SceneKeysMapOntoGuideSettings) {
     const Scene scene = Scene::parse(
         "simulation:\n  formulation: rigid\n  substeps: 4\n  damping: 2.5\n  strand_collision: true\n"
-        "  limits: {bend: 20, twist: 5}\n  gravity: [0, -1, 0]\nhair:\n  guides: {segments: 10, length: 0.3}\n",
+        "  rod_integrator: euler\n"
+        "  limits: {bend: 20, twist: 5}\n  gravity: [0, -1, 0]\nhair:\n  guides: {segments: 10, length: 0.3}\n"
+        "  material: {tapered: true}\n",
         "test.yaml", ".");
     const GuideSettings s = guideSettings(scene);
     EXPECT_EQ(s.formulation, GuideFormulation::Rigid);
     EXPECT_EQ(s.substeps, 4);
+    EXPECT_EQ(s.rodIntegrator, RodIntegrator::Euler);
+    EXPECT_TRUE(s.taperedFibre);
+    EXPECT_FALSE(GuideSettings{}.taperedFibre) << "the root's section all along by default";
     EXPECT_FLOAT_EQ(s.damping, 2.5f);
     EXPECT_TRUE(s.strandCollision);
     EXPECT_FLOAT_EQ(s.bendLimit, 20.f);

@@ -8,6 +8,7 @@ namespace hp {
 GuideSettings guideSettings(const Scene& scene) {
     GuideSettings s;
     s.formulation = parseFormulation(scene.text("simulation.formulation"));
+    s.rodIntegrator = parseRodIntegrator(scene.text("simulation.rod_integrator"));
     readKeys(scene, s, {
         {"hair.guides.segments", &GuideSettings::segments},
         {"hair.guides.length", &GuideSettings::length},
@@ -27,6 +28,7 @@ GuideSettings guideSettings(const Scene& scene) {
         {"hair.material.density", &GuideSettings::density},
         {"hair.material.hairs_per_guide", &GuideSettings::hairsPerGuide},
         {"simulation.rod_substeps", &GuideSettings::rodSubsteps},
+        {"hair.material.tapered", &GuideSettings::taperedFibre},
         {"simulation.preload_probes", &GuideSettings::preloadProbes},
         {"simulation.preload", &GuideSettings::preload},
         {"simulation.head_collision", &GuideSettings::headCollision},

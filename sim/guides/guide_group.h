@@ -117,6 +117,10 @@ class GuideGroup {
     /// Vertices pinned in the last substeps (no place outside the head at
     /// their length), then cleared. Only the rod formulation pins.
     virtual size_t takePinned() { return 0; }
+    /// State a group keeps beside set.x / set.v (the rod's BDF2 history),
+    /// appended to and read back from a checkpoint; none by default.
+    virtual void save(BlobWriter&) const {}
+    virtual void restore(BlobReader&) {}
 
     size_t begin() const { return begin_; }
     size_t end() const { return end_; }
@@ -137,8 +141,12 @@ class Formulation {
 
 std::unique_ptr<Formulation> makeRopeFormulation(const GuideSet& set);
 std::unique_ptr<Formulation> makeRodFormulation();
-/// The rod formulation's mass per length, kg/m (rod::Material::massPerLength).
+/// The rod formulation's mean mass per length over the taper, kg/m
+/// (rod::Material::meanMassPerLength).
 double rodMassPerLength(const GuideSettings& s);
+/// The rod's mass of the fibre between arc-length fractions t0 and t1, of
+/// the given length, kg (rod::Material::segmentMass: the taper).
+double rodSegmentMass(const GuideSettings& s, double t0, double t1, double length);
 std::unique_ptr<Formulation> makeRigidFormulation(const GuideSet& set, const HeadPose& head);
 
 /// Strand-strand contacts for the rope formulation: Bullet's broadphase and

@@ -31,6 +31,14 @@ GuideFormulation parseFormulation(const std::string& name) {
     throw Error(cat("unknown guide formulation '", name, "' (choices: rod, rope, rigid)"));
 }
 
+const char* rodIntegratorName(RodIntegrator i) { return i == RodIntegrator::Euler ? "euler" : "bdf2"; }
+
+RodIntegrator parseRodIntegrator(const std::string& name) {
+    if (name == "bdf2") return RodIntegrator::Bdf2;
+    if (name == "euler") return RodIntegrator::Euler;
+    throw Error(cat("unknown rod integrator '", name, "' (choices: bdf2, euler)"));
+}
+
 double GuideSettings::guideMassPerLength() const {
     return formulation == GuideFormulation::Rod ? guides::rodMassPerLength(*this) : double(massPerLength);
 }
@@ -216,10 +224,18 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
                 set.groomDir[set.segment(g, j)] = e / len;
             }
         }
-        // Lumped masses: each vertex carries half of its two segments.
+        // Lumped masses: each vertex carries half of its two segments. The
+        // rod's fibre tapers (hair.radius.root → tip), so its segments' masses
+        // do too; rope and rigid take a uniform mass per length.
         const float mu = float(s.guideMassPerLength());
+        double guideLength = 0, arc = 0;
+        for (int j = 0; j < set.segments; ++j) guideLength += set.restLength[set.segment(g, j)];
         for (int j = 0; j < set.segments; ++j) {
-            const float half = 0.5f * mu * set.restLength[set.segment(g, j)];
+            const float l = set.restLength[set.segment(g, j)];
+            const float half = s.formulation == GuideFormulation::Rod && s.taperedFibre
+                                   ? float(0.5 * guides::rodSegmentMass(s, arc / guideLength, (arc + l) / guideLength, l))
+                                   : 0.5f * mu * l;
+            arc += l;
             if (j > 0) set.mass[set.vertex(g, j)] += half;
             set.mass[set.vertex(g, j + 1)] += half;
         }
@@ -395,6 +411,7 @@ std::vector<char> GuideSolver::saveState() const {
     m.skeleton.saveClock(w);
     w.put(set.headTransform.matrix());
     set.save(w);
+    for (const auto& grp : m.groups) grp->save(w);
     return std::move(w.data);
 }
 
@@ -408,6 +425,7 @@ void GuideSolver::restoreState(const std::vector<char>& state) {
     m.skeleton.restoreClock(r);
     set.headTransform.matrix() = r.get<Eigen::Matrix4f>();
     set.restore(r);
+    for (auto& grp : m.groups) grp->restore(r);
     r.finish();
     // The Bullet nodes of every world reload x and v before the next step:
     // a rope node's whole state is its position and velocity.

@@ -9,8 +9,8 @@
 // interface; what Bullet computes differs in each (sim/guides/guide_group.h):
 //
 // - `Rod` (default): each guide is an inextensible elastic rod with physical
-//   parameters (E, ρ, fibre radius, hairs per guide), advanced by XPBD
-//   with a direct banded solve per strand (sim/guides/rod_kernels.h,
+//   parameters (E, ρ, the drawn tapered fibre, hairs per guide), advanced by XPBD
+//   in BDF2 steps with a direct banded solve per strand (sim/guides/rod_kernels.h,
 //   sim/guides/rod_group.cpp). Bullet integrates nothing here: it only finds
 //   strand-strand contact pairs and their closest points (broadphase and
 //   capsule narrowphase, sim/guides/strand_contacts.cpp) when
@@ -51,6 +51,15 @@ namespace hp {
 
 enum class GuideFormulation { Rope, Rigid, Rod };
 
+/// The rod's time integrator (sim/guides/rod_kernels.h): `Bdf2`, the
+/// second-order backward differentiation formula (keeps a swing's energy,
+/// damps what the step cannot resolve), or `Euler`, implicit Euler (the
+/// default; first order: damps every motion by ~π·ω·h per period).
+enum class RodIntegrator { Euler, Bdf2 };
+/// "euler" / "bdf2", and back (throws hp::Error naming the choices).
+const char* rodIntegratorName(RodIntegrator i);
+RodIntegrator parseRodIntegrator(const std::string& name);
+
 /// "rope" / "rigid" / "rod".
 const char* formulationName(GuideFormulation f);
 /// Inverse of formulationName; throws hp::Error naming the valid choices.
@@ -74,7 +83,8 @@ struct GuideSettings : StepSettings {
     // Material.
     float massPerLength = 0.005f;   ///< rope, rigid: kg/m (a guide stands for a clump of hairs)
     float bendStiffness = 5e-5f;    ///< rope, rigid: joint spring toward the rest pose, N·m/rad
-    // Rod material (SI): μ = N·ρ·πr², EI = N·E·πr⁴/4, r = rootRadius (sim/guides/rod_kernels.h).
+    // Rod material (SI): μ = N·ρ·πr², EI = N·E·πr⁴/4, r the drawn fibre's radius tapering
+    // from rootRadius to tipRadius (sim/guides/rod_kernels.h Material).
     // No shear modulus: the rod carries no twist (sim/guides/rod_group.cpp).
     float youngsModulus = 3.8e9f;   ///< rod: E, Pa
     float density = 1300.f;         ///< rod: ρ, kg/m³
@@ -82,7 +92,12 @@ struct GuideSettings : StepSettings {
     /// scale with N, drag is a rate and contacts are positions, so N cancels
     /// out of the rod's motion: only the energies reported scale with it.
     float hairsPerGuide = 100.f;
+    /// rod: the fibre tapers as drawn (rootRadius → tipRadius: EI per joint,
+    /// mass per segment); false: the root's section all along. Off by
+    /// default: with it the default scene's settled groom stands up (docs/physics.md).
+    bool taperedFibre = false;
     int rodSubsteps = 2;            ///< rod: XPBD steps per solver substep
+    RodIntegrator rodIntegrator = RodIntegrator::Euler;  ///< rod: the time integrator (docs/physics.md: why Euler stays the default)
     int preloadProbes = 3;          ///< rod: probe steps refining the pre-load (rod::preload)
     float bendDamping = 0.f;        ///< rigid only: joint spring damping, N·m·s/rad
     float damping = 1.0f;           ///< velocity decay rate, 1/s: v *= exp(-damping·t), any step size (rod: air drag)
@@ -115,7 +130,7 @@ struct GuideSettings : StepSettings {
     /// Throws hp::Error naming the first setting out of range.
     void validate() const;
     /// A guide's mass per length as its formulation has it, kg/m: rod
-    /// N·ρ·πr² (hair.material), rope and rigid massPerLength.
+    /// N·ρ·πr² (hair.material) averaged over the taper, rope and rigid massPerLength.
     double guideMassPerLength() const;
 };
 

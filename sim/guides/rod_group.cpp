@@ -6,9 +6,11 @@
 // the rope.
 //
 // Parameters (GuideSettings → rod::Material): mass per length μ and bending
-// stiffness EI from E, ρ, the fibre radius (hair.radius.root; the render
-// taper is not physical here: a uniform fibre) and hairs_per_guide, which
+// stiffness EI from E, ρ, the fibre radius and hairs_per_guide, which
 // cancels out of the motion (μ and EI are both N times one hair's). The
+// fibre is the one drawn: its radius tapers from hair.radius.root to
+// hair.radius.tip (rod::Material), so EI_j is taken per joint and the
+// masses per segment. The
 // shear modulus is not read: with an isotropic section (EI the same about
 // both axes) and a free tip, the quasistatic twist moment is zero along the
 // rod (Bergou et al., "Discrete Elastic Rods", 2008, §4.2: the material
@@ -40,6 +42,7 @@ rod::Material materialOf(const GuideSettings& s) {
     m.youngs = s.youngsModulus;
     m.density = s.density;
     m.radius = s.rootRadius;
+    m.tipRadius = s.taperedFibre ? s.tipRadius : s.rootRadius;
     m.hairsPerGuide = s.hairsPerGuide;
     return m;
 }
@@ -55,17 +58,60 @@ class RodGroup final : public GuideGroup {
             const float m = set.mass[set.vertex(begin, 0) + k];
             invMass_[k] = m > 0.f ? 1.f / m : 0.f;
         }
+        // EI_j of the tapered fibre at joint j's vertex (arc-length fraction
+        // of the rest lengths); the masses taper alike (GuideSolver::initialize).
+        const rod::Material material = materialOf(set.settings);
+        jointStiffness_.resize(n * size_t(set.segments));
+        for (size_t g = begin; g < end; ++g) {
+            double length = 0, arc = 0;
+            for (int j = 0; j < set.segments; ++j) length += set.restLength[set.segment(g, j)];
+            for (int j = 0; j < set.segments; ++j) {
+                jointStiffness_[(g - begin) * size_t(set.segments) + size_t(j)] = material.bendStiffnessAt(arc / length);
+                arc += set.restLength[set.segment(g, j)];
+            }
+        }
         for (size_t g = begin; g < end; ++g) computeCurvature(g, 0.f);
+        if (bdf2()) {
+            xBack_.assign(invMass_.size(), Vec3f::Zero());  // defined bytes for a checkpoint before the first step
+            vBack_.assign(invMass_.size(), Vec3f::Zero());
+        }
     }
 
+    void reset() override {
+        GuideGroup::reset();
+        restart_ = true;  // after the solver has placed the reset guides outside the head
+    }
+    void save(BlobWriter& w) const override {
+        w.put(restart_);
+        w.array(xBack_);
+        w.array(vBack_);
+    }
+    void restore(BlobReader& r) override {
+        restart_ = r.get<bool>();
+        r.array(xBack_, xBack_.size());
+        r.array(vBack_, vBack_.size());
+    }
     void preload(const SubstepContext& ctx) override {
-        const float h = ctx.h / float(std::max(1, set_.settings.rodSubsteps));
+        // From rest a BDF2 step is the implicit Euler step of h' (rod::bdf2Step).
+        float h = ctx.h / float(std::max(1, set_.settings.rodSubsteps));
+        if (bdf2()) h = rod::bdf2Step(h);
         for (size_t g = begin_; g < end_; ++g) computeCurvature(g, set_.settings.preload ? h : 0.f);
     }
     void substep(const SubstepContext& ctx) override;
     size_t takePinned() override { return std::exchange(pinned_, size_t(0)); }
 
   private:
+    bool bdf2() const { return set_.settings.rodIntegrator == RodIntegrator::Bdf2; }
+    /// BDF2's history for the group's guides as they are now, as if they had
+    /// moved at their present velocities (rod::bdf2Start).
+    void restartHistory() {
+        restart_ = false;
+        if (!bdf2()) return;
+        const float h = set_.settings.timeStep / float(std::max(1, set_.settings.substeps)) /
+                        float(std::max(1, set_.settings.rodSubsteps));
+        const size_t first = set_.vertex(begin_, 0);
+        rod::bdf2Start(&set_.x[first], &set_.v[first], int(xBack_.size()), h, xBack_.data(), vBack_.data());
+    }
     rod::RodStrand strand(size_t g) const {
         rod::RodStrand s;
         s.vertices = set_.vertices;
@@ -74,6 +120,7 @@ class RodGroup final : public GuideGroup {
         s.restCurvature = &curvature_[(g - begin_) * size_t(set_.segments)];
         s.ghostDir = set_.groomDir[set_.segment(g, 0)];
         s.bendStiffness = bendStiffness_;
+        s.jointStiffness = &jointStiffness_[(g - begin_) * size_t(set_.segments)];
         return s;
     }
     /// Rest curvatures of guide g from its rest shape at the end-of-step
@@ -90,9 +137,12 @@ class RodGroup final : public GuideGroup {
             rod::preload(s, x.data(), R, set_.settings.gravity, preloadStep, set_.settings.preloadProbes, c, scratch_);
     }
 
-    const double bendStiffness_;  ///< EI of the settings' material (the same for every guide)
+    const double bendStiffness_;  ///< EI at the root (> 0: the guides bend)
+    std::vector<double> jointStiffness_;  ///< EI_j per joint of each guide (the taper)
     std::vector<float> invMass_;
     std::vector<rod::Vec2f> curvature_;
+    std::vector<Vec3f> xBack_, vBack_;  ///< BDF2's history x_{n-1}, v_{n-1} per vertex (empty for Euler)
+    bool restart_ = true;               ///< the history starts afresh at the next substep (a start, a reset)
     rod::RodScratch scratch_;
     size_t pinned_ = 0;
 };
@@ -105,6 +155,7 @@ void RodGroup::substep(const SubstepContext& ctx) {
     const int k = std::max(1, s.rodSubsteps);
     const float h = ctx.h / float(k);
     const float alpha0 = ctx.alpha - ctx.h / s.timeStep;
+    if (restart_) restartHistory();
     // Guides in batches of rod::kLanes (their banded solves share SIMD
     // lanes; each guide's result is that of a lone step).
     for (size_t g0 = begin_; g0 < end_; g0 += rod::kLanes) {
@@ -117,6 +168,10 @@ void RodGroup::substep(const SubstepContext& ctx) {
             targets[l].strand = &strands[l];
             targets[l].x = &set_.x[set_.vertex(g, 0)];
             targets[l].v = &set_.v[set_.vertex(g, 0)];
+            if (bdf2()) {
+                targets[l].xBack = &xBack_[(g - begin_) * size_t(set_.vertices)];
+                targets[l].vBack = &vBack_[(g - begin_) * size_t(set_.vertices)];
+            }
         }
         for (int i = 0; i < k; ++i) {
             const float a = alpha0 + (ctx.alpha - alpha0) * float(i + 1) / float(k);
@@ -141,6 +196,13 @@ class RodFormulation final : public Formulation {
 
 std::unique_ptr<Formulation> makeRodFormulation() { return std::make_unique<RodFormulation>(); }
 
-double rodMassPerLength(const GuideSettings& s) { return materialOf(s).massPerLength(); }
+double rodMassPerLength(const GuideSettings& s) {
+    const rod::Material m = materialOf(s);
+    return s.taperedFibre ? m.meanMassPerLength() : m.massPerLength();  // the latter: the uniform fibre's bits
+}
+
+double rodSegmentMass(const GuideSettings& s, double t0, double t1, double length) {
+    return materialOf(s).segmentMass(t0, t1, length);
+}
 
 }  // namespace hp::guides

@@ -73,7 +73,7 @@ void preloadOffset(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec
     // last joint's three rows), so it is invertible.
     const Eigen::VectorXd lambda = Jt.fullPivLu().solve(f);
     for (int j = 0; j < S; ++j) {
-        const double alpha = voronoiLength(s, j) / s.bendStiffness;
+        const double alpha = voronoiLength(s, j) / stiffnessAt(s, j);
         c[j] += Vec2f(float(alpha * lambda[3 * j]), float(alpha * lambda[3 * j + 1]));
     }
 }
@@ -115,7 +115,7 @@ double bendEnergy(const RodStrand& s, const Vec3f* x, const Mat3f& rootFrame) {
     forJoints(s, x, rootFrame, [&](int j, const Vec3f& u, float ulen, const Vec3f& ej, const Vec3f& a, bool ghost) {
         Vec3f g[2][3];
         const Vec2f C = bendConstraint(u, ulen, ej, a, s.restCurvature[j], ghost, g);
-        e += s.bendStiffness / (2.0 * voronoiLength(s, j)) * double(C.squaredNorm());
+        e += stiffnessAt(s, j) / (2.0 * voronoiLength(s, j)) * double(C.squaredNorm());
     });
     return e;
 }

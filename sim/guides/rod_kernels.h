@@ -33,17 +33,38 @@ using strand::Mat3f;
 ///   EI = N·E·π r⁴/4        bending stiffness, N·m²
 ///   GJ = N·G·π r⁴/2        twist stiffness, N·m²
 /// and the wisp's gravity bending length (EI/μg)^(1/3) is that of one fibre.
+/// The fibre is the one drawn: its radius tapers linearly from `radius` at
+/// the root to `tipRadius` at the tip (strand::taperedRadius, hair.radius.*),
+/// r(t) = r0 + (r1 - r0)·t at arc-length fraction t, so μ and EI vary along
+/// the strand (EI by (r1/r0)⁴: 1/81 at the tip for 60 → 20 µm).
 struct Material {
     float youngs = 3.8e9f;      ///< E, Pa
     float shear = 1.3e9f;       ///< G, Pa
     float density = 1300.f;     ///< ρ, kg/m³
-    float radius = 4e-5f;       ///< r, m (hair.radius.root: a uniform fibre)
+    float radius = 4e-5f;       ///< r0, m: at the root (hair.radius.root)
+    float tipRadius = 4e-5f;    ///< r1, m: at the tip (hair.radius.tip); = radius for a uniform fibre
     float hairsPerGuide = 100.f;///< N
 
     double area() const { return M_PI * double(radius) * radius; }
+    /// At the root.
     double massPerLength() const { return double(hairsPerGuide) * density * area(); }
     double bendStiffness() const { return double(hairsPerGuide) * youngs * area() * radius * radius / 4.0; }
     double twistStiffness() const { return double(hairsPerGuide) * shear * area() * radius * radius / 2.0; }
+
+    double radiusAt(double t) const { return double(radius) + (double(tipRadius) - radius) * t; }
+    /// EI at arc-length fraction t: N·E·π r(t)⁴/4.
+    double bendStiffnessAt(double t) const {
+        const double r = radiusAt(t);
+        return double(hairsPerGuide) * youngs * M_PI * r * r * r * r / 4.0;
+    }
+    /// Mass of the stretch of fibre between fractions t0 and t1, of length
+    /// l: N·ρ·π ∫ r² = N·ρ·π·l·(r_a² + r_a·r_b + r_b²)/3, r linear in between.
+    double segmentMass(double t0, double t1, double l) const {
+        const double a = radiusAt(t0), b = radiusAt(t1);
+        return double(hairsPerGuide) * density * M_PI * l * (a * a + a * b + b * b) / 3.0;
+    }
+    /// Mean mass per length over the strand (segmentMass over [0, 1] per length).
+    double meanMassPerLength() const { return segmentMass(0.0, 1.0, 1.0); }
 };
 
 /// Constant data of one strand of `vertices` vertices for rodStep.
@@ -53,8 +74,15 @@ struct RodStrand {
     const float* invMass = nullptr;        ///< w_i, vertices entries (w_0 = 0: kinematic root)
     const Vec2f* restCurvature = nullptr;  ///< c_j, vertices - 1 entries (joint j; see bendConstraint)
     Vec3f ghostDir = Vec3f::UnitY();       ///< rest direction of segment 0 in the root frame (root-local)
-    double bendStiffness = 0;              ///< EI, N·m²
+    double bendStiffness = 0;              ///< EI, N·m² (0: the strand does not bend)
+    /// EI_j per joint (vertices - 1 entries), N·m²: a tapered fibre's
+    /// (Material::bendStiffnessAt at joint j's vertex); null: bendStiffness
+    /// at every joint.
+    const double* jointStiffness = nullptr;
 };
+
+/// EI at joint j.
+inline double stiffnessAt(const RodStrand& s, int j) { return s.jointStiffness ? s.jointStiffness[j] : s.bendStiffness; }
 
 /// Voronoi length of joint j: l̄_0 = l_0/2 (the clamped end's half
 /// segment), else (l_{j-1} + l_j)/2.
@@ -72,6 +100,7 @@ constexpr int kLanes = 4;
 /// (sim/guides/rod_step.cpp): entry k holds the four lanes' values.
 struct RodScratch {
     std::vector<lanes::V3<lanes::F4>> y;     ///< positions, per vertex
+    std::vector<lanes::V3<lanes::F4>> start; ///< x̄, per vertex: where the step starts (x, or BDF2's extrapolation)
     std::vector<lanes::V3<lanes::F4>> grad;  ///< constraint gradients, per row × 3 vertices
     std::vector<lanes::V3<lanes::F4>> dir;   ///< stretch pass: segment directions
     std::vector<lanes::F4> w, rest, cosine;  ///< inverse masses, rest lengths, d_j·d_{j+1}
@@ -87,13 +116,42 @@ struct RodStepTarget {
     Vec3f* v = nullptr;                      ///< velocities, likewise
     Vec3f rootPos = Vec3f::Zero();           ///< root position at the step's end
     Mat3f rootFrame = Mat3f::Identity();     ///< root frame at the step's end
+    /// BDF2's history (rodSteps): positions and velocities at the previous
+    /// step's start, x_{n-1} and v_{n-1}; they receive x_n and v_n. Null:
+    /// the first-order step (implicit Euler). Every strand of a batch has
+    /// history or none does.
+    Vec3f* xBack = nullptr;
+    Vec3f* vBack = nullptr;
 };
+
+/// The step BDF2 takes from the history (x_{n-1}, v_{n-1}) and the state
+/// (x_n, v_n): the second-order backward differentiation formula
+///   x_{n+1} - 4/3 x_n + 1/3 x_{n-1} = 2/3 h v_{n+1}
+///   v_{n+1} - 4/3 v_n + 1/3 v_{n-1} = 2/3 h a(x_{n+1})
+/// is, with x̄ = (4x_n - x_{n-1})/3, v̄ = (4v_n - v_{n-1})/3 and h' = 2h/3,
+///   x_{n+1} = x̄ + h'·v̄ + h'²·a(x_{n+1}),   v_{n+1} = (x_{n+1} - x̄)/h',
+/// an implicit Euler step of length h' from (x̄, v̄): the XPBD step below
+/// with x̄, v̄, h' in place of x, v, h. From rest (x_{n-1} = x_n, v = 0) it
+/// is exactly the implicit Euler step of h'. Returns h'.
+inline float bdf2Step(float h) { return 2.f * h / 3.f; }
+inline Vec3f bdf2Extrapolate(const Vec3f& now, const Vec3f& back) { return (4.f * now - back) / 3.f; }
+
+/// History of a strand that moved at constant velocity v (x_{n-1} = x - h·v,
+/// v_{n-1} = v; at rest, x_{n-1} = x): then x̄ = x + h·v/3 and v̄ = v, so
+/// x̄ + h'·v̄ = x + h·v, the displacement of the step h, and a start or a
+/// restart (scene cut, reset) needs no separate first-order step.
+inline void bdf2Start(const Vec3f* x, const Vec3f* v, int n, float h, Vec3f* xBack, Vec3f* vBack) {
+    for (int i = 0; i < n; ++i) {
+        xBack[i] = x[i] - h * v[i];
+        vBack[i] = v[i];
+    }
+}
 
 /// The bending constraint of joint j, in the parent's transported frame
 /// (a_j, b_j = d_{j-1} × a_j, both ⊥ d_{j-1}):
 ///   κb_j = 2 d_{j-1} × d_j / (1 + d_{j-1}·d_j)   (|κb| = 2 tan(θ/2), θ the turn)
 ///   C_j = (κb_j·a_j, κb_j·b_j) - c_j
-/// with energy E_j = EI/(2 l̄_j) |C_j|², l̄_j = (l_{j-1} + l_j)/2, l̄_0 = l_0/2
+/// with energy E_j = EI_j/(2 l̄_j) |C_j|², l̄_j = (l_{j-1} + l_j)/2, l̄_0 = l_0/2
 /// (the clamped end's Voronoi half-segment). Returns C_j and writes the
 /// gradients of its two rows with respect to x_{j-1}, x_j, x_{j+1} (the
 /// frame is held fixed: exact for the energy's gradient when c_j = 0, since
@@ -112,7 +170,7 @@ void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec2f* c)
 
 /// Adds to c the pre-load that balances per-vertex forces f at x:
 ///   Σ_r ∇C_r Λ_r = -f  (the free vertices: 3(n-1) equations, 2(n-1) bend
-///   and n-1 stretch multipliers),  c_j += (l̄_j/EI)·Λ_bend,j,
+///   and n-1 stretch multipliers),  c_j += (l̄_j/EI_j)·Λ_bend,j,
 /// since a bend row's force multiplier is Λ = -C/α = (c - κ)/α.
 void preloadOffset(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f* force, Vec2f* c);
 
@@ -126,7 +184,7 @@ void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gr
 /// One XPBD step of length h for one strand (x: positions at the step's
 /// start, v: velocities; root at rootPos with frame rootFrame at the end):
 ///  1. y = x + h·v + h²·g (root: its target; the root's velocity is real);
-///  2. one Newton step of XPBD on y: (J W Jᵀ + α̃) Δλ = -C(y), α̃ = l̄/(EI h²)
+///  2. one Newton step of XPBD on y: (J W Jᵀ + α̃) Δλ = -C(y), α̃ = l̄_j/(EI_j h²)
 ///     for bend rows, 0 for stretch rows (hard), J the constraint gradients,
 ///     W the inverse masses; the system is banded (bandwidth 8 over rows
 ///     ordered joint by joint) and solved by banded LDLᵀ in double;
@@ -161,7 +219,7 @@ int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, floa
 /// run through the same four-lane code the step uses (rod_step.cpp).
 void stretchSolve(Vec3f* x, const float* w, const float* rest, int n);
 
-/// Total bending energy Σ EI/(2 l̄_j)|C_j|² of a strand, J.
+/// Total bending energy Σ EI_j/(2 l̄_j)|C_j|² of a strand, J.
 double bendEnergy(const RodStrand& s, const Vec3f* x, const Mat3f& rootFrame);
 
 }  // namespace hp::rod

@@ -79,6 +79,9 @@ inline void setLane(V3& v, int l, const Vec3f& p) {
 /// gradients (rows a, b, stretch of joint j at 3j..3j+2, slots j-1, j, j+1)
 /// and the system A = J W Jᵀ + α̃ with right-hand side -C(y), for the four
 /// lanes (src[l]: the target in lane l).
+/// h: the step of the prediction and of α̃ (BDF2's h', rod_kernels.h
+/// bdf2Step); with history, the prediction starts from x̄, v̄ (bdf2Extrapolate),
+/// kept in sc.start for the velocities.
 void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, float h, RodScratch& sc) {
     const RodStrand& s0 = *t[0].strand;
     const int n = s0.vertices, S = n - 1;
@@ -92,7 +95,6 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
     // Per-lane constants: masses, rest lengths, the start of the frame, α̃.
     V3 u, a;
     F4 bendLane{};  // nonzero where the strand bends (EI > 0)
-    D4 alphaScale{};
     for (int l = 0; l < kLanes; ++l) {
         const RodStepTarget& tl = t[src[l]];
         const RodStrand& s = *tl.strand;
@@ -102,10 +104,18 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
         setLane(u, l, ul);
         setLane(a, l, frameStart(tl.rootFrame, ul));
         bendLane[l] = s.bendStiffness > 0 ? 1.f : 0.f;
-        alphaScale[l] = s.bendStiffness * double(h) * h;
         // 1. Prediction y = x + h·v + h²·g; the root at its target.
         setLane(y[0], l, tl.rootPos);
-        for (int i = 1; i < n; ++i) setLane(y[i], l, tl.x[i] + h * tl.v[i] + (h * h) * gravity);
+        if (tl.xBack) {
+            for (int i = 0; i < n; ++i) {
+                const Vec3f xs = bdf2Extrapolate(tl.x[i], tl.xBack[i]);
+                setLane(sc.start[size_t(i)], l, xs);
+                if (i > 0) setLane(y[i], l, xs + h * bdf2Extrapolate(tl.v[i], tl.vBack[i]) + (h * h) * gravity);
+            }
+        } else {
+            for (int i = 0; i < n; ++i) setLane(sc.start[size_t(i)], l, tl.x[i]);
+            for (int i = 1; i < n; ++i) setLane(y[i], l, tl.x[i] + h * tl.v[i] + (h * h) * gravity);
+        }
     }
     const auto bends = bendLane != 0.f;
     F4 ulen = lanes::splat<F4>(1.f);
@@ -118,14 +128,14 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
         for (int l = 0; l < kLanes; ++l) {
             const RodStrand& s = *t[src[l]].strand;
             rc[l] = &s.restCurvature[j];
-            alpha[l] = double(voronoiLength(s, j));
+            // α̃ = l̄_j/(EI_j h²), rounded as (EI_j·h)·h
+            alpha[l] = double(voronoiLength(s, j)) / (stiffnessAt(s, j) * double(h) * h);
         }
         const F4 c[2] = {F4{(*rc[0])[0], (*rc[1])[0], (*rc[2])[0], (*rc[3])[0]},
                          F4{(*rc[0])[1], (*rc[1])[1], (*rc[2])[1], (*rc[3])[1]}};
         F4 C[2];
         V3 g[2][3];
         lanes::bendRows(u, ulen, e, a, c, j == 0, C, g);
-        alpha /= alphaScale;  // α̃ = l̄/(EI h²)
         for (int k = 0; k < 2; ++k) {
             const int r = 3 * j + k;
             // A strand without bending stiffness has inert bend rows
@@ -171,10 +181,12 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
 
 /// Steps 3–4 at vertex i > 0 of one strand: exact length and head
 /// clearance (pinned where both cannot hold: returns true), then its
-/// velocity. parent: vertex i-1, placed; y: vertex i after the solves, placed
-/// here; t.x[i] still holds the step's start and receives y.
-bool placeVertex(const RodStepTarget& t, int i, const Vec3f& parent, Vec3f& y, float h, float damp, float friction,
-                 const strand::HeadQuery* head, float radius) {
+/// velocity (y - start)/hv. parent: vertex i-1, placed; y: vertex i after
+/// the solves, placed here; t.x[i] still holds the step's start and receives
+/// y. h: the step's length (the head's motion over it); start, hv: where the
+/// integrator's step starts and its length (x[i] and h, or BDF2's x̄ and h').
+bool placeVertex(const RodStepTarget& t, int i, const Vec3f& parent, Vec3f& y, const Vec3f& start, float h, float hv,
+                 float damp, float friction, const strand::HeadQuery* head, float radius) {
     const Vec3f old = t.x[i];
     strand::Contact contact;
     bool pinned = false;
@@ -201,8 +213,8 @@ bool placeVertex(const RodStepTarget& t, int i, const Vec3f& parent, Vec3f& y, f
             pinned = true;
         }
     }
-    Vec3f vel = (y - old) / h;
-    if (contact.active) vel = strand::contactFriction(vel, head->surfaceVelocity(y, h), contact, friction, h);
+    Vec3f vel = (y - start) / hv;
+    if (contact.active) vel = strand::contactFriction(vel, head->surfaceVelocity(y, h), contact, friction, hv);
     vel *= damp;
     t.x[i] = y;
     t.v[i] = vel;
@@ -231,6 +243,7 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
                                   RodScratch& sc) {
     const int n = targets[0].strand->vertices, N = 3 * (n - 1);
     sc.y.resize(size_t(n));
+    sc.start.resize(size_t(n));
     sc.grad.resize(size_t(N) * 3);
     sc.band.resize(size_t(N) * kRowLen);
     // A accumulates from 0.
@@ -246,7 +259,11 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
     int src[kLanes];
     for (int l = 0; l < kLanes; ++l) src[l] = l < count ? l : 0;  // idle lanes repeat lane 0
 
-    assemble(targets, src, gravity, h, sc);
+    // BDF2 (rod_kernels.h bdf2Step) where the strands carry history: the
+    // implicit Euler step of h' from x̄, v̄; velocities (y - x̄)/h'.
+    const bool bdf2 = targets[0].xBack != nullptr;
+    const float hv = bdf2 ? bdf2Step(h) : h;
+    assemble(targets, src, gravity, hv, sc);
     bandedSolve(lanes::view(sc.band), lanes::view(sc.invD), lanes::view(sc.rhs), N);
     // 2. y += W Jᵀ Δλ: row r of joint r/3 moves its vertices j-1, j, j+1.
     V3* y = sc.y.data();
@@ -271,10 +288,13 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
     const bool collides = head && head->collider;
     int pinned = 0;
     for (int i = 0; i < n; ++i) {
-        const Vec3f* o[kLanes] = {&targets[src[0]].x[i], &targets[src[1]].x[i], &targets[src[2]].x[i],
-                                  &targets[src[3]].x[i]};
-        const V3 old = {F4{o[0]->x(), o[1]->x(), o[2]->x(), o[3]->x()}, F4{o[0]->y(), o[1]->y(), o[2]->y(), o[3]->y()},
-                        F4{o[0]->z(), o[1]->z(), o[2]->z(), o[3]->z()}};
+        // x_n, v_n: BDF2's next history (placeVertex overwrites a scalar lane's x, v).
+        Vec3f oldX[kLanes], oldV[kLanes];
+        if (bdf2)
+            for (int k = 0; k < count; ++k) {
+                oldX[k] = targets[k].x[i];
+                oldV[k] = targets[k].v[i];
+            }
         bool scalar[kLanes] = {};
         if (i > 0) {
             // followTheLeader: parent + e·(l/|e|), or straight up from a collapsed segment.
@@ -289,18 +309,24 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
                 scalar[k] = !exact[k] || (collides && !(head->distance(lane(placed, k), nullptr) >= radius));
                 if (!scalar[k]) continue;
                 Vec3f child = lane(y[i], k);
-                pinned += placeVertex(targets[k], i, lane(parent, k), child, h, damp, friction, head, radius);
+                pinned += placeVertex(targets[k], i, lane(parent, k), child, lane(sc.start[size_t(i)], k), h, hv,
+                                      damp, friction, head, radius);
                 setLane(placed, k, child);
             }
             y[i] = placed;
         }
-        V3 vel = (y[i] - old) / h;
+        V3 vel = (y[i] - sc.start[size_t(i)]) / hv;
         if (i > 0) vel = damp * vel;
-        for (int k = 0; k < count; ++k)
+        for (int k = 0; k < count; ++k) {
+            if (bdf2) {
+                targets[k].xBack[i] = oldX[k];
+                targets[k].vBack[i] = oldV[k];
+            }
             if (!scalar[k]) {
                 targets[k].x[i] = lane(y[i], k);
                 targets[k].v[i] = lane(vel, k);
             }
+        }
     }
     return pinned;
 }

@@ -18,8 +18,8 @@ struct StepSettings {
     float teleportAngle = 45.f;     ///< deg per step
 
     // Render radii written to StrandFrame, tapered linearly root to tip.
-    float rootRadius = 0.00004f;    ///< m (the rod's fibre radius too)
-    float tipRadius = 0.00001f;     ///< m
+    float rootRadius = 0.00004f;    ///< m (the rod's fibre radius at the root too)
+    float tipRadius = 0.00001f;     ///< m (the rod's at the tip)
 
     // Parallelism. Strands are partitioned into groups of this many (one
     // Bullet world each where the model uses Bullet): a fixed mapping, so

@@ -24,7 +24,8 @@
 //
 //   bench_sim [--guides 94,845] [--formulation rod,rope,rigid] [--strand-collision off,on] [--volume off,on]
 //             [--threads 1,2] [--runs 3] [--warmup 20] [--steps 250]
-//             [--substeps 1] [--iterations 20] [--rod-substeps 2] [--per-world 16] [--rate 90]
+//             [--substeps 1] [--iterations 20] [--rod-substeps 2] [--rod-integrator bdf2,euler]
+//             [--per-world 16] [--rate 90]
 //             [--preload on|off] [--collider sphere,grid,bullet,grid+box] [--range 0.05] [--digest]
 //
 // --range: how far the Bullet mesh measures (the query range of
@@ -158,7 +159,7 @@ RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int 
 
 int main(int argc, char** argv) {
     std::vector<std::string> guideList{"94", "845"}, formList{"rod", "rope", "rigid"}, collList{"off", "on"},
-        threadList{"1", "2"}, colliderList{"sphere"}, volList{"off"};
+        threadList{"1", "2"}, colliderList{"sphere"}, volList{"off"}, integratorList{"euler"};
     int runs = 3, warmup = 20, steps = 250, substeps = 1, iterations = 20, perWorld = 16, rodSubsteps = 2;
     float rate = 90.f;
     bool preload = true, digest = false;
@@ -183,6 +184,7 @@ int main(int argc, char** argv) {
         else if (a == "--iterations") iterations = std::stoi(next());
         else if (a == "--per-world") perWorld = std::stoi(next());
         else if (a == "--rod-substeps") rodSubsteps = std::stoi(next());
+        else if (a == "--rod-integrator") integratorList = split(next());
         else if (a == "--rate") rate = std::stof(next());
         else if (a == "--preload") preload = next() != "off";
         else if (a == "--digest") digest = true;
@@ -204,12 +206,15 @@ int main(int argc, char** argv) {
     for (const std::string& gs : guideList)
       for (const std::string& collider : colliderList)
         for (const std::string& form : formList)
+          for (const std::string& integrator : form == "rod" ? integratorList : std::vector<std::string>{""})
             for (const std::string& coll : collList)
                 for (const std::string& th : threadList)
                   for (const std::string& vol : volList) {
                     GuideSettings s;
                     s.volume.enabled = vol == "on";
                     s.formulation = parseFormulation(form);
+                    if (!integrator.empty()) s.rodIntegrator = parseRodIntegrator(integrator);
+                    const std::string label = integrator.empty() ? form : form + " (" + integrator + ")";
                     s.strandCollision = coll == "on";
                     s.threads = std::stoi(th);
                     s.substeps = substeps;
@@ -232,7 +237,7 @@ int main(int argc, char** argv) {
                     double load[1] = {0};
                     getloadavg(load, 1);
                     std::printf("| %s | %s | %s | %s | %s | %s | %.1f (%.1f-%.1f) | %.2f (%.2f) | %.2e | %.3f | %zu | %zu | %.2f |",
-                                gs.c_str(), form.c_str(), collider.c_str(), coll.c_str(), vol.c_str(), th.c_str(), median, sps.front(), sps.back(),
+                                gs.c_str(), label.c_str(), collider.c_str(), coll.c_str(), vol.c_str(), th.c_str(), median, sps.front(), sps.back(),
                                 cpu[cpu.size() / 2], cpu.front(), worst.maxLengthError,
                                 worst.maxPenetration * 1000.0, worst.nanCount, worst.strandContacts, load[0]);
                     if (digest) {
