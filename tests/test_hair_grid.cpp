@@ -25,6 +25,19 @@ using volume::HairGrid;
 
 namespace {
 
+/// The grid's view of particle arrays (x, v, mass), one substep of h seconds.
+GridInput gridInput(std::vector<Vec3f>& x, std::vector<Vec3f>& v, const std::vector<float>& m, float lengthPerMass,
+                    float h) {
+    GridInput in;
+    in.x = x.data();
+    in.v = v.data();
+    in.mass = m.data();
+    in.count = x.size();
+    in.lengthPerMass = lengthPerMass;
+    in.h = h;
+    return in;
+}
+
 /// Random particles in a 6 cm box, masses 0.5-2 mg, velocities ±1 m/s.
 struct Cloud {
     std::vector<Vec3f> x, v;
@@ -38,16 +51,7 @@ struct Cloud {
             m.push_back(1e-6f * (1.25f + 0.75f * u(rng)));
         }
     }
-    GridInput input(float lengthPerMass = 1e4f) {
-        GridInput in;
-        in.x = x.data();
-        in.v = v.data();
-        in.mass = m.data();
-        in.count = x.size();
-        in.lengthPerMass = lengthPerMass;
-        in.h = 1.f / 72.f;
-        return in;
-    }
+    GridInput input(float lengthPerMass = 1e4f) { return gridInput(x, v, m, lengthPerMass, 1.f / 72.f); }
     Eigen::Vector3d momentum() const {
         Eigen::Vector3d p = Eigen::Vector3d::Zero();
         for (size_t i = 0; i < x.size(); ++i) p += double(m[i]) * v[i].cast<double>();
@@ -135,13 +139,7 @@ TEST(HairGrid, MeasuresHairLengthPerVolume) {
             for (int k = 0; k < 24; ++k) x.push_back(a * Vec3f(float(i), float(j), float(k)));
     v.assign(x.size(), Vec3f::Zero());
     std::vector<float> m(x.size(), mass);
-    GridInput in;
-    in.x = x.data();
-    in.v = v.data();
-    in.mass = m.data();
-    in.count = x.size();
-    in.lengthPerMass = lengthPerMass;
-    in.h = 0.01f;
+    GridInput in = gridInput(x, v, m, lengthPerMass, 0.01f);
     VolumeSettings s = frictionOnly(0.f);
     s.cellSize = 0.01f;
     HairGrid grid(s);
