@@ -3,6 +3,7 @@
 
 #include "core/errors.h"
 #include "render/preview/gl_context.h"
+#include "render/preview/preview.h"
 
 #include <gtest/gtest.h>
 
@@ -28,6 +29,22 @@ inline GlContext* glContext(std::string* why) {
     }
     *why = error;
     return ctx.get();
+}
+
+/// One frame of `strands` (and `head`, when given) through a fresh preview
+/// renderer with settings `s`; its stats in `*stats` and the second shadowed
+/// light's voxel grid in `*slot1` when given.
+inline Image renderOnce(const PreviewSettings& s, const View& v, const StrandFrame& strands,
+                        const TriangleMesh* head = nullptr, PreviewStats* stats = nullptr,
+                        VoxelSnapshot* slot1 = nullptr) {
+    PreviewRenderer renderer(s);
+    PreviewFrame frame;
+    frame.strands = &strands;
+    frame.head = head;
+    Image img = renderer.render(v, frame);
+    if (stats) *stats = renderer.stats();
+    if (slot1) *slot1 = renderer.readVoxels(1);
+    return img;
 }
 
 }  // namespace hp::test

@@ -60,18 +60,7 @@ PreviewSettings noShadows() {
     return s;
 }
 
-/// One frame of `strands` (and `head`, when given) through a fresh renderer
-/// with settings `s`; its stats in `*stats` when given.
-Image renderOnce(const PreviewSettings& s, const View& v, const StrandFrame& strands,
-                 const TriangleMesh* head = nullptr, PreviewStats* stats = nullptr) {
-    PreviewRenderer renderer(s);
-    PreviewFrame frame;
-    frame.strands = &strands;
-    frame.head = head;
-    Image img = renderer.render(v, frame);
-    if (stats) *stats = renderer.stats();
-    return img;
-}
+using test::renderOnce;
 
 /// The shadow voxels a fresh renderer with settings `s` fills for one draw of `strands`.
 VoxelSnapshot voxelsOf(const PreviewSettings& s, const View& v, const StrandFrame& strands) {

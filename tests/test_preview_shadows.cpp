@@ -26,17 +26,7 @@ void dump(const std::string& name, const Image& img) {
     if (const char* dir = std::getenv("HAIRPIPE_TEST_DUMP")) writeImage(std::string(dir) + "/" + name + ".exr", img);
 }
 
-Image renderOnce(const PreviewSettings& s, const View& v, const StrandFrame& strands, const TriangleMesh* head,
-                 PreviewStats* stats = nullptr, VoxelSnapshot* slot1 = nullptr) {
-    PreviewRenderer renderer(s);
-    PreviewFrame frame;
-    frame.strands = &strands;
-    frame.head = head;
-    Image img = renderer.render(v, frame);
-    if (stats) *stats = renderer.stats();
-    if (slot1) *slot1 = renderer.readVoxels(1);
-    return img;
-}
+using test::renderOnce;
 
 /// Image position of a world point (pixels, y down).
 Vec2f project(const View& v, const Vec3f& p) {
