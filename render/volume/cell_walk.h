@@ -1,8 +1,10 @@
 // @brief Walks the unit cells a straight segment passes through (3D DDA,
 // Amanatides & Woo 1987), reporting the parameter interval inside each cell.
 //
-// Shared by the voxelizer (deposits per cell) and DensityGrid's ray integrals,
-// so both cut segments at exactly the same planes.
+// Shared by the voxelizer's box filter and DensityGrid's ray integrals, so
+// both cut segments at exactly the same planes. The trilinear voxelizer
+// (render/volume/voxelizer.cpp) writes the same walk out inline, started
+// where a segment enters a tile, with the same plane formula.
 #pragma once
 
 #include <Eigen/Core>

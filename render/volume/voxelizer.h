@@ -11,7 +11,9 @@
 //
 // Parallel over space (TBB): segments are binned into tiles of 32³ voxels;
 // one task owns a tile and adds every segment touching it, in segment order,
-// into a dense buffer. Each voxel's sum is therefore formed in the same order
+// into a dense buffer, walking only the part of the segment whose cells
+// reach the tile (the walk's state where it enters is the one the walk from
+// the segment's start reaches there, so the pieces are the same). Each voxel's sum is therefore formed in the same order
 // whatever the thread count: the result is bit-identical for 1 or N threads,
 // and no per-thread copies of the grid are merged.
 #pragma once

@@ -11,8 +11,18 @@
 // (reset between configurations through /proc/self/clear_refs), and the
 // relative mass error |Σ density·V − hair volume| / hair volume.
 //
+// Written as the vdb stage writes by default (vdb.half_float: true,
+// vdb.compression: none); --float and --compression blosc give the full-float,
+// Blosc-compressed file of earlier versions. The mass error is reported for
+// the grid (before writing) and for the file as read back (half floats round
+// each value to ~3 significant digits).
+//
+// --limits: the machine's bounds for this frame instead: memcpy bandwidth on
+// 1 and 2 threads, and OpenVDB's own Blosc codec (io::bloscToStream, as the
+// writer calls it per leaf) on the frame's active values, in MB/s.
+//
 // usage: bench_vdb [--strands N] [--voxel m ...] [--threads n ...] [--runs k]
-//                  [--filter box|trilinear] [--velocity] [--half] [--compression blosc|none]
+//                  [--filter box|trilinear] [--velocity] [--float] [--compression blosc|none] [--limits]
 //                  [--keep DIR]   (keep the written files there)
 //                  [--sequence F] (instead: write frames 1..F of the hair spinning with the
 //                                  B-sim head, 90°/s about +Y at 24 fps, as hair.####.vdb —
@@ -23,12 +33,16 @@
 #include "tools/bench/bench_support.h"
 
 #include <Eigen/Geometry>
+#include <openvdb/io/Compression.h>
+#include <openvdb/openvdb.h>
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -56,6 +70,89 @@ double peakMiB() {
 
 void resetPeak() { std::ofstream("/proc/self/clear_refs") << "5"; }
 
+/// Counts what is written and keeps none of it.
+struct CountingBuffer : std::streambuf {
+    size_t bytes = 0;
+    std::streamsize xsputn(const char*, std::streamsize n) override {
+        bytes += size_t(n);
+        return n;
+    }
+    int overflow(int c) override {
+        ++bytes;
+        return c;
+    }
+};
+
+/// Best of 5 copies of `bytes` between two buffers on `threads` threads, in GB/s of bytes copied.
+double copyBandwidth(size_t bytes, int threads) {
+    std::vector<char> from(bytes, 1), to(bytes, 0);
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    double best = 1e30;
+    for (int r = 0; r < 5; ++r) {
+        const auto t = std::chrono::steady_clock::now();
+        const size_t chunk = bytes / size_t(threads);
+        tbb::parallel_for(0, threads, [&](int i) {
+            std::memcpy(to.data() + size_t(i) * chunk, from.data() + size_t(i) * chunk, chunk);
+        });
+        best = std::min(best, seconds(t));
+    }
+    return double(bytes) / best * 1e-9;
+}
+
+/// --limits: memory bandwidth, and OpenVDB's Blosc codec and a buffered file
+/// write on this frame's active values (one call per leaf, as the writer).
+void reportLimits(const StrandFrame& frame, double h) {
+    const size_t bytes = size_t(256) << 20;
+    std::printf("memcpy of 256 MiB (best of 5): %.2f GB/s on 1 thread, %.2f GB/s on 2\n", copyBandwidth(bytes, 1),
+                copyBandwidth(bytes, 2));
+    const DensityGrid grid = voxelize(frame, GridTransform::uniform(h));
+    std::vector<std::vector<float>> leaves(grid.blockCount());
+    std::vector<std::vector<openvdb::math::half>> halves(grid.blockCount());
+    size_t values = 0;
+    for (size_t b = 0; b < grid.blockCount(); ++b) {
+        for (int i = 0; i < DensityGrid::kBlockVoxels; ++i)
+            if (grid.blockDensity(b)[i] > 0) leaves[b].push_back(grid.blockDensity(b)[i]);
+        halves[b].assign(leaves[b].begin(), leaves[b].end());
+        values += leaves[b].size();
+    }
+    auto codec = [&](auto& data, const char* what) {
+        double best = 1e30;
+        size_t out = 0;
+        for (int r = 0; r < 3; ++r) {
+            CountingBuffer counter;
+            std::ostream os(&counter);
+            const auto t = std::chrono::steady_clock::now();
+            for (const auto& leaf : data)
+                openvdb::io::bloscToStream(os, reinterpret_cast<const char*>(leaf.data()), sizeof(leaf[0]), leaf.size());
+            best = std::min(best, seconds(t));
+            out = counter.bytes;
+        }
+        const double in = double(values * sizeof(data[0][0]));
+        std::printf("Blosc (OpenVDB io::bloscToStream, LZ4, per leaf, 1 thread) on %zu active %s values: %.0f MB/s "
+                    "(%.3f s), %.1f -> %.1f MiB\n",
+                    values, what, in / best * 1e-6, best, in / (1 << 20), double(out) / (1 << 20));
+    };
+    openvdb::initialize();
+    codec(leaves, "float");
+    codec(halves, "half");
+    // The same values written uncompressed through a 4 MiB stream buffer, as the writer does.
+    const fs::path file = fs::temp_directory_path() / ("bench_vdb_limits_" + std::to_string(::getpid()));
+    double best = 1e30;
+    for (int r = 0; r < 3; ++r) {
+        std::vector<char> buffer(size_t(4) << 20);
+        std::ofstream out;
+        out.rdbuf()->pubsetbuf(buffer.data(), std::streamsize(buffer.size()));
+        const auto t = std::chrono::steady_clock::now();
+        out.open(file, std::ios::binary | std::ios::trunc);
+        for (const auto& leaf : leaves) out.write(reinterpret_cast<const char*>(leaf.data()), std::streamsize(leaf.size() * 4));
+        out.close();
+        best = std::min(best, seconds(t));
+    }
+    fs::remove(file);
+    std::printf("uncompressed write of the float values (4 MiB stream buffer, page cache): %.0f MB/s (%.3f s)\n",
+                double(values * 4) / best * 1e-6, best);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -65,6 +162,9 @@ int main(int argc, char** argv) {
     int runs = 3, sequence = 0;
     VoxelizeSettings vs;
     VdbWriteSettings ws;
+    ws.halfFloat = true;  // the scene defaults (pipeline/scene/keys/vdb.yaml)
+    ws.compression = VdbCompression::None;
+    bool limits = false;
     fs::path keep;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -82,6 +182,8 @@ int main(int argc, char** argv) {
         else if (a == "--filter") vs.filter = next() == "box" ? VoxelFilter::Box : VoxelFilter::Trilinear;
         else if (a == "--velocity") vs.velocity = true;
         else if (a == "--half") ws.halfFloat = true;
+        else if (a == "--float") ws.halfFloat = false;
+        else if (a == "--limits") limits = true;
         else if (a == "--compression") ws.compression = next() == "none" ? VdbCompression::None : VdbCompression::Blosc;
         else if (a == "--keep") keep = next();
         else if (a == "--sequence") sequence = std::max(1, std::atoi(next().c_str()));
@@ -111,6 +213,10 @@ int main(int argc, char** argv) {
                 ws.halfFloat ? "half float" : "float",
                 ws.compression == VdbCompression::Blosc ? "blosc" : "no compression", runs);
 
+    if (limits) {
+        reportLimits(frame, voxels.front());
+        return 0;
+    }
     const fs::path dir = keep.empty() ? fs::temp_directory_path() / ("bench_vdb_" + std::to_string(::getpid())) : keep;
     fs::create_directories(dir);
     if (sequence > 0) {
@@ -148,7 +254,7 @@ int main(int argc, char** argv) {
         for (int n : threads) {
             tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(n));
             resetPeak();
-            std::vector<double> tv, tw, cv, cw;
+            std::vector<double> tv, tw, cv, cw, tf;
             size_t activeVoxels = 0, bytes = 0, blocks = 0;
             double massError = 0;
             const fs::path file = dir / ("hair_" + std::to_string(int(h * 1e6)) + "um.vdb");
@@ -171,14 +277,20 @@ int main(int argc, char** argv) {
                 writeDensityVdb(file, std::move(grid), info, ws);  // consumes the grid, as the stage does
                 tw.push_back(seconds(t));
                 cw.push_back(bench::processCpuSeconds() - c);
+                tf.push_back(tv.back() + tw.back());
                 bytes = size_t(fs::file_size(file));
             }
-            const bench::Stats v = bench::stats(tv), w = bench::stats(tw), vc = bench::stats(cv), wc = bench::stats(cw);
-            std::printf("voxel %.2f mm, %d thread%s: voxelize %.3f s [%.3f-%.3f] (cpu %.3f s), "
+            const double peak = peakMiB();
+            // The file's own mass error (read back outside the timings).
+            const double fileMassError = std::abs(readDensityVdb(file).density.totalVolume() - volume) / volume;
+            const bench::Stats v = bench::stats(tv), w = bench::stats(tw), vc = bench::stats(cv), wc = bench::stats(cw),
+                               f = bench::stats(tf);
+            std::printf("voxel %.2f mm, %d thread%s: frame %.3f s [%.3f-%.3f] = voxelize %.3f s [%.3f-%.3f] (cpu %.3f s) + "
                         "write %.3f s [%.3f-%.3f] (cpu %.3f s), file %.1f MiB, %zu active voxels in %zu leaves, "
-                        "peak RSS %.0f MiB, mass error %.2e\n",
-                        h * 1e3, n, n == 1 ? " " : "s", v.median, v.min, v.max, vc.median, w.median, w.min, w.max,
-                        wc.median, double(bytes) / (1 << 20), activeVoxels, blocks, peakMiB(), massError);
+                        "peak RSS %.0f MiB, mass error %.2e (file %.2e)\n",
+                        h * 1e3, n, n == 1 ? " " : "s", f.median, f.min, f.max, v.median, v.min, v.max, vc.median,
+                        w.median, w.min, w.max, wc.median, double(bytes) / (1 << 20), activeVoxels, blocks, peak,
+                        massError, fileMassError);
             std::fflush(stdout);
         }
     }
