@@ -31,6 +31,8 @@ GuideSettings guideSettings(const Scene& scene) {
         {"hair.material.tapered", &GuideSettings::taperedFibre},
         {"simulation.preload_probes", &GuideSettings::preloadProbes},
         {"simulation.preload", &GuideSettings::preload},
+        {"simulation.preload_contact", &GuideSettings::preloadContact},
+        {"simulation.preload_reach", &GuideSettings::preloadReach},
         {"simulation.head_collision", &GuideSettings::headCollision},
         {"simulation.strand_collision", &GuideSettings::strandCollision},
         {"simulation.strands_per_world", &GuideSettings::strandsPerWorld},

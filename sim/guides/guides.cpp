@@ -61,6 +61,7 @@ void GuideSettings::validate() const {
     check(formulation != GuideFormulation::Rod || rootRadius > 0.f, "the rod needs a fibre radius (root radius) > 0");
     check(rodSubsteps >= 1, "rod substeps must be ≥ 1");
     check(preloadProbes >= 0, "pre-load probes must be ≥ 0");
+    check(preloadReach >= 0.f, "pre-load reach must be ≥ 0");
     check(friction >= 0.f, "friction must be ≥ 0");
     check(bendLimit > 0.f && bendLimit < 180.f, "bend limit must be in (0, 180) degrees");
     check(twistLimit > 0.f && twistLimit < 90.f, "twist limit must be in (0, 90) degrees");
@@ -284,6 +285,7 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
         ctx.h = s.timeStep / float(s.substeps);
         ctx.headTransform = head.transform;
         ctx.headCollision = false;
+        ctx.head.collider = head.collider.get();  // at the first frame's pose: the rod's pre-load leans on it
         m.forGroups([&](guides::GuideGroup& grp) { grp.preload(ctx); });
     }
     m.skeleton.start(head);

@@ -104,6 +104,12 @@ struct GuideSettings : StepSettings {
     float friction = 0.2f;          ///< Coulomb friction against the head and between strands
     Vec3f gravity = Vec3f(0.f, -9.81f, 0.f);  ///< m/s²
     bool preload = true;            ///< pre-load the springs so the rest shape holds under gravity at t0
+    /// rod: the pre-load leans on the head where the groom lies on it (the head
+    /// carries what lies on it, rest curvature what hangs free: rod::preload);
+    /// false (the default until the shot's still head holds it: docs/physics.md):
+    /// every vertex's full weight goes into rest curvature.
+    bool preloadContact = false;
+    float preloadReach = 0.001f;    ///< rod: a vertex within collisionRadius + this of the head leans on it, m
 
     // Joint limits (Gomes 2024: ±30° about the bending axes, ±10° twist, soft).
     float bendLimit = 30.f;         ///< deg

@@ -30,6 +30,7 @@
 // under-converged) was not measured.
 #include "sim/guides/guide_group.h"
 #include "sim/guides/rod_kernels.h"
+#include "sim/guides/rod_preload.h"
 
 #include <algorithm>
 #include <utility>
@@ -95,7 +96,15 @@ class RodGroup final : public GuideGroup {
         // From rest a BDF2 step is the implicit Euler step of h' (rod::bdf2Step).
         float h = ctx.h / float(std::max(1, set_.settings.rodSubsteps));
         if (bdf2()) h = rod::bdf2Step(h);
-        for (size_t g = begin_; g < end_; ++g) computeCurvature(g, set_.settings.preload ? h : 0.f);
+        // The head at the first frame, where the groom may lean on it
+        // (ctx.head: the collider posed there; headCollision is off during
+        // the pre-load so that no other formulation projects).
+        const GuideSettings& s = set_.settings;
+        rod::PreloadContact contact;
+        if (s.preloadContact && s.headCollision && ctx.head.collider) contact.head = &ctx.head;
+        contact.radius = s.collisionRadius;
+        contact.reach = s.preloadReach;
+        for (size_t g = begin_; g < end_; ++g) computeCurvature(g, s.preload ? h : 0.f, contact);
     }
     void substep(const SubstepContext& ctx) override;
     size_t takePinned() override { return std::exchange(pinned_, size_t(0)); }
@@ -125,8 +134,8 @@ class RodGroup final : public GuideGroup {
     }
     /// Rest curvatures of guide g from its rest shape at the end-of-step
     /// root; with a pre-load step h > 0, the rest shape is made a static
-    /// equilibrium of steps of h under gravity (rod::preload).
-    void computeCurvature(size_t g, float preloadStep) {
+    /// equilibrium of steps of h under gravity and the head's contact (rod::preload).
+    void computeCurvature(size_t g, float preloadStep, const rod::PreloadContact& contact = {}) {
         const Mat3f R = set_.rootRot1[g].toRotationMatrix();
         std::vector<Vec3f> x(size_t(set_.vertices));
         set_.restShape(g, set_.rootPos1[g], R, x.data());
@@ -134,7 +143,8 @@ class RodGroup final : public GuideGroup {
         rod::Vec2f* c = &curvature_[(g - begin_) * size_t(set_.segments)];
         rod::restCurvature(s, x.data(), R, c);
         if (preloadStep > 0.f)
-            rod::preload(s, x.data(), R, set_.settings.gravity, preloadStep, set_.settings.preloadProbes, c, scratch_);
+            rod::preload(s, x.data(), R, set_.settings.gravity, preloadStep, set_.settings.preloadProbes, contact, c,
+                         scratch_);
     }
 
     const double bendStiffness_;  ///< EI at the root (> 0: the guides bend)

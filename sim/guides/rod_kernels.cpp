@@ -1,6 +1,5 @@
 #include "sim/guides/rod_kernels.h"
 
-#include <Eigen/LU>
 
 #include <algorithm>
 #include <cmath>
@@ -47,9 +46,8 @@ Vec2f bendConstraint(const Vec3f& u, float parentLen, const Vec3f& e, const Vec3
     return Vec2f(C[0], C[1]);
 }
 
-void preloadOffset(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f* force, Vec2f* c) {
+Eigen::MatrixXd equilibriumMatrix(const RodStrand& s, const Vec3f* x, const Mat3f& R) {
     const int S = s.vertices - 1;
-    if (s.bendStiffness <= 0) return;
     Eigen::MatrixXd Jt = Eigen::MatrixXd::Zero(3 * S, 3 * S);
     forJoints(s, x, R, [&](int j, const Vec3f& u, float ulen, const Vec3f& e, const Vec3f& a, bool ghost) {
         Vec3f g[2][3];
@@ -66,16 +64,7 @@ void preloadOffset(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec
             }
         }
     });
-    Eigen::VectorXd f(3 * S);
-    for (int v = 1; v <= S; ++v)
-        for (int k = 0; k < 3; ++k) f[3 * (v - 1) + k] = -double(force[v][k]);
-    // Jᵀ is block triangular from the tip (vertex n-1 appears only in the
-    // last joint's three rows), so it is invertible.
-    const Eigen::VectorXd lambda = Jt.fullPivLu().solve(f);
-    for (int j = 0; j < S; ++j) {
-        const double alpha = voronoiLength(s, j) / stiffnessAt(s, j);
-        c[j] += Vec2f(float(alpha * lambda[3 * j]), float(alpha * lambda[3 * j + 1]));
-    }
+    return Jt;
 }
 
 void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec2f* c) {
@@ -83,30 +72,6 @@ void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec2f* c)
         Vec3f g[2][3];
         c[j] = bendConstraint(u, ulen, e, a, Vec2f::Zero(), ghost, g);  // C_j(x) = 0
     });
-}
-
-void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gravity, float h, int probes,
-             Vec2f* c, RodScratch& sc) {
-    const int n = s.vertices;
-    std::vector<Vec3f> f(size_t(n), Vec3f::Zero()), xt(size_t(n), Vec3f::Zero()), vt(size_t(n), Vec3f::Zero());
-    for (int i = 1; i < n; ++i) f[size_t(i)] = gravity / s.invMass[i];
-    preloadOffset(s, x, R, f.data(), c);
-    // The analytic pre-load balances the forces at x; rodStep linearises at
-    // its prediction y = x + h²g, about a millimetre away. Each probe step
-    // from rest measures the drift δ that remains and cancels its force
-    // M·δ/h² the same way. How much each probe gains depends on the strand:
-    // ~10× on a free strand, ~1.2× on the default shot's settled guides,
-    // whose median drift per step goes 9.3 → 7.2 → 6.5 → 6.0 µm with 0, 1,
-    // 2, 3 probes (simulation.preload_probes says so to the user).
-    for (int probe = 0; probe < probes; ++probe) {
-        for (int i = 0; i < n; ++i) {
-            xt[size_t(i)] = x[i];
-            vt[size_t(i)] = Vec3f::Zero();
-        }
-        rodStep(s, xt.data(), vt.data(), x[0], R, gravity, h, 0.f, 0.f, nullptr, 0.f, sc);
-        for (int i = 1; i < n; ++i) f[size_t(i)] = (xt[size_t(i)] - x[i]) / (s.invMass[i] * h * h);
-        preloadOffset(s, x, R, f.data(), c);
-    }
 }
 
 double bendEnergy(const RodStrand& s, const Vec3f* x, const Mat3f& rootFrame) {

@@ -168,18 +168,14 @@ Vec3f frameStart(const Mat3f& R, const Vec3f& d);
 /// root frame R: C_j(x) = 0, so x is the stress-free shape.
 void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec2f* c);
 
-/// Adds to c the pre-load that balances per-vertex forces f at x:
-///   Σ_r ∇C_r Λ_r = -f  (the free vertices: 3(n-1) equations, 2(n-1) bend
-///   and n-1 stretch multipliers),  c_j += (l̄_j/EI_j)·Λ_bend,j,
-/// since a bend row's force multiplier is Λ = -C/α = (c - κ)/α.
-void preloadOffset(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f* force, Vec2f* c);
-
-/// Pre-loads c (holding the rest curvatures) so that x is a static
-/// equilibrium of rodStep with step h under gravity: preloadOffset for the
-/// weights, then `probes` probe steps from rest, each cancelling the drift
-/// left (GuideSettings::preloadProbes).
-void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gravity, float h, int probes,
-             Vec2f* c, RodScratch& scratch);
+/// The equilibrium matrix Jᵀ of a strand at x: the gradients of its
+/// constraints with respect to the free vertices x_1..x_{n-1}, one column
+/// per constraint row (joint j: columns 3j, 3j+1 its two bend rows, 3j+2
+/// its stretch row; row 3(i-1)+k: vertex i's coordinate k), the stretch
+/// rows' gradients d_j. Square (3(n-1)) and invertible: block triangular
+/// from the tip (vertex n-1 appears only in the last joint's rows). The
+/// pre-load solves with it (sim/guides/rod_preload.h).
+Eigen::MatrixXd equilibriumMatrix(const RodStrand& s, const Vec3f* x, const Mat3f& R);
 
 /// One XPBD step of length h for one strand (x: positions at the step's
 /// start, v: velocities; root at rootPos with frame rootFrame at the end):

@@ -1,0 +1,215 @@
+// The rod's pre-load leaning on the head (sim/guides/rod_preload.h): a
+// strand lying on a sphere's top is a static equilibrium at the start, and
+// when the sphere turns over, the strand falls away from it instead of
+// standing on the rest curvature of a cantilever; a strand hanging free of
+// the head is still held in its groomed shape; the non-negative
+// least-squares solve against a problem whose answer is known.
+#include "rod_cases.h"
+#include "sim/guides/rod_preload.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+using namespace hp;
+using namespace hp::rodcases;
+
+namespace {
+
+constexpr float kRadius = 0.1f;  ///< the sphere's, m (a head's size)
+
+/// A strand on a sphere of kRadius about the origin, its root fixed to the
+/// sphere, which turns about z by turn(t) radians (the collider is the same
+/// sphere whatever the turn; the root and its frame turn with it).
+struct OnSphere {
+    GuideSolver solver;
+    SurfaceFrame root;
+    std::function<float(double)> turn = [](double) { return 0.f; };
+    float maxSpeed = 0.f;  ///< over the last step
+
+    OnSphere(const GuideSettings& s, const std::vector<Vec3f>& groom, const SurfaceFrame& r) : solver(s), root(r) {
+        const std::vector<std::vector<Vec3f>> grooms{groom};
+        solver.initialize({root}, pose(0.0), &grooms);
+    }
+    HeadPose pose(double t) const {
+        HeadPose p;
+        p.time = t;
+        p.transform = Eigen::Isometry3f(Eigen::AngleAxisf(turn(t), Vec3f::UnitZ()));
+        p.collider = std::make_shared<SphereCollider>(Vec3f::Zero(), kRadius);
+        return p;
+    }
+    void run(double seconds) {
+        const int steps = int(std::lround(seconds / solver.settings().timeStep));
+        for (int k = 0; k < steps; ++k) {
+            const HeadPose p = pose(solver.nextTime());
+            const Eigen::Matrix3f R = p.transform.linear();
+            SurfaceFrame f;
+            f.position = R * root.position;
+            f.normal = R * root.normal;
+            f.tangent = R * root.tangent;
+            solver.step({f}, p);
+        }
+        const StrandFrame f = frame();
+        maxSpeed = 0.f;
+        for (const Vec3f& v : f.velocities) maxSpeed = std::max(maxSpeed, v.norm());
+    }
+    StrandFrame frame() const {
+        StrandFrame f;
+        solver.write(f);
+        return f;
+    }
+};
+
+GuideSettings onHead(float length, bool contact) {
+    GuideSettings s = rodSettings(3.8e9f, 1.f, true);
+    s.length = length;
+    s.headCollision = true;
+    s.preloadContact = contact;
+    return s;
+}
+
+/// A strand combed flat over the sphere's top toward +x: its vertices on
+/// the circle of radius kRadius + the collision radius (where the step
+/// keeps them), from the top down through `length` of arc.
+std::vector<Vec3f> lyingOnTop(const GuideSettings& s) {
+    const float rho = kRadius + s.collisionRadius, l = s.length / float(s.segments);
+    const float step = 2.f * std::asin(l / (2.f * rho));  // the chord of one segment
+    std::vector<Vec3f> x(size_t(s.segments) + 1);
+    for (int i = 0; i <= s.segments; ++i)
+        x[size_t(i)] = rho * Vec3f(std::sin(step * float(i)), std::cos(step * float(i)), 0.f);
+    return x;
+}
+
+SurfaceFrame topRoot(const GuideSettings& s) {
+    SurfaceFrame r;
+    r.position = Vec3f(0.f, kRadius + s.collisionRadius, 0.f);
+    r.normal = Vec3f::UnitY();
+    r.tangent = Vec3f::UnitZ();
+    return r;
+}
+
+}  // namespace
+
+TEST(RodPreload, NonNegativeLeastSquaresMatchesTheKnownOptimum) {
+    // min |λ - b|² over λ ≥ 0 with A = I is max(b, 0) componentwise; with a
+    // full A whose unconstrained optimum is feasible it is A⁻¹b.
+    Eigen::VectorXd b(4);
+    b << 1.5, -2.0, 0.25, -1e-3;
+    const Eigen::VectorXd x = rod::nonNegativeLeastSquares(Eigen::MatrixXd::Identity(4, 4), b);
+    for (int i = 0; i < 4; ++i) EXPECT_NEAR(x[i], std::max(b[i], 0.0), 1e-12) << i;
+    Eigen::MatrixXd A(3, 2);
+    A << 1, 1, 0, 1, 1, 0;
+    const Eigen::Vector2d inside(0.5, 2.0);
+    const Eigen::VectorXd y = rod::nonNegativeLeastSquares(A, A * inside);
+    EXPECT_NEAR(y[0], inside[0], 1e-12);
+    EXPECT_NEAR(y[1], inside[1], 1e-12);
+    // Optimum on the bound: b = (0, 2, -1) pulls λ0 below 0. With λ0 = 0 the
+    // best λ1 projects b on A's second column (1, 1, 0): λ1 = 2/2 = 1, and
+    // the residual (-1, 1, -1) gives w0 = -2 < 0, w1 = 0 (Kuhn-Tucker).
+    Eigen::Vector3d c(0.0, 2.0, -1.0);
+    const Eigen::VectorXd z = rod::nonNegativeLeastSquares(A, c);
+    EXPECT_NEAR(z[0], 0.0, 1e-12);
+    EXPECT_NEAR(z[1], 1.0, 1e-12);
+}
+
+TEST(RodPreload, StrandLyingOnTheHeadIsAnEquilibrium) {
+    // 15 cm combed flat over the top of a 10 cm sphere (85° of arc): the
+    // sphere carries its weight where it lies (the normal component; the
+    // tangential one pulls along the strand, a tension), so the pre-load
+    // needs almost no rest curvature and the strand is an equilibrium: after
+    // 0.5 s no vertex moves faster than 1% of the speed one free step of
+    // gravity gives (g·h).
+    const GuideSettings s = onHead(0.15f, true);
+    OnSphere still(s, lyingOnTop(s), topRoot(s));
+    still.run(0.5);
+    const float bound = 0.01f * float(kG) * s.timeStep;
+    RecordProperty("lying_speed_um_per_s", std::to_string(still.maxSpeed * 1e6f));
+    EXPECT_LT(still.maxSpeed, bound) << "the strand lying on the sphere moves";
+    float moved = 0;
+    const std::vector<Vec3f> groom = lyingOnTop(s);
+    for (size_t i = 0; i < groom.size(); ++i) moved = std::max(moved, (still.frame().positions[i] - groom[i]).norm());
+    RecordProperty("lying_moved_um", std::to_string(moved * 1e6f));
+    EXPECT_LT(moved, s.preloadReach) << "the strand lying on the sphere slid or sagged";
+
+}
+
+TEST(RodPreload, HeadCarriesWhatLiesOnItAndRestCurvatureWhatHangs) {
+    // The same strand lying over the sphere's top, pre-loaded by the kernel
+    // directly. The sphere can carry the normal component of each vertex's
+    // weight, and the tangential one pulls along the strand (a tension in
+    // the stretch rows), so a rest state that leans on the sphere needs
+    // almost no extra curvature: the elastic energy the pre-load stores,
+    // Σ EI/(2 l̄)·|Δc_j|², must be below 1% of what a pre-load ignoring the
+    // sphere stores (all the weight held up as a cantilever).
+    const GuideSettings s = onHead(0.15f, true);
+    const std::vector<Vec3f> x = lyingOnTop(s);
+    const int n = int(x.size());
+    const rod::Material m = material(s);
+    std::vector<float> rest(size_t(n - 1)), invMass(size_t(n), 0.f);
+    for (int j = 0; j + 1 < n; ++j) rest[size_t(j)] = (x[size_t(j) + 1] - x[size_t(j)]).norm();
+    for (int j = 0; j + 1 < n; ++j) {
+        const float half = float(0.5 * m.massPerLength() * rest[size_t(j)]);
+        if (j > 0) invMass[size_t(j)] += half;
+        invMass[size_t(j) + 1] += half;
+    }
+    for (int i = 1; i < n; ++i) invMass[size_t(i)] = 1.f / invMass[size_t(i)];
+    std::vector<rod::Vec2f> c(size_t(n - 1));
+    rod::RodStrand strand;
+    strand.vertices = n;
+    strand.restLength = rest.data();
+    strand.invMass = invMass.data();
+    strand.restCurvature = c.data();
+    strand.ghostDir = (x[1] - x[0]).normalized();  // root frame = world
+    strand.bendStiffness = m.bendStiffness();
+    const SphereCollider sphere(Vec3f::Zero(), kRadius);
+    strand::HeadQuery head;
+    head.collider = &sphere;
+    const float h = s.timeStep / float(s.substeps * s.rodSubsteps);
+    auto preloadEnergy = [&](bool lean) {
+        rod::restCurvature(strand, x.data(), rod::Mat3f::Identity(), c.data());
+        const std::vector<rod::Vec2f> c0 = c;
+        rod::PreloadContact contact;
+        contact.head = lean ? &head : nullptr;
+        contact.radius = s.collisionRadius;
+        contact.reach = s.preloadReach;
+        rod::RodScratch scratch;
+        rod::preload(strand, x.data(), rod::Mat3f::Identity(), s.gravity, h, s.preloadProbes, contact, c.data(),
+                     scratch);
+        double e = 0;
+        for (int j = 0; j + 1 < n; ++j)
+            e += m.bendStiffness() / (2.0 * rod::voronoiLength(strand, j)) * double((c[size_t(j)] - c0[size_t(j)]).squaredNorm());
+        return e;
+    };
+    const double leaning = preloadEnergy(true), cantilever = preloadEnergy(false);
+    RecordProperty("preload_energy_leaning_nJ", std::to_string(leaning * 1e9));
+    RecordProperty("preload_energy_cantilever_nJ", std::to_string(cantilever * 1e9));
+    EXPECT_GT(cantilever, 0.0);
+    EXPECT_LT(leaning, 0.01 * cantilever) << "the pre-load still holds up what lies on the sphere";
+}
+
+TEST(RodPreload, StrandHangingFreeOfTheHeadKeepsItsGroom) {
+    // Combed out sideways from the sphere's side and turning down, clear of
+    // the sphere: nothing to lean on, so the rest curvature carries the
+    // whole weight as before, and the groom holds (within 1 mm in 1 s, as
+    // the pre-load's test without a head asks).
+    const GuideSettings s = onHead(kLength, true);
+    std::vector<Vec3f> x(size_t(s.segments) + 1);
+    const float l = kLength / float(s.segments);
+    x[0] = Vec3f(kRadius + s.collisionRadius, 0.f, 0.f);
+    for (int i = 0; i < s.segments; ++i) {
+        const float a = 0.6f * float(i) / float(s.segments);
+        x[size_t(i) + 1] = x[size_t(i)] + l * Vec3f(std::cos(a), -std::sin(a), 0.2f * std::sin(2.f * a)).normalized();
+    }
+    SurfaceFrame r;
+    r.position = x[0];
+    r.normal = Vec3f::UnitX();
+    r.tangent = Vec3f::UnitZ();
+    OnSphere held(s, x, r);
+    held.run(1.0);
+    float moved = 0;
+    for (size_t i = 0; i < x.size(); ++i) moved = std::max(moved, (held.frame().positions[i] - x[i]).norm());
+    RecordProperty("free_moved_um", std::to_string(moved * 1e6f));
+    EXPECT_LE(moved, 1e-3f) << "the pre-loaded groom moved " << moved * 1000 << " mm in 1 s";
+}
