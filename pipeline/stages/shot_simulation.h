@@ -84,6 +84,12 @@ class ShotSimulation {
     const HeadSetup& head() const { return head_; }
     size_t guideCount() const;
     size_t followerCount() const;
+    /// Per strand of a frame (guides, then followers): the head's parts it
+    /// ignores (bit k: part k; sim/collision/mesh_parts.h), those its root
+    /// lies inside at the first frame. Depth "inside" is measured with
+    /// pose().collider->signedDistanceIgnoring(p, nullptr, mask). The guides
+    /// (rod) collide so; followers collide with every part.
+    const std::vector<uint32_t>& ignoredParts() const { return ignoredParts_; }
 
     /// False for models whose state cannot be restored bit for bit (the rigid
     /// formulation keeps orientations and warm-start impulses inside Bullet).
@@ -136,6 +142,7 @@ class ShotSimulation {
     StepStats pending_;  ///< steps since the last output frame
     double pendingHeadMs_ = 0;
     size_t pendingSteps_ = 0;
+    std::vector<uint32_t> ignoredParts_;  ///< ignoredParts()
     SettledGroom settled_;  ///< the settling's report (strands moved into the model)
     bool settleRan_ = false;
     std::optional<FollowerSource> source_, previousSource_;  ///< cachedGuides()
