@@ -9,11 +9,11 @@
 //   the head by the definition of docs/colliders.md (the parts its root
 //   lies inside ignored);
 // - the strands are the same on both thread counts.
-// Not yet met: on the tip clip the fold buries roots on the sphere's
-// underside under the neck as it turns, and followers grown inside the
-// other part are still pushed out of it (they do not ignore it): there the
-// depth is recorded (worst_*_depth_um) but not bounded; docs/benchmarks.md
-// has the figures.
+// Not yet met: on the tip clip, where the sphere folds down onto the neck,
+// guide vertices end up to 13 mm and pinned follower vertices up to 56 mm
+// inside (200 guides, 5 000 followers; docs/benchmarks.md, B-sim-fold); the
+// followers do not ignore parts yet. There the depth is recorded
+// (worst_*_depth_um) but not bounded.
 // Counts are cut to 60 guides and 600 followers (the scenes have 200 and
 // 5 000); the failures showed at these counts.
 #include "pipeline/scene/scene.h"
@@ -24,7 +24,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 using namespace hp;
 using namespace hp::test;
@@ -77,12 +79,15 @@ std::vector<StrandFrame> run(const char* scene, int threads, bool boundDepth, Wo
 Worst checkClip(const char* scene, bool boundDepth) {
     Worst w;
     const std::vector<StrandFrame> one = run(scene, 1, boundDepth, w), two = run(scene, 2, boundDepth, w);
-    RecordProperty("worst_stretch_e9", int(w.stretch * 1e9f));
-    RecordProperty("worst_guide_depth_um", int(w.guideDepth * 1e6f));
-    RecordProperty("worst_follower_depth_um", int(w.followerDepth * 1e6f));
-    RecordProperty("most_pinned_guide_vertices", int(w.pinned));
-    ASSERT_EQ(one.size(), two.size());
-    for (size_t k = 0; k < one.size(); ++k) EXPECT_EQ(one[k].positions, two[k].positions) << "frame index " << k;
+    ::testing::Test::RecordProperty("worst_stretch_e9", int(w.stretch * 1e9f));
+    ::testing::Test::RecordProperty("worst_guide_depth_um", int(w.guideDepth * 1e6f));
+    ::testing::Test::RecordProperty("worst_follower_depth_um", int(w.followerDepth * 1e6f));
+    ::testing::Test::RecordProperty("most_pinned_guide_vertices", int(w.pinned));
+    EXPECT_EQ(one.size(), two.size());
+    for (size_t k = 0; k < std::min(one.size(), two.size()); ++k)
+        EXPECT_EQ(one[k].positions, two[k].positions) << "frame index " << k;
+    std::printf("%s: worst stretch %.2e, depth guides %.3f mm, followers %.3f mm, most pinned guide vertices %zu\n",
+                scene, double(w.stretch), 1e3 * double(w.guideDepth), 1e3 * double(w.followerDepth), w.pinned);
     return w;
 }
 
@@ -91,6 +96,10 @@ Worst checkClip(const char* scene, bool boundDepth) {
 TEST(FoldHead, TipClipKeepsLengthsOnOneAndTwoThreads) { checkClip("scenes/fold_tip.yaml", false); }
 
 TEST(FoldHead, JumpClipIsOneCutKeepsLengthsAndClearanceOnOneAndTwoThreads) {
-    // The jump the file interpolates over three steps is one cut on each run.
-    EXPECT_EQ(checkClip("scenes/fold_jump.yaml", true).cuts, 2u);
+    // The jump the file interpolates over three steps is one cut on each run,
+    // and none of its steps is simulated as motion: no vertex pinned (its
+    // last step, 8 cm, pinned guide vertices before it joined the cut).
+    const Worst w = checkClip("scenes/fold_jump.yaml", true);
+    EXPECT_EQ(w.cuts, 2u);
+    EXPECT_EQ(w.pinned, 0u);
 }

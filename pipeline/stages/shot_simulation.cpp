@@ -204,13 +204,10 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame, c
     evaluateRoots(pose_.mesh, roots_.guides, guideFrames_);
     initializeGuides(settings, imported.get(), settleCache);
     // A head that folds into itself: each strand ignores the parts its root
-    // lies inside at the first frame (docs/colliders.md).
-    ignoredParts_ = partsAroundRoots(head_.motion->partition(), pose_.mesh, roots_.guides);
-    model_->setIgnoredParts(ignoredParts_);
-    const std::vector<uint32_t> followerParts = partsAroundRoots(head_.motion->partition(), pose_.mesh, roots_.followers);
-    ignoredParts_.insert(ignoredParts_.end(), followerParts.begin(), followerParts.end());
+    // lies inside (docs/colliders.md), pose by pose.
+    updateIgnoredParts(pose_.mesh);
     if (std::any_of(ignoredParts_.begin(), ignoredParts_.end(), [](uint32_t m) { return m != 0; }))
-        logInfo("head: ", head_.motion->partition().count(), " parts overlap; ",
+        logInfo("head: ", head_.motion->partition().count(), " parts overlap; at the first frame ",
                 std::count_if(ignoredParts_.begin(), ignoredParts_.end(), [](uint32_t m) { return m != 0; }),
                 " strands grow inside another part and ignore it");
 
@@ -248,6 +245,18 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame, c
     stats_.settleEnergy = settled_.kineticEnergy;
     stats_.settleConverged = settled_.converged;
     stats_.settleCached = settled_.fromCache;
+}
+
+void ShotSimulation::updateIgnoredParts(const TriangleMesh& mesh) {
+    const MeshPartition& parts = head_.motion->partition();
+    if (parts.count() < 2) {
+        ignoredParts_.assign(roots_.guides.size() + roots_.followers.size(), 0u);
+        return;
+    }
+    ignoredParts_ = partsAroundRoots(parts, mesh, roots_.guides);
+    model_->setIgnoredParts(ignoredParts_);
+    const std::vector<uint32_t> followers = partsAroundRoots(parts, mesh, roots_.followers);
+    ignoredParts_.insert(ignoredParts_.end(), followers.begin(), followers.end());
 }
 
 void ShotSimulation::initializeGuides(const GuideSettings& settings, const ImportedGroom* imported,
@@ -327,6 +336,10 @@ void ShotSimulation::stepTo(int frame) {
         const auto headStart = std::chrono::steady_clock::now();
         const HeadPose pose = head_.motion->sample(t);
         evaluateRoots(pose.mesh, roots_.guides, guideFrames_);
+        // A head that folds into itself: the parts each guide's root lies
+        // inside at the step's end, which the fold changes as it moves.
+        if (head_.motion->partition().count() > 1)
+            model_->setIgnoredParts(partsAroundRoots(head_.motion->partition(), pose.mesh, roots_.guides));
         pendingHeadMs_ += msSince(headStart);
         const StepStats s = model_->step(guideFrames_, pose);
         if (pendingSteps_++ == 0) pending_ = s;
@@ -347,6 +360,7 @@ void ShotSimulation::produceFrame(double time) {
     pose_ = head_.motion->sample(time);
     evaluateRoots(pose_.mesh, roots_.guides, guideFrames_);
     evaluateRoots(pose_.mesh, roots_.followers, followerFrames_);
+    if (head_.motion->partition().count() > 1) updateIgnoredParts(pose_.mesh);
     const double headMs = pendingHeadMs_ + msSince(headStart);
 
     // The guides are written into the frame in place; the followers are

@@ -8,12 +8,13 @@
 // - The head's solid is the union of its parts' solids, with signed distance
 //   φ(p) = min_k φ_k(p): exact outside the union; inside, the depth into the
 //   part that holds p deepest (a lower bound of the depth into the union).
-// - A strand whose root lies inside another part at the first frame
-//   (φ_k(root) < 0 for a part k other than the root's own) ignores that
-//   part: its vertices collide with φ_s(p) = min over the parts it does not
-//   ignore. Hair grown under another part's surface is neither pushed
-//   through that surface nor counted as inside it. A strand's depth, as
-//   the statistics and tests report it, is -φ_s at its free vertices.
+// - A strand whose root lies inside another part at a pose (φ_k(root) < 0
+//   for a part k other than the root's own) ignores that part there: its
+//   vertices collide with φ_s(p) = min over the parts it does not ignore.
+//   Hair grown under another part's surface, or whose root a fold carries
+//   under it, is neither pushed through that surface nor counted as inside
+//   it. A strand's depth, as the statistics and tests report it, is -φ_s at
+//   its free vertices.
 #pragma once
 
 #include "sim/strands/head.h"
@@ -63,8 +64,8 @@ class PartsCollider final : public Collider {
 
 /// @brief Per root, the parts it lies inside: bit k set when φ_k(root) <
 /// -tolerance for a part k other than the part of the root's triangle,
-/// measured exactly (MeshCollider of each part) on `mesh`, the pose the
-/// strands start from. All zero for a mesh of one part.
+/// measured exactly (MeshCollider of each part) on `mesh`, the pose it is
+/// asked for. All zero for a mesh of one part.
 std::vector<uint32_t> partsAroundRoots(const MeshPartition& partition, const TriangleMesh& mesh,
                                        const std::vector<SurfacePoint>& roots, float tolerance = 1e-5f);
 

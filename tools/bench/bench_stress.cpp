@@ -12,7 +12,9 @@
 //
 //   bench_stress [--scene scenes/stress.yaml] [--threads 2] [--set key=value ...] [--per-frame]
 //
-// --per-frame adds a line per frame: the deepest guide and follower vertex,
+// --per-frame adds a line per frame: the deepest guide and follower vertex
+// (and, on a head that folds into itself, the deepest vertex of a strand
+// whose root lies inside another part),
 // pinned guide vertices, and the followers' projected, bent, pinned and
 // left-inside vertices (FollowerStats).
 //
@@ -108,10 +110,14 @@ int stress(const std::string& path, const std::vector<std::string>& overrides, b
         if (d > depthWorst) depthWorst = d, depthFrame = frame;
         if (perFrame) {
             const SimFrameStats& st = sim.stats();
-            std::printf("frame %d: depth mm guides %.3f followers %.3f; guides pinned %zu; followers projected %zu, "
-                        "bent %zu, pinned %zu, left inside %zu (%.3f mm)\n",
+            float grown = 0.f;  // strands grown inside another part
+            for (size_t s = 0; s < depth.size(); ++s)
+                if (ignore[s]) grown = std::max(grown, depth[s]);
+            std::printf("frame %d: depth mm guides %.3f followers %.3f (grown inside another part %.3f); guides pinned "
+                        "%zu; followers projected %zu, bent %zu, pinned %zu, left inside %zu (%.3f mm)\n",
                         frame, 1e3 * *std::max_element(depth.begin(), depth.begin() + long(guides)),
-                        1e3 * *std::max_element(depth.begin() + long(guides), depth.end()), st.guides.pinnedCount,
+                        1e3 * *std::max_element(depth.begin() + long(guides), depth.end()), 1e3 * grown,
+                        st.guides.pinnedCount,
                         st.followerProjected, st.followers.bent, st.followers.pinned, st.followers.penetrationCount,
                         1e3 * st.followers.maxPenetration);
         }
