@@ -432,6 +432,8 @@ TEST(Guides, StatisticsAccumulateAndPrintAsJson) {
     b.penetrationCount = 3;
     b.msPerStep = 4;
     b.kineticEnergy = 0.5;
+    a.cuts = 1;  // cuts begun are summed: one per cut, however many steps it spans
+    b.cuts = 1;
     a.accumulate(b);
     EXPECT_DOUBLE_EQ(a.maxLengthError, 1e-6);
     EXPECT_DOUBLE_EQ(a.maxPenetration, 2e-4);
@@ -442,7 +444,7 @@ TEST(Guides, StatisticsAccumulateAndPrintAsJson) {
     const std::string line = a.json(12, 0.5);
     EXPECT_NE(line.find("\"frame\": 12"), std::string::npos) << line;
     EXPECT_NE(line.find("\"penetrations\": 3"), std::string::npos) << line;
-    EXPECT_NE(line.find("\"reset\": false}"), std::string::npos) << line;
+    EXPECT_NE(line.find("\"reset\": false, \"cuts\": 2}"), std::string::npos) << line;
     EXPECT_EQ(line.find('\n'), std::string::npos);
 }
 

@@ -2,10 +2,12 @@
 // pipeline/stages/head_source.h): scalp selection, groom roots, scene errors, the
 // frame source, `hairpipe info`, and the committed default head asset.
 #include "pipeline/head/default_head.h"
+#include "pipeline/head/fold_head.h"
 #include "pipeline/head/head_setup.h"
 #include "pipeline/stages/head_source.h"
 #include "render/image/image_io.h"
 #include "sim/collision/mesh_collider.h"
+#include "sim/collision/mesh_parts.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -92,6 +94,41 @@ TEST(DefaultHead, CommittedBodyIsWhatTheToolWrites) {
     EXPECT_EQ(loaded.meshes[0].name, "shoulders");
     ASSERT_EQ(loaded.clips.size(), 2u);
     EXPECT_EQ(loaded.clips[0].name, "nod_shake_turn") << "the head's clips, so the body plays the head's clip";
+}
+
+TEST(FoldHead, CommittedAssetIsWhatTheToolWritesAndFoldsIntoItself) {
+    // scenes/assets/fold.glb: `make_head OUT --fold`, the head of scenes/fold_*.yaml.
+    EXPECT_TRUE(committedAssetIsToolOutput("fold.glb", " --fold"));
+    HeadImportSettings s;
+    s.file = sourcePath("scenes/assets/fold.glb");
+    const HeadRig loaded = importHead(s);
+    ASSERT_EQ(loaded.meshes.size(), 1u) << "one skinned mesh";
+    EXPECT_EQ(loaded.boneCount(), 2u);
+    ASSERT_EQ(loaded.clips.size(), 2u);
+    EXPECT_EQ(loaded.clips[0].name, "fold_tip");
+    EXPECT_EQ(loaded.clips[1].name, "fold_jump");
+    // Two shells: the sphere (every vertex at 0.1 m from the origin) and the
+    // neck cylinder (at 0.045 m from the Y axis, or on a cap), whose top cap
+    // lies 4 cm inside the sphere.
+    const TriangleMesh rest = loaded.restMesh();
+    const MeshPartition parts = partitionMesh(rest, weldVertices(rest.positions));
+    ASSERT_EQ(parts.count(), 2u);
+    for (const Vec3f& p : parts.part(rest, 0).positions) ASSERT_NEAR(p.norm(), kFoldHeadRadius, 1e-6f);
+    float top = -1.f, bottom = 1.f;
+    for (const Vec3f& p : parts.part(rest, 1).positions) {
+        const float radial = Vec2f(p.x(), p.z()).norm();
+        const bool onCap = std::abs(p.y() - kFoldNeckTop) < 1e-6f ||
+                           std::abs(p.y() - (kFoldNeckTop - kFoldNeckLength)) < 1e-6f;
+        ASSERT_TRUE(std::abs(radial - kFoldNeckRadius) < 1e-6f || onCap) << p.transpose();
+        top = std::max(top, p.y()), bottom = std::min(bottom, p.y());
+    }
+    EXPECT_NEAR(top, -kFoldHeadRadius + 0.04f, 1e-6f);
+    EXPECT_NEAR(top - bottom, kFoldNeckLength, 1e-6f);
+    // fold_jump: the rig moves 0.5 m between two keys 1/30 s apart.
+    TriangleMesh before = rest, after = rest;
+    loaded.pose(1, kFoldJumpStart, before);
+    loaded.pose(1, kFoldJumpStart + 1.0 / 30.0, after);
+    EXPECT_NEAR((after.positions[0] - before.positions[0]).x(), kFoldJumpDistance, 1e-5f);
 }
 
 // Adult proportions (stature ~1.75 m): the shoulder tips (acromion) lie

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 
@@ -122,6 +123,39 @@ TEST(SceneCut, NoVertexInsideAnyColliderOnTheCutFrameAndAfter) {
     }
 }
 
+// A 0.5 m jump the head file interpolates linearly over 1/30 s, steps of
+// 1/72 s: the steps move 0.208, 0.208 and 0.083 m. The third moves less than
+// the cut distance but belongs to the same jump: one cut over three steps,
+// each restarting the strands at rest outside the head and the floor at
+// their exact lengths, none simulated as motion (no vertex pinned).
+TEST(SceneCut, JumpSpreadOverThreeStepsIsOneCut) {
+    GuideSettings s;
+    s.timeStep = 1.f / 72.f;
+    GuideSolver solver(s);
+    const float radius = 0.1f;
+    const std::vector<Vec3f> dirs = fibonacciCap(24, -Vec3f::UnitY(), 0.3f);
+    const double jumpStart = 10.0 / 72.0, jumpEnd = jumpStart + 1.0 / 30.0;
+    auto centreAt = [&](double t) {
+        const double a = std::clamp((t - jumpStart) / (jumpEnd - jumpStart), 0.0, 1.0);
+        return Vec3f(float(0.5 * a), 0.3f, 0.f);
+    };
+    HeadPose pose = headAt(0.0, centreAt(0.0), radius);
+    solver.initialize(roots(dirs, radius, pose), pose);
+    size_t cuts = 0;
+    StrandFrame frame;
+    for (int k = 1; k <= 20; ++k) {
+        pose = headAt(solver.nextTime(), centreAt(solver.nextTime()), radius);
+        const StepStats& st = solver.step(roots(dirs, radius, pose), pose);
+        cuts += st.cuts;
+        EXPECT_EQ(st.reset, k >= 11 && k <= 13) << "step " << k;
+        EXPECT_EQ(st.pinnedCount, 0u) << "step " << k;
+        EXPECT_LE(st.maxLengthError, 1e-4) << "step " << k;
+        solver.write(frame);
+        if (k >= 11 && k <= 13) EXPECT_EQ(deepest(frame, *pose.collider), 0.f) << "step " << k;
+    }
+    EXPECT_EQ(cuts, 1u);
+}
+
 TEST(SceneCut, InfoListsTheCutsOfTheClip) {
     TempDir dir;
     const fs::path scene = writeSmallScene(dir.path(), "1-12");
@@ -139,6 +173,11 @@ TEST(SceneCut, InfoListsTheCutsOfTheClip) {
     const ProcessResult looser =
         runHairpipe("info " + q(scene) + " --set 'head.animate.yaw=[[1, 0], [6, 0], [6.2, 120]]' --set simulation.cut_angle=150 --set simulation.cut_distance=0.2");
     EXPECT_NE(looser.output.find("cuts:    0 "), std::string::npos) << looser.output;
+    // The folding head's jump: one cut over three steps.
+    const ProcessResult fold = runHairpipe("info " + q(sourcePath("scenes/fold_jump.yaml")));
+    ASSERT_EQ(fold.exitCode, 0) << fold.output;
+    EXPECT_NE(fold.output.find("cuts:    1 "), std::string::npos) << fold.output;
+    EXPECT_NE(fold.output.find("moved 0.500 m over 3 steps"), std::string::npos) << fold.output;
 }
 
 // The stress clip's cut at 2 s (frame 50 at 25 fps), hair everywhere, the

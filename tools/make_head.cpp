@@ -8,8 +8,13 @@
 //                                        neck and clips (scenes/assets/body.glb)
 //   make_head OUT.glb --sphere RADIUS    a static UV sphere, Gomes 2024's and
 //                                        the benchmarks' head (scenes/assets/sphere.glb)
+//   make_head OUT.glb --fold             the folding head: a sphere and a neck
+//                                        cylinder overlapping in one skinned mesh,
+//                                        clips fold_tip and fold_jump
+//                                        (pipeline/head/fold_head.h, scenes/assets/fold.glb)
 #include "core/errors.h"
 #include "pipeline/head/default_head.h"
+#include "pipeline/head/fold_head.h"
 #include "pipeline/batch/output.h"
 #include "sim/strands/head.h"
 
@@ -188,7 +193,7 @@ void zeroUnusedGlbBytes(const std::filesystem::path& file) {
     if (!out) throw IoError(file.string(), "cannot rewrite the file");
 }
 
-const char* const kUsage = "usage: make_head OUT.glb [--body] [--rings N] [--sectors N] [--key-rate HZ] | OUT.glb --sphere RADIUS";
+const char* const kUsage = "usage: make_head OUT.glb [--body | --fold] [--rings N] [--sectors N] [--key-rate HZ] | OUT.glb --sphere RADIUS";
 
 int intOption(const std::string& name, const char* value) {
     char* end = nullptr;
@@ -204,7 +209,7 @@ int main(int argc, char** argv) {
         DefaultHeadOptions options;
         std::string out;
         double sphere = 0;
-        bool body = false;
+        bool body = false, fold = false;
         for (int i = 1; i < argc; ++i) {
             const std::string a = argv[i];
             if (a == "--rings") options.rings = intOption(a, i + 1 < argc ? argv[++i] : nullptr);
@@ -212,6 +217,7 @@ int main(int argc, char** argv) {
             else if (a == "--key-rate") options.keyRate = intOption(a, i + 1 < argc ? argv[++i] : nullptr);
             else if (a == "--sphere" && i + 1 < argc) sphere = std::atof(argv[++i]);
             else if (a == "--body") body = true;
+            else if (a == "--fold") fold = true;
             else if (a == "-h" || a == "--help" || (!a.empty() && a[0] == '-') || !out.empty())
                 throw UsageError(kUsage);
             else out = a;
@@ -220,7 +226,11 @@ int main(int argc, char** argv) {
 
         if (sphere < 0 || (sphere == 0 && std::find(argv, argv + argc, std::string("--sphere")) != argv + argc))
             throw UsageError("make_head: --sphere needs a positive radius in metres");
-        const HeadRig rig = sphere > 0 ? sphereRig(float(sphere)) : body ? makeDefaultBody(options) : makeDefaultHead(options);
+        if (fold && (body || sphere > 0)) throw UsageError(kUsage);
+        const HeadRig rig = sphere > 0 ? sphereRig(float(sphere))
+                            : body     ? makeDefaultBody(options)
+                            : fold     ? makeFoldHead({})
+                                       : makeDefaultHead(options);
         aiScene scene;
         scene.mRootNode = buildNodes(rig, 0);
         scene.mNumMeshes = unsigned(rig.meshes.size());

@@ -237,9 +237,11 @@ void printClipCuts(const Scene& scene, const ShotSettings& shot) {
     std::cout << "cuts:    " << cuts.size() << " (simulation.cut_distance " << scene.number("simulation.cut_distance")
               << " m, cut_angle " << scene.number("simulation.cut_angle") << " deg per step)\n";
     for (const ClipCut& c : cuts) {
-        char line[160];
-        std::snprintf(line, sizeof line, "  t = %.4f s (frame %.2f): head moved %.3f m, turned %.1f deg, a root moved %.3f m\n",
-                      c.time, c.time * shot.fps, c.jump.headMove, c.jump.headTurn, c.jump.rootMove);
+        char line[200];
+        std::snprintf(line, sizeof line,
+                      "  t = %.4f s (frame %.2f): head moved %.3f m, turned %.1f deg, a root moved %.3f m%s\n", c.time,
+                      c.time * shot.fps, c.jump.headMove, c.jump.headTurn, c.jump.rootMove,
+                      c.steps > 1 ? cat(" over ", c.steps, " steps from t = ", c.start - step, " s").c_str() : "");
         std::cout << line;
     }
 }

@@ -79,6 +79,7 @@ AnimatedHead::AnimatedHead(std::shared_ptr<const HeadRig> rig, HeadAnimationSett
     rest_ = rig_->restMesh();         // the topology (triangles, uvs) every pose shares
     rest_ = posed(settings_.restTime);
     weld_ = weldVertices(rest_.positions);
+    parts_ = partitionMesh(rest_, weld_);
     std::vector<uint32_t> all(rest_.positions.size());
     for (uint32_t i = 0; i < all.size(); ++i) all[i] = i;
     fitVertices_ = thinned(std::move(all));
@@ -129,6 +130,12 @@ std::shared_ptr<const LevelSet> AnimatedHead::restLevelSet() const {
     std::call_once(gridOnce_, [this] {
         grid_ = std::make_shared<const LevelSet>(rest_, settings_.levelSet);
         restExact_ = std::make_shared<const MeshCollider>(rest_, weld_);
+        if (parts_.count() > 1)
+            for (size_t k = 0; k < parts_.count(); ++k) {
+                const TriangleMesh part = parts_.part(rest_, k);
+                partGrids_.push_back(std::make_shared<const LevelSet>(part, settings_.levelSet));
+                partExact_.push_back(std::make_shared<const MeshCollider>(part, parts_.welds[k]));
+            }
     });
     return grid_;
 }
@@ -138,25 +145,46 @@ std::shared_ptr<const MeshCollider> AnimatedHead::restCollider() const {
     return restExact_;
 }
 
+std::shared_ptr<const Collider> AnimatedHead::headCollider(const HeadPose& pose) const {
+    if (parts_.count() > 1 && settings_.collider != ColliderMethod::None) {
+        // A head that folds into itself: one collider per part, joined as
+        // their union (docs/colliders.md).
+        if (settings_.collider == ColliderMethod::Rigid) restLevelSet();
+        std::vector<std::shared_ptr<const Collider>> parts;
+        for (size_t k = 0; k < parts_.count(); ++k) {
+            if (settings_.collider == ColliderMethod::Rigid) {
+                parts.push_back(std::make_shared<LevelSetCollider>(partGrids_[k], pose.transform, partExact_[k]));
+                continue;
+            }
+            const TriangleMesh part = parts_.part(pose.mesh, k);
+            auto exact = std::make_shared<const MeshCollider>(part, parts_.welds[k]);
+            if (settings_.collider == ColliderMethod::Exact) parts.push_back(std::move(exact));
+            else
+                parts.push_back(std::make_shared<LevelSetCollider>(
+                    std::make_shared<const LevelSet>(part, settings_.levelSet), Eigen::Isometry3f::Identity(),
+                    std::move(exact)));
+        }
+        return std::make_shared<PartsCollider>(std::move(parts));
+    }
+    switch (settings_.collider) {
+        case ColliderMethod::Rigid:
+            return std::make_shared<LevelSetCollider>(restLevelSet(), pose.transform, restCollider());
+        case ColliderMethod::PerFrame:
+            return std::make_shared<LevelSetCollider>(std::make_shared<const LevelSet>(pose.mesh, settings_.levelSet),
+                                                      Eigen::Isometry3f::Identity(),
+                                                      std::make_shared<const MeshCollider>(pose.mesh, weld_));
+        case ColliderMethod::Exact: return std::make_shared<MeshCollider>(pose.mesh, weld_);
+        case ColliderMethod::None: break;
+    }
+    return nullptr;
+}
+
 HeadPose AnimatedHead::sample(double time) const {
     HeadPose pose;
     pose.time = time;
     pose.mesh = posed(time);
     pose.transform = fitRigidTransform(rest_.positions, pose.mesh.positions, fitVertices_);
-    switch (settings_.collider) {
-        case ColliderMethod::Rigid:
-            pose.collider = std::make_shared<LevelSetCollider>(restLevelSet(), pose.transform, restCollider());
-            break;
-        case ColliderMethod::PerFrame: {
-            auto exact = std::make_shared<const MeshCollider>(pose.mesh, weld_);
-            pose.collider = std::make_shared<LevelSetCollider>(
-                std::make_shared<const LevelSet>(pose.mesh, settings_.levelSet), Eigen::Isometry3f::Identity(),
-                std::move(exact));
-            break;
-        }
-        case ColliderMethod::Exact: pose.collider = std::make_shared<MeshCollider>(pose.mesh, weld_); break;
-        case ColliderMethod::None: break;
-    }
+    pose.collider = headCollider(pose);
     if (world_) {
         std::vector<Eigen::Isometry3f> poses;
         std::vector<std::vector<Vec3f>> skins(settings_.colliders.size());

@@ -7,6 +7,7 @@
 #include "sim/collision/collision_world.h"
 #include "sim/collision/level_set.h"
 #include "sim/collision/mesh_collider.h"
+#include "sim/collision/mesh_parts.h"
 
 #include <functional>
 #include <memory>
@@ -81,6 +82,12 @@ class AnimatedHead final : public HeadMotion {
     std::shared_ptr<const LevelSet> restLevelSet() const;
     std::shared_ptr<const MeshCollider> restCollider() const;
 
+    /// The mesh's connected parts (sim/collision/mesh_parts.h). With more
+    /// than one (a head that folds into itself) every pose's collider is a
+    /// PartsCollider of one collider of the chosen method per part, so a
+    /// strand can ignore the parts its root lies inside.
+    const MeshPartition& partition() const { return parts_; }
+
   private:
     TriangleMesh posed(double time) const;
 
@@ -92,6 +99,11 @@ class AnimatedHead final : public HeadMotion {
     mutable std::once_flag gridOnce_;
     mutable std::shared_ptr<const LevelSet> grid_;
     mutable std::shared_ptr<const MeshCollider> restExact_;
+    MeshPartition parts_;
+    mutable std::vector<std::shared_ptr<const LevelSet>> partGrids_;       ///< per part: rest grid (parts_.count() > 1)
+    mutable std::vector<std::shared_ptr<const MeshCollider>> partExact_;  ///< per part: rest exact collider
+    /// The head's collider at `pose` (mesh and transform set) by the chosen method.
+    std::shared_ptr<const Collider> headCollider(const HeadPose& pose) const;
     std::shared_ptr<const CollisionWorld> world_;  ///< settings_.colliders in Bullet; null when none
 };
 

@@ -23,16 +23,32 @@ std::vector<ClipCut> findClipCuts(const Scene& scene, const HeadSetup& head, dou
     }
     const float maxDistance = float(scene.number("simulation.cut_distance"));
     const float maxAngle = float(scene.number("simulation.cut_angle"));
+    auto jumpBetween = [&](const HeadPose& a, const HeadPose& b) {
+        float rootMove = 0.f;
+        for (uint32_t v : scalpVertices)
+            rootMove = std::max(rootMove, (b.mesh.positions[v] - a.mesh.positions[v]).norm());
+        return stepJump(a.transform, b.transform, rootMove);
+    };
     std::vector<ClipCut> cuts;
     HeadPose previous = motion.sample(startTime);
+    HeadPose before;  // the pose before the cut being followed
+    bool inCut = false;
     const long steps = std::lround((endTime - startTime) / step);
     for (long k = 1; k <= steps; ++k) {
         HeadPose pose = motion.sample(startTime + double(k) * step);
-        float rootMove = 0.f;
-        for (uint32_t v : scalpVertices)
-            rootMove = std::max(rootMove, (pose.mesh.positions[v] - previous.mesh.positions[v]).norm());
-        const StepJump jump = stepJump(previous.transform, pose.transform, rootMove);
-        if (isCut(jump, maxDistance, maxAngle)) cuts.push_back({pose.time, jump});
+        const StepJump jump = jumpBetween(previous, pose);
+        if (inCut && continuesCut(jump, maxDistance, maxAngle)) {
+            ClipCut& c = cuts.back();
+            c.time = pose.time;
+            ++c.steps;
+            c.jump = jumpBetween(before, pose);
+        } else if (isCut(jump, maxDistance, maxAngle)) {
+            cuts.push_back({pose.time, pose.time, 1, jump});
+            before = previous;
+            inCut = true;
+        } else {
+            inCut = false;
+        }
         previous = std::move(pose);
     }
     return cuts;

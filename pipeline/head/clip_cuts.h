@@ -11,15 +11,19 @@
 
 namespace hp {
 
-/// @brief One step of the shot that is a scene cut.
+/// @brief One scene cut of the shot: one step, or the steps a jump the file
+/// interpolates between two keys spreads over (scene_cut.h continuesCut).
 struct ClipCut {
-    double time = 0.0;  ///< shot time at the end of the step (the first time of the new shot), s
-    StepJump jump;      ///< what moved over the step
+    double time = 0.0;   ///< shot time at the end of its last step (the first time of the new shot), s
+    double start = 0.0;  ///< shot time at the end of its first step, s
+    int steps = 1;       ///< steps it spans
+    StepJump jump;       ///< what moved from the step before it to its end
 };
 
 /// @brief Steps the shot's head from `startTime` to `endTime` at `step`
-/// seconds (the simulation's frame-aligned step) and returns every step
-/// whose jump exceeds simulation.cut_distance / cut_angle. The root move is
+/// seconds (the simulation's frame-aligned step) and returns every cut the
+/// guide solver finds: a step whose jump exceeds simulation.cut_distance /
+/// cut_angle, with the steps after it that continue it. The root move is
 /// measured on the scalp's vertices (a root moves no farther than the
 /// corners of its triangle).
 std::vector<ClipCut> findClipCuts(const Scene& scene, const HeadSetup& head, double startTime, double endTime,

@@ -11,6 +11,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -58,6 +59,9 @@ class GuideModel {
     virtual StepStats step(const std::vector<SurfaceFrame>& roots, const HeadPose& head) {
         return solver.step(roots, head);
     }
+    /// The head's parts each guide ignores (GuideSolver::setIgnoredParts); a
+    /// model without the notion collides with every part.
+    virtual void setIgnoredParts(const std::vector<uint32_t>&) {}
     /// -1 unless the model has a saturation.
     virtual double saturation() const { return -1; }
     /// False when the model's state cannot be saved exactly (then a stopped
@@ -79,6 +83,7 @@ class RigidChainModel final : public GuideModel {
                     const std::vector<std::vector<Vec3f>>* groom) override {
         solver_.initialize(roots, head, groom);
     }
+    void setIgnoredParts(const std::vector<uint32_t>& masks) override { solver_.setIgnoredParts(masks); }
     bool canCheckpoint() const override { return solver_.settings().formulation != GuideFormulation::Rigid; }
     std::vector<char> saveState() const override { return solver_.saveState(); }
     void restoreState(const std::vector<char>& state) override { solver_.restoreState(state); }
@@ -146,6 +151,7 @@ std::string SimFrameStats::json() const {
       << ", \"kinetic_energy\": " << guides.kineticEnergy << ", \"nan_count\": " << guides.nanCount
       << ", \"pinned\": " << guides.pinnedCount
       << ", \"strand_contacts\": " << guides.strandContacts << ", \"reset\": " << (guides.reset ? "true" : "false")
+      << ", \"cuts\": " << guides.cuts
       << ", \"ms_per_step\": " << guides.msPerStep << ", \"head_ms\": " << headMs
       << ", \"follower_ms\": " << followerMs << ", \"follower_projected\": " << followerProjected
       << ", \"frame_ms\": " << totalMs << ", \"strands\": " << strands << ", \"vertices\": " << vertices;
@@ -197,6 +203,13 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame, c
     pose_ = head_.motion->sample(t0);
     evaluateRoots(pose_.mesh, roots_.guides, guideFrames_);
     initializeGuides(settings, imported.get(), settleCache);
+    // A head that folds into itself: each strand ignores the parts its root
+    // lies inside (docs/colliders.md), pose by pose.
+    updateIgnoredParts(pose_.mesh);
+    if (std::any_of(ignoredParts_.begin(), ignoredParts_.end(), [](uint32_t m) { return m != 0; }))
+        logInfo("head: ", head_.motion->partition().count(), " parts overlap; at the first frame ",
+                std::count_if(ignoredParts_.begin(), ignoredParts_.end(), [](uint32_t m) { return m != 0; }),
+                " strands grow inside another part and ignore it");
 
     // Followers learn the guides' rest shapes from the guides at t0.
     StrandFrame rest;
@@ -232,6 +245,18 @@ ShotSimulation::ShotSimulation(const Scene& scene, double fps, int startFrame, c
     stats_.settleEnergy = settled_.kineticEnergy;
     stats_.settleConverged = settled_.converged;
     stats_.settleCached = settled_.fromCache;
+}
+
+void ShotSimulation::updateIgnoredParts(const TriangleMesh& mesh) {
+    const MeshPartition& parts = head_.motion->partition();
+    if (parts.count() < 2) {
+        ignoredParts_.assign(roots_.guides.size() + roots_.followers.size(), 0u);
+        return;
+    }
+    ignoredParts_ = partsAroundRoots(parts, mesh, roots_.guides);
+    model_->setIgnoredParts(ignoredParts_);
+    const std::vector<uint32_t> followers = partsAroundRoots(parts, mesh, roots_.followers);
+    ignoredParts_.insert(ignoredParts_.end(), followers.begin(), followers.end());
 }
 
 void ShotSimulation::initializeGuides(const GuideSettings& settings, const ImportedGroom* imported,
@@ -311,6 +336,10 @@ void ShotSimulation::stepTo(int frame) {
         const auto headStart = std::chrono::steady_clock::now();
         const HeadPose pose = head_.motion->sample(t);
         evaluateRoots(pose.mesh, roots_.guides, guideFrames_);
+        // A head that folds into itself: the parts each guide's root lies
+        // inside at the step's end, which the fold changes as it moves.
+        if (head_.motion->partition().count() > 1)
+            model_->setIgnoredParts(partsAroundRoots(head_.motion->partition(), pose.mesh, roots_.guides));
         pendingHeadMs_ += msSince(headStart);
         const StepStats s = model_->step(guideFrames_, pose);
         if (pendingSteps_++ == 0) pending_ = s;
@@ -331,6 +360,7 @@ void ShotSimulation::produceFrame(double time) {
     pose_ = head_.motion->sample(time);
     evaluateRoots(pose_.mesh, roots_.guides, guideFrames_);
     evaluateRoots(pose_.mesh, roots_.followers, followerFrames_);
+    if (head_.motion->partition().count() > 1) updateIgnoredParts(pose_.mesh);
     const double headMs = pendingHeadMs_ + msSince(headStart);
 
     // The guides are written into the frame in place; the followers are

@@ -84,6 +84,13 @@ class ShotSimulation {
     const HeadSetup& head() const { return head_; }
     size_t guideCount() const;
     size_t followerCount() const;
+    /// Per strand of the current frame (guides, then followers): the head's
+    /// parts it ignores (bit k: part k; sim/collision/mesh_parts.h), those
+    /// its root lies inside at this frame's pose. Depth "inside" is measured
+    /// with pose().collider->signedDistanceIgnoring(p, nullptr, mask). The
+    /// guides (rod) collide so, with the masks of each step's pose;
+    /// followers collide with every part.
+    const std::vector<uint32_t>& ignoredParts() const { return ignoredParts_; }
 
     /// False for models whose state cannot be restored bit for bit (the rigid
     /// formulation keeps orientations and warm-start impulses inside Bullet).
@@ -117,6 +124,8 @@ class ShotSimulation {
     /// Steps the guides to `frame` and produces its strands (advanceTo's one frame).
     void stepTo(int frame);
     void produceFrame(double time);
+    /// ignoredParts() at the pose `mesh`; hands the guides theirs.
+    void updateIgnoredParts(const TriangleMesh& mesh);
     /// The guides' rest shape at t0: imported, combed or straight, settled.
     void initializeGuides(const GuideSettings& settings, const struct ImportedGroom* imported,
                           const SettleCache& settleCache);
@@ -136,6 +145,7 @@ class ShotSimulation {
     StepStats pending_;  ///< steps since the last output frame
     double pendingHeadMs_ = 0;
     size_t pendingSteps_ = 0;
+    std::vector<uint32_t> ignoredParts_;  ///< ignoredParts()
     SettledGroom settled_;  ///< the settling's report (strands moved into the model)
     bool settleRan_ = false;
     std::optional<FollowerSource> source_, previousSource_;  ///< cachedGuides()

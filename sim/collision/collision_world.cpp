@@ -427,8 +427,12 @@ std::shared_ptr<const Collider> CollisionWorld::posed(const std::vector<Eigen::I
 }
 
 float CompositeCollider::signedDistance(const Vec3f& p, Vec3f* normal) const {
+    return signedDistanceIgnoring(p, normal, 0u);
+}
+
+float CompositeCollider::signedDistanceIgnoring(const Vec3f& p, Vec3f* normal, uint32_t ignoreParts) const {
     float best = std::numeric_limits<float>::infinity();
-    if (head_) best = head_->signedDistance(p, normal);
+    if (head_) best = ignoreParts ? head_->signedDistanceIgnoring(p, normal, ignoreParts) : head_->signedDistance(p, normal);
     if (others_) {
         Vec3f n;
         const float d = others_->signedDistance(p, normal ? &n : nullptr);

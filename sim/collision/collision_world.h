@@ -88,6 +88,8 @@ class CompositeCollider final : public Collider {
     CompositeCollider(std::shared_ptr<const Collider> head, std::shared_ptr<const Collider> others)
         : head_(std::move(head)), others_(std::move(others)) {}
     float signedDistance(const Vec3f& p, Vec3f* normal = nullptr) const override;
+    /// The parts a strand ignores are the head's (sim/collision/mesh_parts.h).
+    float signedDistanceIgnoring(const Vec3f& p, Vec3f* normal, uint32_t ignoreParts) const override;
 
   private:
     std::shared_ptr<const Collider> head_, others_;

@@ -45,6 +45,10 @@ struct GuideSet : solver::StrandState {
     std::vector<float> limitPerIteration;  ///< per segment: the same spread over Bullet's link iterations
     std::vector<float> minSpan, maxSpan;   ///< per segment: rope bend limits as spans (strand::bendLimitSpan)
     std::vector<float> mass;          ///< per vertex (0 for the kinematic root)
+    /// Per guide: the head's parts it ignores (strand::HeadQuery::ignoreParts);
+    /// empty: none (GuideSolver::setIgnoredParts).
+    std::vector<uint32_t> ignoreParts;
+    uint32_t ignoredParts(size_t g) const { return ignoreParts.empty() ? 0u : ignoreParts[g]; }
 
     /// Bumped whenever x / v are written outside a group's own substep (a
     /// reset, strand-strand contacts), so the groups reload their worlds.

@@ -142,8 +142,13 @@ struct GuideSolver::Impl final : solver::StrandModel {
     /// Lengths and head clearance of one guide after strand-strand pushes.
     void relax(size_t g, const strand::HeadQuery* head) {
         Vec3f* x = &set.x[set.vertex(g, 0)];
+        strand::HeadQuery own;
+        if (head) {
+            own = *head;
+            own.ignoreParts = set.ignoredParts(g);
+        }
         for (int j = 0; j < set.segments; ++j)
-            strand::placeSegment(x[j], x[j + 1], set.restLength[set.segment(g, j)], head,
+            strand::placeSegment(x[j], x[j + 1], set.restLength[set.segment(g, j)], head ? &own : nullptr,
                                  set.settings.collisionRadius);
     }
 
@@ -374,8 +379,11 @@ StepStats GuideSolver::Impl::measure(const Collider* collider) const {
                     if (p.firstNan < 0) p.firstNan = long(g);
                 }
                 // The root sits on the scalp by definition; only the free vertices count.
+                // Inside by the head's parts the strand does not ignore (sim/collision/mesh_parts.h).
                 if (i > 0 && collider) {
-                    const float d = collider->signedDistance(set.x[k]);
+                    const uint32_t ignore = set.ignoredParts(g);
+                    const float d = ignore ? collider->signedDistanceIgnoring(set.x[k], nullptr, ignore)
+                                           : collider->signedDistance(set.x[k]);
                     if (d < 0.f) {
                         ++p.inside;
                         p.maxDepth = std::max(p.maxDepth, double(-d));
@@ -436,6 +444,12 @@ void GuideSolver::restoreState(const std::vector<char>& state) {
 
 const GuideSettings& GuideSolver::settings() const { return impl_->set.settings; }
 StepStats GuideSolver::measure(const Collider* collider) const { return impl_->measure(collider); }
+
+void GuideSolver::setIgnoredParts(std::vector<uint32_t> masks) {
+    if (!masks.empty() && masks.size() != impl_->set.count)
+        throw Error(cat("guide solver: ", masks.size(), " part masks for ", impl_->set.count, " guides"));
+    impl_->set.ignoreParts = std::move(masks);
+}
 
 void GuideSolver::jointAngles(float& maxBend, float& maxTwist) const {
     maxBend = maxTwist = 0.f;

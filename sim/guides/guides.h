@@ -156,6 +156,12 @@ class GuideSolver : public StrandSolver {
                     const std::vector<std::vector<Vec3f>>* groom = nullptr);
 
     const GuideSettings& settings() const;
+    /// Per guide, the head's parts it ignores (bit k: part k; those its root
+    /// lies inside, sim/collision/mesh_parts.h partsAroundRoots), after
+    /// initialize: contact, pinning and the penetration statistics then use
+    /// the head without them. Rod formulation (the rope's and rigid chain's
+    /// Bullet steps see every part). Empty: none. Throws hp::Error on a size mismatch.
+    void setIgnoredParts(std::vector<uint32_t> masks);
     /// Statistics of the current state without stepping (used after initialize).
     StepStats measure(const Collider* collider) const;
 

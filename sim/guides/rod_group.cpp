@@ -178,6 +178,7 @@ void RodGroup::substep(const SubstepContext& ctx) {
             targets[l].strand = &strands[l];
             targets[l].x = &set_.x[set_.vertex(g, 0)];
             targets[l].v = &set_.v[set_.vertex(g, 0)];
+            targets[l].ignoreParts = set_.ignoredParts(g);
             if (bdf2()) {
                 targets[l].xBack = &xBack_[(g - begin_) * size_t(set_.vertices)];
                 targets[l].vBack = &vBack_[(g - begin_) * size_t(set_.vertices)];

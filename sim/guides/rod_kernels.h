@@ -122,6 +122,8 @@ struct RodStepTarget {
     /// history or none does.
     Vec3f* xBack = nullptr;
     Vec3f* vBack = nullptr;
+    /// The head's parts this strand ignores (strand::HeadQuery::ignoreParts).
+    uint32_t ignoreParts = 0;
 };
 
 /// The step BDF2 takes from the history (x_{n-1}, v_{n-1}) and the state

@@ -286,6 +286,14 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
     // The signed-distance queries stay one per lane (a virtual call).
     const float damp = strand::dampingFactor(drag, h);
     const bool collides = head && head->collider;
+    // Each lane's view of the head: the parts its strand ignores.
+    strand::HeadQuery laneHead[kLanes];
+    const strand::HeadQuery* heads[kLanes] = {};
+    for (int k = 0; k < count && head; ++k) {
+        laneHead[k] = *head;
+        laneHead[k].ignoreParts = targets[k].ignoreParts;
+        heads[k] = &laneHead[k];
+    }
     int pinned = 0;
     for (int i = 0; i < n; ++i) {
         // x_n, v_n: BDF2's next history (placeVertex overwrites a scalar lane's x, v).
@@ -306,11 +314,11 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
             const F4 q = lanes::norm(placed - parent) / l - 1.f;
             const auto exact = lanes::select(q < 0.f, -q, q) < 1e-4f;
             for (int k = 0; k < count; ++k) {
-                scalar[k] = !exact[k] || (collides && !(head->distance(lane(placed, k), nullptr) >= radius));
+                scalar[k] = !exact[k] || (collides && !(heads[k]->distance(lane(placed, k), nullptr) >= radius));
                 if (!scalar[k]) continue;
                 Vec3f child = lane(y[i], k);
                 pinned += placeVertex(targets[k], i, lane(parent, k), child, lane(sc.start[size_t(i)], k), h, hv,
-                                      damp, friction, head, radius);
+                                      damp, friction, heads[k], radius);
                 setLane(placed, k, child);
             }
             y[i] = placed;

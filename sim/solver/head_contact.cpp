@@ -9,7 +9,8 @@ namespace hp::strand {
 
 float HeadQuery::distance(const Vec3f& x, Vec3f* normal) const {
     Vec3f n;
-    const float d = collider->signedDistance(toCollider * x, &n);
+    const float d = ignoreParts ? collider->signedDistanceIgnoring(toCollider * x, &n, ignoreParts)
+                                : collider->signedDistance(toCollider * x, &n);
     if (normal) *normal = normalToWorld * n;
     return d;
 }

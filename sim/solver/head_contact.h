@@ -27,6 +27,9 @@ struct HeadQuery {
     Eigen::Isometry3f toCollider = Eigen::Isometry3f::Identity();
     Eigen::Matrix3f normalToWorld = Eigen::Matrix3f::Identity();
     Eigen::Isometry3f toPrevious = Eigen::Isometry3f::Identity();
+    /// The head's parts this strand ignores (bit k: part k): those its root
+    /// lies inside (sim/collision/mesh_parts.h). 0: none.
+    uint32_t ignoreParts = 0;
 
     /// Signed distance (negative inside) and outward world normal at `x`.
     float distance(const Vec3f& x, Vec3f* normal) const;

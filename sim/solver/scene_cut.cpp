@@ -16,4 +16,8 @@ bool isCut(const StepJump& jump, float maxDistance, float maxAngle) {
     return jump.headMove > maxDistance || jump.rootMove > maxDistance || jump.headTurn > maxAngle;
 }
 
+bool continuesCut(const StepJump& jump, float maxDistance, float maxAngle) {
+    return isCut(jump, 0.5f * maxDistance, 0.5f * maxAngle);
+}
+
 }  // namespace hp

@@ -27,4 +27,13 @@ StepJump stepJump(const Eigen::Isometry3f& from, const Eigen::Isometry3f& to, fl
 /// `maxDistance` metres, or the head turned more than `maxAngle` degrees.
 bool isCut(const StepJump& jump, float maxDistance, float maxAngle);
 
+/// @brief Whether the step after a cut step goes on with the same cut. A
+/// file's sampler interpolates the jump between two keys linearly, so a jump
+/// whose keys lie more than a step apart spreads over several steps: each
+/// whole step inside it moves the same amount, the last one only what is
+/// left of it. A step right after a cut continues it while it still moves
+/// more than half the limits (isCut(jump, maxDistance / 2, maxAngle / 2));
+/// a cut is one cut however many steps it spans.
+bool continuesCut(const StepJump& jump, float maxDistance, float maxAngle);
+
 }  // namespace hp

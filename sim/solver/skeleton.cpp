@@ -18,6 +18,7 @@ void Skeleton::start(const HeadPose& head) {
     steps_ = 0;
     headTransform_ = head.transform;
     last_ = StepStats{};
+    inCut_ = false;
     started_ = true;
 }
 
@@ -39,10 +40,15 @@ const StepStats& Skeleton::step(const std::vector<SurfaceFrame>& roots, const He
 
     // A scene cut or teleport: the head or a root jumps further in one step
     // than the limits allow. The strands restart at rest on the new roots.
+    // A jump the head file interpolates over several steps is one cut: every
+    // step of it restarts the strands on that step's pose (placed outside
+    // every collider at their lengths), none of them simulates it as motion
+    // (scene_cut.h continuesCut).
     const Eigen::Isometry3f& T0 = headTransform_;
     const Eigen::Isometry3f& T1 = head.transform;
-    const bool cut =
-        isCut(stepJump(T0, T1, state_.rootJump()), settings_.teleportDistance, settings_.teleportAngle);
+    const StepJump jump = stepJump(T0, T1, state_.rootJump());
+    const bool starts = isCut(jump, settings_.teleportDistance, settings_.teleportAngle);
+    const bool cut = starts || (inCut_ && continuesCut(jump, settings_.teleportDistance, settings_.teleportAngle));
     model_.beginStep(head, cut);
     if (cut) {
         model_.resetToRest(head);
@@ -82,6 +88,8 @@ const StepStats& Skeleton::step(const std::vector<SurfaceFrame>& roots, const He
 
     last_ = model_.measure(head.collider.get());
     last_.reset = cut;
+    last_.cuts = cut && !inCut_ ? 1 : 0;
+    inCut_ = cut;
     last_.setCounters(counters);
     last_.msPerStep = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - clock0).count();
     return last_;
@@ -121,6 +129,7 @@ void Skeleton::saveClock(BlobWriter& w) const {
     w.put(startTime_);
     w.put(steps_);
     w.put(headTransform_.matrix());
+    w.put(uint8_t(inCut_ ? 1 : 0));
 }
 
 void Skeleton::restoreClock(BlobReader& r) {
@@ -129,6 +138,7 @@ void Skeleton::restoreClock(BlobReader& r) {
     startTime_ = r.get<double>();
     steps_ = r.get<long>();
     headTransform_.matrix() = r.get<Eigen::Matrix4f>();
+    inCut_ = r.get<uint8_t>() != 0;
 }
 
 }  // namespace hp::solver

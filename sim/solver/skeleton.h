@@ -10,8 +10,9 @@
 // One step of Skeleton::step, for every model:
 //  1. the roots' end-of-step targets; the state so far kept as the step before;
 //  2. a scene cut (the head or a root jumps beyond the teleport limits in
-//     one step, sim/solver/scene_cut.h) resets the strands to rest on the
-//     new roots; otherwise the model advances through `substeps` substeps,
+//     one step, or the step after a cut still jumps beyond half of them:
+//     one cut spread over several steps, sim/solver/scene_cut.h) resets the
+//     strands to rest on the new roots; otherwise the model advances through `substeps` substeps,
 //     each seeing the head interpolated (slerp, lerp) to the substep's end;
 //  3. the model's end of step (guards, counters), the roots' targets and the
 //     clock advance, the state is measured.
@@ -116,6 +117,7 @@ class Skeleton {
     double startTime_ = 0;  ///< head.time at start
     long steps_ = 0;        ///< steps since; time = startTime + steps·timeStep (no drift)
     Eigen::Isometry3f headTransform_ = Eigen::Isometry3f::Identity();
+    bool inCut_ = false;  ///< the last step was (part of) a scene cut
     StepStats last_;
     bool started_ = false;
 };

@@ -25,6 +25,7 @@ void StepStats::accumulate(const StepStats& s) {
     msPerStep = (msPerStep * double(steps) + s.msPerStep * double(s.steps)) / double(steps + s.steps);
     steps += s.steps;
     reset = reset || s.reset;
+    cuts += s.cuts;
 }
 
 void StepStats::setCounters(const StepStats& c) {
@@ -44,9 +45,9 @@ std::string StepStats::json(int frame, double time) const {
                   "{\"frame\": %d, \"time\": %.6f, \"max_length_error\": %.3e, \"mean_length_error\": %.3e, "
                   "\"penetrations\": %zu, \"max_penetration_m\": %.3e, \"kinetic_energy_j\": %.6e, "
                   "\"nan\": %zu, \"clamped\": %zu, \"pinned\": %zu, \"strand_contacts\": %zu, \"ms_per_step\": %.3f, "
-                  "\"steps\": %zu, \"reset\": %s}",
+                  "\"steps\": %zu, \"reset\": %s, \"cuts\": %zu}",
                   frame, time, maxLengthError, meanLengthError, penetrationCount, maxPenetration, kineticEnergy,
-                  nanCount, clampedCount, pinnedCount, strandContacts, msPerStep, steps, reset ? "true" : "false");
+                  nanCount, clampedCount, pinnedCount, strandContacts, msPerStep, steps, reset ? "true" : "false", cuts);
     return buf;
 }
 

@@ -20,6 +20,7 @@ struct StepStats {
     size_t nanCount = 0;            ///< non-finite vertex positions or velocities
     long firstNonFinite = -1;       ///< lowest strand index with a non-finite value (-1: none)
     double msPerStep = 0;           ///< wall-clock milliseconds of step()
+    size_t cuts = 0;                ///< scene cuts that began in the step(s): one per cut, however many steps it spans
     bool reset = false;             ///< a teleport / scene cut reset the strands this step
 
     // Guides (sim/guides/guides.h).

@@ -58,6 +58,13 @@ class Collider {
     /// Signed distance at `p`; when `normal` is given, the outward unit normal
     /// of the nearest surface point (the distance gradient).
     virtual float signedDistance(const Vec3f& p, Vec3f* normal = nullptr) const = 0;
+    /// The same for a strand that ignores the head's parts in the mask
+    /// `ignoreParts` (bit k: part k; a head that folds into itself,
+    /// sim/collision/mesh_parts.h). Colliders without parts ignore the mask.
+    virtual float signedDistanceIgnoring(const Vec3f& p, Vec3f* normal, uint32_t ignoreParts) const {
+        (void)ignoreParts;
+        return signedDistance(p, normal);
+    }
 };
 
 /// An exact sphere (the benchmark head).

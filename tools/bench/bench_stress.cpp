@@ -5,13 +5,16 @@
 // frame by frame and reports steps/s (simulation only, measurements
 // excluded), the worst segment stretch of guides and of followers against
 // their lengths on the first frame, the deepest free vertex inside any
-// collider (the pose's composite collider: head + Bullet world) after any
-// frame, pinned vertices (the most in one frame; rod only: the rope pins
+// collider (the pose's composite collider: head + Bullet world; on a head
+// that folds into itself, without the parts the strand's root lies inside,
+// docs/colliders.md) after any frame, pinned vertices (the most in one frame; rod only: the rope pins
 // nothing) and NaN.
 //
 //   bench_stress [--scene scenes/stress.yaml] [--threads 2] [--set key=value ...] [--per-frame]
 //
-// --per-frame adds a line per frame: the deepest guide and follower vertex,
+// --per-frame adds a line per frame: the deepest guide and follower vertex
+// (and, on a head that folds into itself, the deepest vertex of a strand
+// whose root lies inside another part),
 // pinned guide vertices, and the followers' projected, bent, pinned and
 // left-inside vertices (FollowerStats).
 //
@@ -84,7 +87,7 @@ int stress(const std::string& path, const std::vector<std::string>& overrides, b
         const StrandFrame& f = sim.advanceTo(frame);
         simSeconds += since(t);
         steps += sim.stats().guides.steps;
-        resets += sim.stats().guides.reset ? 1 : 0;
+        resets += int(sim.stats().guides.cuts);
         pinnedWorst = std::max(pinnedWorst, sim.stats().guides.pinnedCount);
         followerPinnedWorst = std::max(followerPinnedWorst, sim.stats().followers.pinned);
         followerBentWorst = std::max(followerBentWorst, sim.stats().followers.bent);
@@ -94,11 +97,12 @@ int stress(const std::string& path, const std::vector<std::string>& overrides, b
         std::atomic<size_t> bad{0};
         std::vector<float> depth(f.strandCount(), 0.f);
         const Collider* collider = sim.pose().collider.get();
+        const std::vector<uint32_t>& ignore = sim.ignoredParts();  // a head that folds into itself
         tbb::parallel_for(size_t(0), f.strandCount(), [&](size_t s) {
             for (uint32_t i = f.first(s); i < f.offsets[s + 1]; ++i) {
                 if (!f.positions[i].allFinite()) ++bad;
                 else if (i > f.first(s) && collider)
-                    depth[s] = std::max(depth[s], -collider->signedDistance(f.positions[i]));
+                    depth[s] = std::max(depth[s], -collider->signedDistanceIgnoring(f.positions[i], nullptr, ignore[s]));
             }
         });
         nan += bad;
@@ -106,10 +110,14 @@ int stress(const std::string& path, const std::vector<std::string>& overrides, b
         if (d > depthWorst) depthWorst = d, depthFrame = frame;
         if (perFrame) {
             const SimFrameStats& st = sim.stats();
-            std::printf("frame %d: depth mm guides %.3f followers %.3f; guides pinned %zu; followers projected %zu, "
-                        "bent %zu, pinned %zu, left inside %zu (%.3f mm)\n",
+            float grown = 0.f;  // strands grown inside another part
+            for (size_t s = 0; s < depth.size(); ++s)
+                if (ignore[s]) grown = std::max(grown, depth[s]);
+            std::printf("frame %d: depth mm guides %.3f followers %.3f (grown inside another part %.3f); guides pinned "
+                        "%zu; followers projected %zu, bent %zu, pinned %zu, left inside %zu (%.3f mm)\n",
                         frame, 1e3 * *std::max_element(depth.begin(), depth.begin() + long(guides)),
-                        1e3 * *std::max_element(depth.begin() + long(guides), depth.end()), st.guides.pinnedCount,
+                        1e3 * *std::max_element(depth.begin() + long(guides), depth.end()), 1e3 * grown,
+                        st.guides.pinnedCount,
                         st.followerProjected, st.followers.bent, st.followers.pinned, st.followers.penetrationCount,
                         1e3 * st.followers.maxPenetration);
         }

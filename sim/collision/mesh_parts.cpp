@@ -1,0 +1,110 @@
+#include "sim/collision/mesh_parts.h"
+
+#include "core/errors.h"
+#include "sim/collision/mesh_collider.h"
+
+#include <limits>
+#include <numeric>
+
+namespace hp {
+
+TriangleMesh MeshPartition::part(const TriangleMesh& mesh, size_t k) const {
+    TriangleMesh m;
+    const std::vector<uint32_t>& v = vertices[k];
+    m.positions.reserve(v.size());
+    for (uint32_t i : v) m.positions.push_back(mesh.positions[i]);
+    if (mesh.normals.size() == mesh.positions.size())
+        for (uint32_t i : v) m.normals.push_back(mesh.normals[i]);
+    m.triangles = triangles[k];
+    return m;
+}
+
+MeshPartition partitionMesh(const TriangleMesh& mesh, const std::vector<uint32_t>& weld) {
+    if (weld.size() != mesh.positions.size())
+        throw Error(cat("partitionMesh: weld map has ", weld.size(), " entries for ", mesh.positions.size(), " vertices"));
+    // Union-find over welded vertices: a triangle joins its three corners.
+    std::vector<uint32_t> parent(mesh.positions.size());
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto find = [&](uint32_t i) {
+        while (parent[i] != i) i = parent[i] = parent[parent[i]];
+        return i;
+    };
+    auto unite = [&](uint32_t a, uint32_t b) {
+        a = find(a), b = find(b);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    };
+    for (const Tri& t : mesh.triangles) {
+        unite(weld[t[0]], weld[t[1]]);
+        unite(weld[t[0]], weld[t[2]]);
+    }
+    MeshPartition out;
+    out.triangleParts.resize(mesh.triangles.size());
+    std::vector<uint32_t> partOfRoot(mesh.positions.size(), std::numeric_limits<uint32_t>::max());
+    std::vector<uint32_t> local(mesh.positions.size(), std::numeric_limits<uint32_t>::max());
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+        const Tri& tri = mesh.triangles[t];
+        uint32_t& k = partOfRoot[find(weld[tri[0]])];
+        if (k == std::numeric_limits<uint32_t>::max()) {
+            k = uint32_t(out.vertices.size());
+            out.vertices.emplace_back();
+            out.triangles.emplace_back();
+        }
+        out.triangleParts[t] = k;
+    }
+    // Each part's vertices ascending, then its triangles over local indices.
+    for (uint32_t v = 0; v < mesh.positions.size(); ++v) {
+        const uint32_t k = partOfRoot[find(weld[v])];
+        if (k == std::numeric_limits<uint32_t>::max()) continue;  // a vertex no triangle uses
+        local[v] = uint32_t(out.vertices[k].size());
+        out.vertices[k].push_back(v);
+    }
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+        const Tri& tri = mesh.triangles[t];
+        out.triangles[out.triangleParts[t]].push_back({local[tri[0]], local[tri[1]], local[tri[2]]});
+    }
+    out.welds.resize(out.count());
+    for (size_t k = 0; k < out.count(); ++k)
+        for (uint32_t v : out.vertices[k]) out.welds[k].push_back(local[weld[v]]);
+    return out;
+}
+
+PartsCollider::PartsCollider(std::vector<std::shared_ptr<const Collider>> parts) : parts_(std::move(parts)) {
+    if (parts_.empty()) throw Error("PartsCollider: no parts");
+}
+
+float PartsCollider::signedDistance(const Vec3f& p, Vec3f* normal) const {
+    return signedDistanceIgnoring(p, normal, 0u);
+}
+
+float PartsCollider::signedDistanceIgnoring(const Vec3f& p, Vec3f* normal, uint32_t ignoreParts) const {
+    // Union of the parts kept: φ = min_k φ_k, the normal of the part that
+    // gives it. Parts in a fixed order, so ties resolve alike on every thread.
+    float best = std::numeric_limits<float>::infinity();
+    Vec3f n = Vec3f::UnitY();
+    for (size_t k = 0; k < parts_.size(); ++k) {
+        if (k < kMaxIgnoredParts && (ignoreParts >> k) & 1u) continue;
+        Vec3f nk;
+        const float d = parts_[k]->signedDistance(p, normal ? &nk : nullptr);
+        if (d < best) best = d, n = nk;
+    }
+    if (normal) *normal = n;
+    return best;
+}
+
+std::vector<uint32_t> partsAroundRoots(const MeshPartition& partition, const TriangleMesh& mesh,
+                                       const std::vector<SurfacePoint>& roots, float tolerance) {
+    std::vector<uint32_t> masks(roots.size(), 0u);
+    if (partition.count() < 2) return masks;
+    std::vector<std::unique_ptr<MeshCollider>> parts;
+    for (size_t k = 0; k < std::min<size_t>(partition.count(), kMaxIgnoredParts); ++k)
+        parts.push_back(std::make_unique<MeshCollider>(partition.part(mesh, k), partition.welds[k]));
+    for (size_t r = 0; r < roots.size(); ++r) {
+        const uint32_t own = partition.triangleParts[roots[r].triangle];
+        const Vec3f p = evaluate(mesh, roots[r]).position;
+        for (size_t k = 0; k < parts.size(); ++k)
+            if (k != own && parts[k]->signedDistance(p) < -tolerance) masks[r] |= 1u << k;
+    }
+    return masks;
+}
+
+}  // namespace hp
