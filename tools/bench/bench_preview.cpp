@@ -62,6 +62,8 @@ int main(int argc, char** argv) {
     bool profile = false;
     bool fitted = false, rig = false;
     int otherResolution = -1;
+    int voxels = -1, shadowMap = -1, msaa = -1;
+    float pieces = -1.f;
     std::string png;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -82,6 +84,14 @@ int main(int argc, char** argv) {
             rig = std::string(argv[++i]) == "rig";
         } else if (a == "--other-resolution" && more) {
             otherResolution = std::atoi(argv[++i]);
+        } else if (a == "--voxels" && more) {
+            voxels = std::atoi(argv[++i]);
+        } else if (a == "--shadow-map" && more) {
+            shadowMap = std::atoi(argv[++i]);
+        } else if (a == "--msaa" && more) {
+            msaa = std::atoi(argv[++i]);
+        } else if (a == "--pieces" && more) {
+            pieces = float(std::atof(argv[++i]));
         } else if (a == "--png" && more) {
             png = argv[++i];
         } else {
@@ -96,6 +106,10 @@ int main(int argc, char** argv) {
         if (rig) view.lights = threePointRig();
         PreviewSettings settings;  // 4x MSAA, voxels (additive, nearest, 256^3) + 2048^2 PCF shadow map
         if (otherResolution >= 0) settings.shadow.otherResolution = otherResolution;
+        if (voxels >= 0) settings.shadow.voxels = voxels != 0;
+        if (shadowMap >= 0) settings.shadow.shadowMap = shadowMap != 0;
+        if (msaa >= 0) settings.msaa = msaa;
+        if (pieces >= 0.f) settings.tessellationPixels = pieces;
         const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 32, 64);
         std::printf("bench_preview: %s\n", context->description().c_str());
         std::printf("hair shading: %s\n", fitted ? "fitted (dual scattering)" : "kajiya-kay");
@@ -138,7 +152,8 @@ int main(int argc, char** argv) {
                 renderer.setSettings(p);
                 renderer.draw(view, frame);
                 for (const PreviewStats::Pass& pass : renderer.stats().passes)
-                    std::printf("    %-16s wall %8.1f ms  cpu %8.1f ms\n", pass.name.c_str(), pass.wallMs, pass.cpuMs);
+                    std::printf("    %-16s wall %8.1f ms  cpu %8.1f ms  (calling thread %8.1f ms)\n", pass.name.c_str(),
+                                pass.wallMs, pass.cpuMs, pass.threadMs);
                 renderer.setSettings(settings);
             }
         }
