@@ -10,8 +10,18 @@
 layout(isolines, equal_spacing) in;
 in vec4 cPoint[];
 patch in float pSegments;
+#ifdef CAPTURE
+// The first light's voxel pass keeps its pieces for the other lights'
+// (transform feedback, render/preview/preview_gpu.h CapturedPieces): world
+// position, tangent and radius, 28 bytes a vertex.
+layout(xfb_buffer = 0, xfb_stride = 28) out;
+layout(location = 0, xfb_offset = 0) out vec3 tWorld;
+layout(location = 1, xfb_offset = 12) out vec3 tTangent;
+layout(location = 2, xfb_offset = 24) out float tRadius;
+#else
 layout(location = 0) out vec3 tWorld;
 layout(location = 1) out vec3 tTangent;
+#endif
 #ifdef LINE_OUTPUT
 // Thin hair goes straight to the rasterizer as lines of the minimum width:
 // the outputs are the hair fragment shader's inputs (as ribbon.glsl's).
@@ -20,7 +30,7 @@ layout(location = 3) out vec3 gColor;
 #ifndef SHADE_PER_FRAGMENT
 #include "hair_shading.glsl"
 #endif
-#else
+#elif !defined(CAPTURE)
 layout(location = 2) out float tRadius;
 #endif
 

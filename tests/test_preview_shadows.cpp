@@ -234,5 +234,71 @@ TEST(PreviewShadows, CapAndOrderOfShadowedLights) {
     }
 }
 
+// The strands are tessellated once, from the first shadowed light, and the
+// captured pieces voxelized into every light's grid
+// (PreviewShadowSettings::shareTessellation). Each grid, summed and times a
+// voxel column's cross-section, is the hair's projected area seen from its
+// light, sum of 2 r |segment| sin(theta) with theta between strand and that
+// light, computed here from straight strands (whose pieces are exact
+// whatever the tessellation); the first light's grid is the same with and
+// without sharing.
+TEST(PreviewShadows, SharedTessellationFillsEveryLightsGrid) {
+    HP_REQUIRE_GL();
+    View v = test::frontView(64, 48);
+    const Vec3f directions[] = {Vec3f(0.f, 0.f, -1.f), Vec3f(1.f, -0.3f, -0.6f), Vec3f(-0.4f, -1.f, 0.5f)};
+    v.lights.assign(3, v.lights[0]);
+    for (int k = 0; k < 3; ++k) v.lights[size_t(k)].direction = directions[k].normalized();
+    StrandFrame strands;
+    uint32_t seed = 4242;
+    auto random = [&seed] {
+        seed = seed * 1664525u + 1013904223u;
+        return float(seed >> 8) / float(1u << 24);
+    };
+    const float radius = 0.0001f;
+    std::vector<std::pair<Vec3f, Vec3f>> lines;
+    for (int i = 0; i < 200; ++i) {
+        const Vec3f a(-0.04f + 0.02f * random(), -0.04f + 0.08f * random(), -0.04f + 0.08f * random());
+        const Vec3f b(0.04f - 0.02f * random(), -0.04f + 0.08f * random(), -0.04f + 0.08f * random());
+        std::vector<Vec3f> p(9);
+        for (int j = 0; j < 9; ++j) p[size_t(j)] = a + (b - a) * (float(j) / 8.f);
+        const std::vector<float> r(9, radius);
+        strands.addStrand(uint32_t(i), p.data(), r.data(), 9);  // two sorted patches of 4 segments
+        lines.push_back({a, b});
+    }
+    auto grids = [&](bool share) {
+        PreviewSettings s;
+        s.shadow.resolution = 64;
+        s.shadow.otherResolution = 48;
+        s.shadow.shareTessellation = share;
+        PreviewRenderer renderer(s);
+        PreviewFrame frame;
+        frame.strands = &strands;
+        renderer.draw(v, frame);
+        EXPECT_EQ(renderer.stats().shadowedLights, 3);
+        std::vector<VoxelSnapshot> out;
+        for (int k = 0; k < 3; ++k) out.push_back(renderer.readVoxels(k));
+        return out;
+    };
+    const std::vector<VoxelSnapshot> shared = grids(true), own = grids(false);
+    for (int k = 0; k < 3; ++k) {
+        const VoxelSnapshot& snap = shared[size_t(k)];
+        ASSERT_EQ(snap.resolution, k == 0 ? 64 : 48);
+        ASSERT_FALSE(snap.grid.perspective);
+        const Vec3f d = v.lights[size_t(k)].direction.normalized();
+        double projected = 0.0;
+        for (const auto& [a, b] : lines) projected += 2.0 * radius * double((b - a).cross(d).norm());
+        double crossings = 0.0;
+        for (float c : snap.raw) crossings += c;
+        const double res = snap.resolution;
+        const double column = 1.0 / (double(snap.grid.scale.x()) * res * double(snap.grid.scale.y()) * res);
+        EXPECT_NEAR(crossings * column / projected, 1.0, 0.05)
+            << "light " << k << ": grid " << crossings * column << " m^2, strands " << projected << " m^2";
+        std::cout << "light " << k << " (shared tessellation): grid / projected area " << crossings * column / projected
+                  << "\n";
+    }
+    EXPECT_EQ(shared[0].raw, own[0].raw) << "the first light's grid does not depend on sharing";
+    EXPECT_EQ(shared[0].summed, own[0].summed);
+}
+
 }  // namespace
 }  // namespace hp

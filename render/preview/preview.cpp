@@ -33,8 +33,33 @@ double cpuMilliseconds() {
     return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
 }
 
+double threadCpuMilliseconds() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);  // the calling thread: llvmpipe's vertex pipeline
+    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
 double wallMilliseconds() {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// Whether the ribbon pass can draw anything: true unless every strand vertex
+/// lies in front of the camera and is at most `lineWidth` pixels wide there,
+/// in which case strand.tesc's THICK_PASS culls every patch (its `widest`
+/// is the same 2 r f / w over the same vertices; the 1e-3 margin covers
+/// float rounding). Skipping the pass saves the vertex and tessellation
+/// control shaders of every patch, a few percent of a frame on llvmpipe.
+bool mayHaveThickStrands(const StrandFrame& s, const Mat4f& viewProj, float focalPixels, float lineWidth) {
+    if (lineWidth <= 0.f) return true;  // no line path: the ribbon pass draws every strand
+    const bool radii = s.radii.size() == s.positions.size();
+    const Eigen::RowVector4f wRow = viewProj.row(3);
+    for (size_t i = 0; i < s.positions.size(); ++i) {
+        const float w = wRow * s.positions[i].homogeneous();
+        if (w <= 1e-5f) return true;  // at or behind the eye: the shader's clamp makes it wide
+        const float radius = radii ? s.radii[i] : 0.00004f;  // StrandBuffers::upload's default
+        if (2.f * radius * focalPixels / w > lineWidth * (1.f - 1e-3f)) return true;
+    }
+    return false;
 }
 
 }  // namespace
@@ -42,11 +67,13 @@ double wallMilliseconds() {
 struct PreviewRenderer::Impl {
     PreviewSettings settings;
     PreviewStats stats;
-    GlProgram strand, strandLines, strandVoxel, fur, furVoxel, head, headDepth, prefix, resolveMs, resolveSs, present;
+    GlProgram strand, strandLines, strandVoxel, voxelLines, fur, furVoxel, head, headDepth, prefix, resolveMs, resolveSs,
+        present;
     StrandBuffers strands;
     HeadBuffers headBuffers;
     RenderTargets targets;
     ShadowTargets shadows;
+    CapturedPieces captured;
     GLuint cameraUbo = 0, emptyVao = 0, query = 0;
     GLuint lightUbo[kMaxShadowedLights] = {};  ///< one per shadowed light: its passes' grid
     GLsync fence = nullptr;
@@ -55,6 +82,7 @@ struct PreviewRenderer::Impl {
     bool voxelsDrawn = false;
     std::vector<int> warnedUnfitted;  ///< lights already warned about
     int strandPatchSize = 0;
+    bool thickStrands = true;  ///< some strand may be wider than the line path's width (the ribbon pass runs)
     bool strandsVisible = false, headVisible = false, furVisible = false;  // what this frame draws
     bool shadedPerFragment = false;
     std::vector<ShadowSlot> slots;   ///< this frame's shadowed lights
@@ -77,6 +105,8 @@ struct PreviewRenderer::Impl {
         head = GlProgram("head", {{ShaderStage::Vertex, "head.vert"}, {ShaderStage::Fragment, "head.frag"}});
         headDepth = GlProgram("head shadow map", {{ShaderStage::Vertex, "head.vert"}, {ShaderStage::Fragment, "head.frag"}},
                               {"DEPTH_ONLY"});
+        voxelLines = GlProgram("captured strand voxelization",
+                               {{ShaderStage::Vertex, "voxel_lines.vert"}, {ShaderStage::Fragment, "voxelize.frag"}});
         prefix = GlProgram("voxel sum", {{ShaderStage::Compute, "prefix.comp"}});
         const Files resolveStages = {{ShaderStage::Vertex, "fullscreen.vert"}, {ShaderStage::Fragment, "resolve.frag"}};
         resolveMs = GlProgram("resolve (multisampled)", resolveStages, {"MULTISAMPLE"});
@@ -107,6 +137,7 @@ struct PreviewRenderer::Impl {
         headBuffers.destroy();
         targets.destroy();
         shadows.destroy();
+        captured.destroy();
         glDeleteBuffers(1, &cameraUbo);
         glDeleteBuffers(kMaxShadowedLights, lightUbo);
         glDeleteVertexArrays(1, &emptyVao);
@@ -136,7 +167,7 @@ struct PreviewRenderer::Impl {
         thin.push_back("LINE_OUTPUT");
         strand = GlProgram("strand ribbons", camera, thick);
         strandLines = GlProgram("strand lines", lines, thin);
-        strandVoxel = GlProgram("strand voxelization", voxel, {cat("PATCH_SIZE ", patchSize)});
+        strandVoxel = GlProgram("strand voxelization", voxel, {cat("PATCH_SIZE ", patchSize), "CAPTURE"});
         fur = GlProgram("generated hair",
                         {{ShaderStage::Vertex, "fur.vert"},
                          {ShaderStage::TessControl, "fur.tesc"},
@@ -189,16 +220,26 @@ struct PreviewRenderer::Impl {
         glDrawElements(GL_TRIANGLES, GLsizei(headBuffers.indexCount), GL_UNSIGNED_INT, nullptr);
     }
 
-    /// Each shadowed light in turn (the last slot first, so the shared r32ui
-    /// grid ends with slot 0's voxels for readVoxels): its head shadow map
-    /// layer, then the hair voxelized from it and summed along it into the
-    /// slot's density grid.
-    void shadowPasses(bool mapOn, bool voxelsOn) {
+    /// Each shadowed light in turn: its head shadow map layer, then the hair
+    /// voxelized from it and summed along it into the slot's density grid.
+    /// With shareTessellation the first slot's pass captures its strand
+    /// pieces and the others draw those (one tessellation for all lights).
+    void shadowPasses(bool mapOn, bool voxelsOn, const StrandFrame* strandFrame) {
         const PreviewShadowSettings& sh = settings.shadow;
         const int n = int(slots.size());
         shadows.ensure(std::clamp(sh.shadowMapSize, 16, 16384), n, slotResolution);
         glDisable(GL_BLEND);
-        for (int k = n - 1; k >= 0; --k) {
+        const bool share = voxelsOn && sh.shareTessellation && n > 1 && strandsVisible && strands.indexCount;
+        if (share)
+            captured.ensure(lightPieceVertexBound(strands, *strandFrame, slots[0].grid, slotResolution[0],
+                                                  std::clamp(settings.tessellationLevel, 1, 64),
+                                                  settings.tessellationPixels * float(supersample())));
+        const int mode = sh.mode == VoxelMode::Binary ? 0 : (sh.splat == VoxelSplat::Trilinear ? 2 : 1);
+        for (const GlProgram* p : {&strandVoxel, &voxelLines, &furVoxel}) {
+            glProgramUniform1i(p->id(), p->uniform("uMode"), mode);
+            glProgramUniform1i(p->id(), p->uniform("uCrossings"), sh.weight == VoxelWeight::Crossings ? 1 : 0);
+        }
+        for (int k = 0; k < n; ++k) {
             glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightUbo[k]);
             if (mapOn) {
                 glBindFramebuffer(GL_FRAMEBUFFER, shadows.mapFbo[k]);
@@ -217,26 +258,38 @@ struct PreviewRenderer::Impl {
             if (!voxelsOn) continue;
             const int res = slotResolution[k];
             const GLuint zero = 0;
-            glClearTexSubImage(shadows.voxels, 0, 0, 0, 0, res, res, res, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+            glClearTexImage(shadows.voxels[k], 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
             mark("voxel clear");
             glBindFramebuffer(GL_FRAMEBUFFER, shadows.voxelFbo);
             glViewport(0, 0, res, res);
             glDisable(GL_DEPTH_TEST);
             glDepthMask(GL_FALSE);
-            glBindImageTexture(0, shadows.voxels, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
-            const int mode = sh.mode == VoxelMode::Binary ? 0 : (sh.splat == VoxelSplat::Trilinear ? 2 : 1);
-            for (const GlProgram* p : {&strandVoxel, &furVoxel}) {
-                glProgramUniform1i(p->id(), p->uniform("uMode"), mode);
-                glProgramUniform1i(p->id(), p->uniform("uCrossings"), sh.weight == VoxelWeight::Crossings ? 1 : 0);
+            glBindImageTexture(0, shadows.voxels[k], 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
+            if (share && k == 0) {
+                // The program is bound before capturing starts (GL forbids
+                // changing it while transform feedback is active).
+                strandVoxel.use();
+                glBindVertexArray(strands.vao);
+                glPatchParameteri(GL_PATCH_VERTICES, strands.patchSize);
+                glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, captured.feedback);
+                glBeginTransformFeedback(GL_LINES);
+                glDrawElements(GL_PATCHES, GLsizei(strands.indexCount), GL_UNSIGNED_INT, nullptr);
+                glEndTransformFeedback();
+                glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
+            } else if (share) {
+                voxelLines.use();
+                glBindVertexArray(captured.vao);
+                glDrawTransformFeedback(GL_LINES, captured.feedback);
+            } else {
+                drawStrands(strandVoxel);
             }
-            drawStrands(strandVoxel);
             drawFur(furVoxel);
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
             mark("voxelize");
             prefix.use();
             glProgramUniform1i(prefix.id(), prefix.uniform("uSum"), sh.sumAlongLight ? 1 : 0);
             glProgramUniform1i(prefix.id(), prefix.uniform("uResolution"), res);
-            glBindImageTexture(0, shadows.voxels, 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32UI);
+            glBindImageTexture(0, shadows.voxels[k], 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32UI);
             glBindImageTexture(1, shadows.density[k], 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
             const GLuint groups = GLuint((res + 7) / 8);
             glDispatchCompute(groups, groups, 1);
@@ -304,9 +357,10 @@ struct PreviewRenderer::Impl {
             glLineWidth(lineWidth);
             drawStrands(strandLines);
             glLineWidth(1.f);
+            mark("strand lines");
         }
-        drawStrands(strand);
-        mark("strands");
+        if (thickStrands) drawStrands(strand);
+        mark("strand ribbons");
         if (query) glBeginQuery(GL_GEOMETRY_SHADER_INVOCATIONS, query);
         drawFur(fur);
         if (query) {
@@ -340,14 +394,14 @@ struct PreviewRenderer::Impl {
         glDrawArrays(GL_TRIANGLES, 0, 3);
     }
 
-    double lastWall = 0.0, lastCpu = 0.0;
+    double lastWall = 0.0, lastCpu = 0.0, lastThread = 0.0;
     /// With settings.profile: finishes the GL work so far and records it as `pass`.
     void mark(const char* pass) {
         if (!settings.profile) return;
         glFinish();
-        const double wall = wallMilliseconds(), cpu = cpuMilliseconds();
-        if (pass) stats.passes.push_back({pass, wall - lastWall, cpu - lastCpu});
-        lastWall = wall, lastCpu = cpu;
+        const double wall = wallMilliseconds(), cpu = cpuMilliseconds(), thread = threadCpuMilliseconds();
+        if (pass) stats.passes.push_back({pass, wall - lastWall, cpu - lastCpu, thread - lastThread});
+        lastWall = wall, lastCpu = cpu, lastThread = thread;
     }
 
     void draw(const View& view, const PreviewFrame& frame);
@@ -445,6 +499,8 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
                                        voxelsOn, mapOn});
     const float lineWidth = linePathWidth();
     u.blend[2] = lineWidth > 0.f ? 1.f : 0.f;
+    thickStrands = drawStrandsNow && mayHaveThickStrands(*frame.strands, Eigen::Map<const Mat4f>(u.viewProj),
+                                                         u.eye[3], lineWidth > 0.f ? u.tess[3] : 0.f);
     glNamedBufferSubData(cameraUbo, 0, sizeof(u), &u);
     if (voxelsOn || mapOn) {
         for (size_t k = 0; k < slots.size(); ++k) {
@@ -452,7 +508,7 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
             setPassGrid(l, slots[k].grid, slotResolution[k]);
             glNamedBufferSubData(lightUbo[k], 0, sizeof(l), &l);
         }
-        shadowPasses(mapOn, voxelsOn);
+        shadowPasses(mapOn, voxelsOn, frame.strands);
     }
     targets.ensure(cam.width, cam.height, samples(), supersample());
     cameraPass(voxelsOn, mapOn, lineWidth);
@@ -523,16 +579,10 @@ VoxelSnapshot PreviewRenderer::readVoxels(int slot) const {
     const size_t n = size_t(r) * r * r;
     snap.resolution = r;
     snap.grid = m.slots[size_t(slot)].grid;
-    if (slot == 0) {  // the shared r32ui grid holds slot 0's voxels, in a corner of its largest resolution
-        const int full = m.shadows.voxelResolution;
-        std::vector<uint32_t> raw(size_t(full) * full * full);
-        glGetTextureImage(m.shadows.voxels, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(raw.size() * 4), raw.data());
-        snap.raw.resize(n);
-        for (int z = 0; z < r; ++z)
-            for (int y = 0; y < r; ++y)
-                for (int x = 0; x < r; ++x)
-                    snap.raw[(size_t(z) * r + y) * r + x] = float(raw[(size_t(z) * full + y) * full + x]) / kVoxelUnit;
-    }
+    std::vector<uint32_t> raw(n);
+    glGetTextureImage(m.shadows.voxels[slot], 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(n * 4), raw.data());
+    snap.raw.resize(n);
+    for (size_t i = 0; i < n; ++i) snap.raw[i] = float(raw[i]) / kVoxelUnit;
     snap.summed.resize(n);
     glGetTextureImage(m.shadows.density[slot], 0, GL_RED, GL_FLOAT, GLsizei(n * 4), snap.summed.data());
     return snap;

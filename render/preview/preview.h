@@ -38,7 +38,9 @@
 //   (Dehlin and Styngberg's binary/additive, nearest/trilinear), summed along
 //   the light in a compute pass into the light's density grid, transmittance
 //   alpha^C; times a PCF shadow map of the head from that light. Point lights
-//   use a perspective frustum.
+//   use a perspective frustum. The strands are tessellated once for all the
+//   lights (from the first; the pieces captured by transform feedback and
+//   drawn again as lines from the others' views).
 // - Output: R, G, B premultiplied linear radiance (the environment colour
 //   fills what coverage leaves), A the coverage of hair and head, Z the
 //   camera-space depth in metres (distance along the view axis, not along
@@ -105,6 +107,12 @@ struct PreviewShadowSettings {
     VoxelWeight weight = VoxelWeight::Crossings;
     /// Fragments only: transmittance per counted fragment (or occupied voxel).
     float alpha = 0.85f;
+    /// With several shadowed lights, tessellate the strands once, from the
+    /// first shadowed light, capture the pieces (transform feedback) and
+    /// voxelize that geometry into every light's grid; false tessellates the
+    /// strands again from each light (pieces of `tessellationPixels` in each
+    /// light's own raster). The first light's grid is the same either way.
+    bool shareTessellation = true;
     bool shadowMap = true;        ///< PCF shadow map of the opaque head (hair and head receive it)
     int shadowMapSize = 2048;
     int pcfRadius = 1;            ///< (2r+1)^2 bilinear comparisons (seed eq. 8)
@@ -150,10 +158,13 @@ struct PreviewStats {
     bool shadowed = false;         ///< at least one light is shadowed
     int shadowedLights = 0;        ///< lights with a light grid this frame
     std::string renderer;          ///< GL_RENDERER
-    /// With PreviewSettings::profile: (pass, wall ms, process CPU ms) in order.
+    /// With PreviewSettings::profile: (pass, wall ms, process CPU ms, CPU ms
+    /// of the calling thread) in order. On llvmpipe the calling thread runs
+    /// the vertex, tessellation and geometry shaders (Mesa's draw module) and
+    /// its rasterizer threads the fragments, so threadMs is the serial part.
     struct Pass {
         std::string name;
-        double wallMs = 0.0, cpuMs = 0.0;
+        double wallMs = 0.0, cpuMs = 0.0, threadMs = 0.0;
     };
     std::vector<Pass> passes;
 };
@@ -197,8 +208,7 @@ class PreviewRenderer {
     /// viewport (x, y, width, height) — the viewer's window.
     void present(int x, int y, int width, int height) const;
     /// Reads the shadow grid of the last draw of the `slot`-th shadowed light
-    /// (empty when voxels were off or there is no such light). `raw` is
-    /// filled for slot 0 only (the slots share one voxel grid, slot 0 last).
+    /// (empty when voxels were off or there is no such light).
     VoxelSnapshot readVoxels(int slot = 0) const;
     const PreviewStats& stats() const;
 

@@ -7,6 +7,7 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 namespace hp {
@@ -118,6 +119,36 @@ void StrandBuffers::sortBackToFront(const StrandFrame& s, const Vec3f& eye, cons
         std::copy_n(list.begin() + std::ptrdiff_t(p * ps), ps, sortedList.begin() + std::ptrdiff_t(i * ps));
     }
     glNamedBufferSubData(indices, 0, GLsizeiptr(sortedList.size() * sizeof(uint32_t)), sortedList.data());
+}
+
+size_t lightPieceVertexBound(const StrandBuffers& b, const StrandFrame& s, const LightGrid& grid, int resolution,
+                             int level, float pixels) {
+    // strand.tesc measures a patch's length between its vertices 1 ..
+    // segments + 1 in raster pixels of the light pass (grid coordinates times
+    // the resolution) and cuts it into clamp(ceil(L / pixels), 1, most)
+    // pieces with most = segments level, split over ceil(pieces / 64)
+    // isolines of ceil(pieces / lines) pieces each: at most pieces + lines.
+    const size_t ps = size_t(b.patchSize);
+    size_t vertices = 0;
+    for (size_t p = 0; p < b.counts.size(); ++p) {
+        const uint32_t segs = b.counts[p];
+        const double most = double(segs) * double(std::max(level, 1));
+        double pieces = most;
+        if (pixels > 0.f) {
+            double length = 0.0;
+            Vec3f previous = grid.toGrid(s.positions[b.list[p * ps + 1]]);
+            for (uint32_t i = 2; i <= segs + 1; ++i) {
+                const Vec3f g = grid.toGrid(s.positions[b.list[p * ps + i]]);
+                length += double((g - previous).head<2>().norm()) * resolution;
+                previous = g;
+            }
+            // 1% and one piece for the GPU's float rounding of L.
+            pieces = std::min(most, std::max(1.0, length * 1.01 / double(pixels) + 2.0));
+        }
+        pieces = std::ceil(pieces);
+        vertices += size_t(2.0 * (pieces + std::ceil(pieces / 64.0)));
+    }
+    return vertices;
 }
 
 // ---- head ------------------------------------------------------------------

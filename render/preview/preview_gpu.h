@@ -160,23 +160,48 @@ struct RenderTargets {
 static_assert(kMaxShadowedLights == 4, "ShadowTargets::ensure/destroy and shaders/common.glsl spell out 4 slots");
 
 /// Shadow resources of up to kMaxShadowedLights lights (slots): the head's
-/// shadow maps (one layer each of a depth array texture), one r32ui voxel
-/// grid that every slot's voxelization reuses in turn (its largest
-/// resolution), the summed R32F grid of each slot that the shading samples,
-/// and an attachment-less framebuffer for voxelization.
+/// shadow maps (one layer each of a depth array texture), each slot's r32ui
+/// voxel grid and the summed R32F grid that the shading samples, and an
+/// attachment-less framebuffer for voxelization (its size the largest
+/// resolution).
 struct ShadowTargets {
-    int mapSize = 0, mapLayers = 0, voxelResolution = 0;
+    int mapSize = 0, mapLayers = 0, fboSize = 0;
     unsigned map = 0;
     unsigned mapFbo[kMaxShadowedLights] = {};
-    unsigned voxelFbo = 0, voxels = 0;
+    unsigned voxelFbo = 0;
+    unsigned voxels[kMaxShadowedLights] = {};
     unsigned density[kMaxShadowedLights] = {};
-    int resolution[kMaxShadowedLights] = {};  ///< of density[k]
+    int resolution[kMaxShadowedLights] = {};  ///< of voxels[k] and density[k]
     unsigned dummyDensity = 0, dummyMap = 0;  ///< bound when a shadow kind is off
 
-    /// Makes `slots` shadow-map layers of mapSize² and a density grid of
-    /// resolutions[k]³ per slot.
+    /// Makes `slots` shadow-map layers of mapSize² and a voxel and a density
+    /// grid of resolutions[k]³ per slot.
     void ensure(int mapSize, int slots, const int* resolutions);
     void destroy();
 };
+
+/// The strands' light-pass pieces captured once by transform feedback
+/// (shaders/strand.tese with CAPTURE: world position, tangent, radius, 28
+/// bytes a vertex, two vertices a piece) and drawn again as lines for the
+/// other lights' voxel grids.
+struct CapturedPieces {
+    unsigned buffer = 0, feedback = 0, vao = 0;
+    size_t capacity = 0;  ///< bytes
+    static constexpr size_t kVertexBytes = 28;
+
+    /// Makes room for `vertices` captured vertices.
+    void ensure(size_t vertices);
+    void destroy();
+};
+
+/// Most vertices strand.tesc and strand.tese emit for the patches of
+/// `buffers` drawn from a light pass with grid `grid` of `resolution`²
+/// raster pixels: per patch, its pieces clamp(ceil(L / pixels), 1, segments
+/// level) (L its polyline's raster length; the most when `pixels` <= 0),
+/// plus the rounding of the isolines (at most one piece per 64), two
+/// vertices a piece. A bound, never below the count, so the capture buffer
+/// never overflows.
+size_t lightPieceVertexBound(const StrandBuffers& buffers, const StrandFrame& strands, const LightGrid& grid,
+                             int resolution, int level, float pixels);
 
 }  // namespace hp

@@ -119,15 +119,12 @@ void ShadowTargets::ensure(int size, int slots, const int* resolutions) {
     }
     int largest = 0;
     for (int k = 0; k < slots; ++k) largest = std::max(largest, resolutions[k]);
-    if (largest > voxelResolution) {
-        deleteFramebuffers({&voxelFbo});
-        deleteTextures({&voxels});
-        voxelResolution = largest;
-        glCreateTextures(GL_TEXTURE_3D, 1, &voxels);
-        glTextureStorage3D(voxels, 1, GL_R32UI, largest, largest, largest);
+    if (largest > fboSize) {
         // Voxelization writes through image atomics only: a framebuffer with
         // no attachments gives the rasterizer its viewport (each slot's
         // resolution, at most this).
+        deleteFramebuffers({&voxelFbo});
+        fboSize = largest;
         glCreateFramebuffers(1, &voxelFbo);
         glNamedFramebufferParameteri(voxelFbo, GL_FRAMEBUFFER_DEFAULT_WIDTH, largest);
         glNamedFramebufferParameteri(voxelFbo, GL_FRAMEBUFFER_DEFAULT_HEIGHT, largest);
@@ -136,8 +133,12 @@ void ShadowTargets::ensure(int size, int slots, const int* resolutions) {
     for (int k = 0; k < slots; ++k) {
         const int res = resolutions[k];
         if (res == resolution[k] && density[k]) continue;
-        deleteTextures({&density[k]});
+        deleteTextures({&density[k], &voxels[k]});
         resolution[k] = res;
+        // Each slot its own voxel grid: the first slot's pass captures the
+        // pieces the others draw, so it runs first (8 MB more a 128³ slot).
+        glCreateTextures(GL_TEXTURE_3D, 1, &voxels[k]);
+        glTextureStorage3D(voxels[k], 1, GL_R32UI, res, res, res);
         glCreateTextures(GL_TEXTURE_3D, 1, &density[k]);
         glTextureStorage3D(density[k], 1, GL_R32F, res, res, res);
         glTextureParameteri(density[k], GL_TEXTURE_MIN_FILTER, GL_LINEAR);
@@ -149,9 +150,40 @@ void ShadowTargets::ensure(int size, int slots, const int* resolutions) {
 
 void ShadowTargets::destroy() {
     deleteFramebuffers({&mapFbo[0], &mapFbo[1], &mapFbo[2], &mapFbo[3], &voxelFbo});
-    deleteTextures({&map, &voxels, &density[0], &density[1], &density[2], &density[3], &dummyDensity, &dummyMap});
-    mapSize = mapLayers = voxelResolution = 0;
+    deleteTextures({&map, &voxels[0], &voxels[1], &voxels[2], &voxels[3], &density[0], &density[1], &density[2],
+                    &density[3], &dummyDensity, &dummyMap});
+    mapSize = mapLayers = fboSize = 0;
     for (int& r : resolution) r = 0;
+}
+
+void CapturedPieces::ensure(size_t vertices) {
+    if (!feedback) {
+        glCreateTransformFeedbacks(1, &feedback);
+        // The captured vertices as shaders/voxel_lines.vert reads them.
+        glCreateVertexArrays(1, &vao);
+        const GLuint offsets[] = {0, 12, 24}, sizes[] = {3, 3, 1};
+        for (GLuint a = 0; a < 3; ++a) {
+            glEnableVertexArrayAttrib(vao, a);
+            glVertexArrayAttribFormat(vao, a, GLint(sizes[a]), GL_FLOAT, GL_FALSE, offsets[a]);
+            glVertexArrayAttribBinding(vao, a, 0);
+        }
+    }
+    const size_t bytes = std::max<size_t>(vertices, 2) * kVertexBytes;
+    if (bytes <= capacity && buffer) return;
+    if (buffer) glDeleteBuffers(1, &buffer);
+    capacity = std::max(bytes, capacity + capacity / 2);  // grow by half again, as PersistentBuffer
+    glCreateBuffers(1, &buffer);
+    glNamedBufferStorage(buffer, GLsizeiptr(capacity), nullptr, 0);
+    glTransformFeedbackBufferBase(feedback, 0, buffer);
+    glVertexArrayVertexBuffer(vao, 0, buffer, 0, GLsizei(kVertexBytes));
+}
+
+void CapturedPieces::destroy() {
+    if (buffer) glDeleteBuffers(1, &buffer);
+    if (feedback) glDeleteTransformFeedbacks(1, &feedback);
+    if (vao) glDeleteVertexArrays(1, &vao);
+    buffer = feedback = vao = 0;
+    capacity = 0;
 }
 
 }  // namespace hp

@@ -8,7 +8,8 @@
 //
 //   bench_preview [--strands 10000,100000] [--frames 3] [--warmup 1]
 //                 [--profile] [--png out.png] [--shading kajiya-kay|fitted]
-//                 [--lights one|rig] [--other-resolution N]
+//                 [--lights one|rig] [--other-resolution N] [--max-lights N]
+//                 [--share 0|1] [--voxels 0|1] [--shadow-map 0|1] [--msaa N] [--pieces P]
 // --shading fitted shades with the hair material fitted to the physical
 // fibre (render/reference/hair_fit.h, melanin 1.3) and dual scattering; the
 // default keeps the plain Kajiya-Kay material the benchmark always had.
@@ -17,9 +18,15 @@
 // shadows each of its lights that casts shadows (each costs a voxelization,
 // a sum and a shadow map); --other-resolution sets the voxel resolution of
 // the shadowed lights after the first (PreviewShadowSettings::otherResolution).
+// For experiments: --max-lights N (PreviewShadowSettings::maxLights: 1 shadows
+// the key alone), --share 0 (each light tessellates the strands itself),
+// --voxels 0, --shadow-map 0, --msaa N, --pieces P (tessellationPixels).
 // Per strand count: median, min and max of the timed frames (draw + glFinish,
 // wall and process CPU time, llvmpipe's threads included), readback time,
-// peak resident memory; --profile adds a per-pass breakdown of one extra frame.
+// peak resident memory; --profile adds a per-pass breakdown of one extra frame
+// (wall, process CPU, and the CPU of the calling thread, which on llvmpipe
+// runs the vertex, tessellation and geometry shaders; the rest is its
+// rasterizer threads).
 #include "core/errors.h"
 #include "render/preview/gl_context.h"
 #include "render/preview/preview.h"
@@ -62,6 +69,8 @@ int main(int argc, char** argv) {
     bool profile = false;
     bool fitted = false, rig = false;
     int otherResolution = -1;
+    int voxels = -1, shadowMap = -1, msaa = -1, maxLights = -1, share = -1;
+    float pieces = -1.f;
     std::string png;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -82,10 +91,22 @@ int main(int argc, char** argv) {
             rig = std::string(argv[++i]) == "rig";
         } else if (a == "--other-resolution" && more) {
             otherResolution = std::atoi(argv[++i]);
+        } else if (a == "--voxels" && more) {
+            voxels = std::atoi(argv[++i]);
+        } else if (a == "--shadow-map" && more) {
+            shadowMap = std::atoi(argv[++i]);
+        } else if (a == "--max-lights" && more) {
+            maxLights = std::atoi(argv[++i]);
+        } else if (a == "--share" && more) {
+            share = std::atoi(argv[++i]);
+        } else if (a == "--msaa" && more) {
+            msaa = std::atoi(argv[++i]);
+        } else if (a == "--pieces" && more) {
+            pieces = float(std::atof(argv[++i]));
         } else if (a == "--png" && more) {
             png = argv[++i];
         } else {
-            std::cerr << "usage: bench_preview [--strands N,M] [--frames N] [--warmup N] [--profile] [--png FILE] [--shading kajiya-kay|fitted] [--lights one|rig] [--other-resolution N]\n";
+            std::cerr << "usage: bench_preview [--strands N,M] [--frames N] [--warmup N] [--profile] [--png FILE] [--shading kajiya-kay|fitted] [--lights one|rig] [--other-resolution N] [--max-lights N] [--share 0|1] [--voxels 0|1] [--shadow-map 0|1] [--msaa N] [--pieces P]\n";
             return 1;
         }
     }
@@ -96,6 +117,12 @@ int main(int argc, char** argv) {
         if (rig) view.lights = threePointRig();
         PreviewSettings settings;  // 4x MSAA, voxels (additive, nearest, 256^3) + 2048^2 PCF shadow map
         if (otherResolution >= 0) settings.shadow.otherResolution = otherResolution;
+        if (voxels >= 0) settings.shadow.voxels = voxels != 0;
+        if (shadowMap >= 0) settings.shadow.shadowMap = shadowMap != 0;
+        if (msaa >= 0) settings.msaa = msaa;
+        if (maxLights >= 0) settings.shadow.maxLights = maxLights;
+        if (share >= 0) settings.shadow.shareTessellation = share != 0;
+        if (pieces >= 0.f) settings.tessellationPixels = pieces;
         const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 32, 64);
         std::printf("bench_preview: %s\n", context->description().c_str());
         std::printf("hair shading: %s\n", fitted ? "fitted (dual scattering)" : "kajiya-kay");
@@ -138,7 +165,8 @@ int main(int argc, char** argv) {
                 renderer.setSettings(p);
                 renderer.draw(view, frame);
                 for (const PreviewStats::Pass& pass : renderer.stats().passes)
-                    std::printf("    %-16s wall %8.1f ms  cpu %8.1f ms\n", pass.name.c_str(), pass.wallMs, pass.cpuMs);
+                    std::printf("    %-16s wall %8.1f ms  cpu %8.1f ms  (calling thread %8.1f ms)\n", pass.name.c_str(),
+                                pass.wallMs, pass.cpuMs, pass.threadMs);
                 renderer.setSettings(settings);
             }
         }
