@@ -238,7 +238,8 @@ TEST(Reference, PhysicalWhiteFibreUnderWhiteSkyIsWhite) {
     s.fiber.sigmaA = Vec3f::Zero();
     // Also with split bounces (each of the N continuations counts 1/N) and
     // with the ZSobol layout.
-    for (const auto& [bounces, splits, zsobol] : {std::tuple{0, 1, false}, {2, 1, false}, {2, 3, false}, {2, 1, true}}) {
+    for (const auto& [bounces, splits, zsobol] :
+         {std::tuple{0, 1, false}, {2, 1, false}, {2, 3, false}, {2, 1, true}}) {
         s.bounces = bounces;
         s.bounceSplits = splits;
         s.sampler = zsobol ? sampling::SamplerType::ZSobol : sampling::SamplerType::Independent;

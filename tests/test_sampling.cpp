@@ -71,7 +71,8 @@ TEST(Sampling, EveryPassOfAPixelIsANet) {
                     SCOPED_TRACE(::testing::Message() << samplerName(type) << " first " << first << " pixel " << x
                                                       << "," << y << " pair " << pair);
                     EXPECT_TRUE(isNet(points(layout, x, y, 0, first, pair)));
-                    for (uint32_t b = first; b < 16 * first; b *= 2) EXPECT_TRUE(isNet(points(layout, x, y, b, 2 * b, pair)));
+                    for (uint32_t b = first; b < 16 * first; b *= 2)
+                        EXPECT_TRUE(isNet(points(layout, x, y, b, 2 * b, pair)));
                 }
         }
 }

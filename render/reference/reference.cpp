@@ -233,8 +233,8 @@ Image ReferenceRenderer::render(const View& shotView, const StrandFrame* strands
                 if (outOfTime) return;
                 const int tx = int(t % size_t(tilesX)), ty = int(t / size_t(tilesX));
                 const int x0 = tx * ts, y0 = ty * ts;
-                rays += sampleTile(ctx, layout, film, x0, y0, std::min(x0 + ts, film.width), std::min(y0 + ts, film.height),
-                                   target);
+                rays += sampleTile(ctx, layout, film, x0, y0, std::min(x0 + ts, film.width),
+                                   std::min(y0 + ts, film.height), target);
                 if (settings.progress) {
                     std::lock_guard<std::mutex> lock(progressMutex);
                     settings.progress(++done, tiles);

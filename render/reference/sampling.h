@@ -128,7 +128,8 @@ struct SamplerLayout {
 class PixelSampler {
   public:
     /// The independent layout: `seed` and `frame` select the sequence; (x, y) the pixel.
-    PixelSampler(uint64_t seed, int frame, int x, int y) : PixelSampler(SamplerLayout{SamplerType::Independent, seed, frame}, x, y) {}
+    PixelSampler(uint64_t seed, int frame, int x, int y)
+        : PixelSampler(SamplerLayout{SamplerType::Independent, seed, frame}, x, y) {}
 
     PixelSampler(const SamplerLayout& layout, int x, int y)
         : layout_(layout),
