@@ -19,6 +19,7 @@
 
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 using namespace hp;
 using namespace hp::test;
@@ -134,9 +135,22 @@ TEST(Reference, ShadowRaysCountEachStrandCrossingOnce) {
 TEST(Reference, SameBitsForOneAndTwoThreads) {
     HairOnHead shot = hairOnHead(80, 60);
     shot.view.environment = Vec3f(0.1f, 0.1f, 0.12f);
-    for (ReferenceMode mode : {ReferenceMode::KajiyaKay, ReferenceMode::Physical}) {
+    // Physical twice more: with the ZSobol layout (one sequence for the
+    // image) and with split bounces.
+    struct Case {
+        ReferenceMode mode;
+        sampling::SamplerType sampler;
+        int splits;
+    };
+    for (const Case& c : {Case{ReferenceMode::KajiyaKay, sampling::SamplerType::Independent, 1},
+                          Case{ReferenceMode::Physical, sampling::SamplerType::Independent, 1},
+                          Case{ReferenceMode::Physical, sampling::SamplerType::ZSobol, 1},
+                          Case{ReferenceMode::Physical, sampling::SamplerType::Independent, 3}}) {
+        const ReferenceMode mode = c.mode;
         ReferenceSettings s;
         s.mode = mode;
+        s.sampler = c.sampler;
+        s.bounceSplits = c.splits;
         s.samplesPerPixel = 4;
         s.bounces = 3;
         s.tileSize = 8;
@@ -147,7 +161,7 @@ TEST(Reference, SameBitsForOneAndTwoThreads) {
         tbb::task_arena(2).execute([&] { two = ReferenceRenderer().render(shot.view, &shot.strands, &shot.head, s); });
         ASSERT_EQ(one.pixels.size(), two.pixels.size());
         EXPECT_EQ(0, std::memcmp(one.pixels.data(), two.pixels.data(), one.pixels.size() * sizeof(float)))
-            << referenceModeName(mode);
+            << referenceModeName(mode) << " " << sampling::samplerName(c.sampler) << " splits " << c.splits;
         double coverage = 0.0;
         for (int y = 0; y < one.height; ++y)
             for (int x = 0; x < one.width; ++x) coverage += one.at(x, y, 3);
@@ -222,8 +236,13 @@ TEST(Reference, PhysicalWhiteFibreUnderWhiteSkyIsWhite) {
     s.mode = ReferenceMode::Physical;
     s.samplesPerPixel = 32;
     s.fiber.sigmaA = Vec3f::Zero();
-    for (int bounces : {0, 2}) {
+    // Also with split bounces (each of the N continuations counts 1/N) and
+    // with the ZSobol layout.
+    for (const auto& [bounces, splits, zsobol] :
+         {std::tuple{0, 1, false}, {2, 1, false}, {2, 3, false}, {2, 1, true}}) {
         s.bounces = bounces;
+        s.bounceSplits = splits;
+        s.sampler = zsobol ? sampling::SamplerType::ZSobol : sampling::SamplerType::Independent;
         const Image img = ReferenceRenderer().render(view, &strands, nullptr, s);
         double sum = 0.0;
         int n = 0;
@@ -231,7 +250,7 @@ TEST(Reference, PhysicalWhiteFibreUnderWhiteSkyIsWhite) {
             for (int x = 4; x < 60; ++x)
                 if (img.at(x, y, 3) == 1.f) sum += img.at(x, y, 1), ++n;
         ASSERT_GT(n, 100);
-        EXPECT_NEAR(sum / n, 1.0, 0.03) << "bounces " << bounces;
+        EXPECT_NEAR(sum / n, 1.0, 0.03) << "bounces " << bounces << " splits " << splits << " zsobol " << zsobol;
     }
 }
 

@@ -50,6 +50,9 @@ ReferenceSettings referenceSettings(const Scene& s, const ShotSettings& shot) {
     r.filter.radius = r.filter.type == PixelFilterType::Box ? 0.5f : float(s.number("reference.filter.radius"));
     r.filter.sigma = float(s.number("reference.filter.sigma"));
     r.bounces = int(s.integer("reference.depth"));
+    r.bounceSplits = int(s.integer("reference.bounce_splits"));
+    r.sampler = s.text("reference.sampler") == "independent" ? sampling::SamplerType::Independent
+                                                              : sampling::SamplerType::ZSobol;
     r.seed = s.has("reference.seed") ? uint64_t(s.integer("reference.seed")) : uint64_t(shot.seed);
     r.shadows = s.flag("reference.shadows");
     r.shadowRouletteThreshold = float(s.number("reference.shadow_roulette"));

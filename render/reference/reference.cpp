@@ -64,6 +64,7 @@ void checkSettings(const View& view, const ReferenceSettings& s) {
     if (!(s.filter.radius > 0.f) || (s.filter.type == PixelFilterType::Gaussian && !(s.filter.sigma > 0.f)))
         throw FrameError(cat("reference: pixel filter radius ", s.filter.radius, ", sigma ", s.filter.sigma));
     if (s.bounces < 0) throw FrameError(cat("reference: ", s.bounces, " bounces"));
+    if (s.bounceSplits < 1) throw FrameError(cat("reference: ", s.bounceSplits, " bounce splits"));
     if (s.tileSize < 1) throw FrameError(cat("reference: tile size ", s.tileSize));
     const float t = view.hair.transmittance;
     if (!(t >= 0.f && t <= 1.f)) throw FrameError(cat("reference: hair transmittance ", t, " is outside [0, 1]"));
@@ -115,7 +116,8 @@ struct Film {
 /// Takes each active pixel of one tile from its sample count up to `target`
 /// samples (indices n .. target−1 of its sequence). The first half's sum is
 /// kept at index target/2, which is where the previous pass stopped.
-uint64_t sampleTile(const ShadingContext& ctx, Film& film, int x0, int y0, int x1, int y1, uint32_t target) {
+uint64_t sampleTile(const ShadingContext& ctx, const sampling::SamplerLayout& layout, Film& film, int x0, int y0, int x1,
+                    int y1, uint32_t target) {
     const ReferenceSettings& s = ctx.settings;
     const Camera& cam = ctx.view.camera;
     const bool layers = !film.diffuse.empty(), ids = !film.ids.empty();
@@ -127,7 +129,7 @@ uint64_t sampleTile(const ShadingContext& ctx, Film& film, int x0, int y0, int x
             const size_t k = size_t(y) * size_t(film.width) + size_t(x);
             if (!film.active[k]) continue;
             PixelState& px = film.pixels[k];
-            sampling::PixelSampler sampler(s.seed, s.frame, x, y);
+            sampling::PixelSampler sampler(layout, x, y);
             for (uint32_t i = px.n; i < target; ++i) {
                 if (i == target / 2) px.firstHalf = px.sum;
                 sampler.start(i);
@@ -218,6 +220,9 @@ Image ReferenceRenderer::render(const View& shotView, const StrandFrame* strands
     // pixels whose error is below the threshold stop (with their neighbours
     // dilated back in), and the target doubles, so counts stay powers of two.
     const uint32_t first = adaptive ? uint32_t(settings.minSamples) : last;
+    // The sampler's levels are the passes (render/reference/sampling.h).
+    const auto layout = sampling::SamplerLayout::make(settings.sampler, settings.seed, settings.frame, film.width,
+                                                      film.height, first);
     for (uint32_t target = first;; target *= 2) {
         std::atomic<size_t> done{0};
         tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& range) {
@@ -228,8 +233,8 @@ Image ReferenceRenderer::render(const View& shotView, const StrandFrame* strands
                 if (outOfTime) return;
                 const int tx = int(t % size_t(tilesX)), ty = int(t / size_t(tilesX));
                 const int x0 = tx * ts, y0 = ty * ts;
-                rays += sampleTile(ctx, film, x0, y0, std::min(x0 + ts, film.width), std::min(y0 + ts, film.height),
-                                   target);
+                rays += sampleTile(ctx, layout, film, x0, y0, std::min(x0 + ts, film.width),
+                                   std::min(y0 + ts, film.height), target);
                 if (settings.progress) {
                     std::lock_guard<std::mutex> lock(progressMutex);
                     settings.progress(++done, tiles);

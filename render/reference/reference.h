@@ -34,6 +34,7 @@
 #include "render/image/image_io.h"
 #include "render/reference/hair_bsdf.h"
 #include "render/reference/pixel_filter.h"
+#include "render/reference/sampling.h"
 #include "render/view/view.h"
 #include "sim/strands/head.h"
 #include "sim/strands/strand.h"
@@ -79,6 +80,12 @@ struct ReferenceSettings {
     double timeLimit = 0.0;
     PixelFilter filter;          ///< Gaussian σ 0.5 px, radius 1.5 px (pbrt-v4's default)
     int bounces = 4;             ///< physical: indirect bounces after the first hit (0 = direct light only)
+    /// physical: independent indirect paths from each camera sample's first
+    /// hit, each counted 1/N (unbiased; 1 = one path, as before).
+    int bounceSplits = 1;
+    /// How pixels share the sampler's sequences: independent (white-noise
+    /// error) or zsobol (blue noise across pixels), render/reference/sampling.h.
+    sampling::SamplerType sampler = sampling::SamplerType::Independent;
     uint64_t seed = 1;
     int frame = 0;               ///< part of the random sequence, so frames decorrelate
     bool shadows = true;

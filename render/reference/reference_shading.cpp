@@ -114,8 +114,8 @@ SampleResult shadeKajiyaKay(const ShadingContext& ctx, const Vec3f& o, const Vec
 /// escapes to the environment, adds their radiance. Both estimates of the
 /// same light are weighted by the power heuristic (Veach and Guibas 1995),
 /// so together they count it once; delta lights are light-sampled only.
-SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit hit,
-                           sampling::PixelSampler& sampler) {
+SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit hit, sampling::PixelSampler& sampler,
+                           Vec3f beta = Vec3f::Ones(), int firstBounce = 0) {
     SampleResult r;
     const ReferenceSettings& s = ctx.settings;
     const EnvironmentLight& env = ctx.environment;
@@ -134,8 +134,7 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
     bool hittable = false;
     for (const SampledLight& l : ctx.lights) hittable = hittable || (!l.delta() && !firstHitLight(l));
     hittable = (hittable && bsdfSampling) || (env.active() && skyBsdfSampling);
-    Vec3f beta = Vec3f::Ones();
-    for (int bounce = 0;; ++bounce) {
+    for (int bounce = firstBounce;; ++bounce) {
         const bool last = bounce >= s.bounces;
         const Vec3f p = o + hit.t * d;
         const Vec3f wo = -d;
@@ -203,67 +202,91 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
         }
         if (last && !hittable) break;
 
-        // BSDF sampling: the path's next direction.
-        const Vec2f u0 = sampler.next2D(), u1 = sampler.next2D();
-        const VertexSample bs = bsdf.sample(u0, u1);
-        if (!bs.valid) break;
-        beta = beta.cwiseProduct(bs.weight);
-        // Russian roulette from the second bounce on (as pbrt-v4: the first
-        // bounces carry most of the picture and cost little): continue with
-        // probability max(β) (≤ 1) and reweight, which is unbiased and stops
-        // the many paths that dark hair has already absorbed.
-        if (!last && bounce >= 1) {
-            const float survive = std::min(1.f, beta.maxCoeff());
-            const float ur = sampler.next1D();
-            if (survive < 1.f) {
-                if (!(ur < survive)) break;
-                beta /= survive;
-            }
-        }
-        o = origin;
-        d = bs.wi;
-        // The path goes on with the head opaque: a bounce off the skin must
-        // not see hair through the neck. A direction into the head's surface
-        // (the wrap lobe past the terminator) ends it.
-        const bool intoHead = onHead && !(d.dot(headNg) > 0.f);
+        // BSDF sampling: the path's next direction, with `throughput`
+        // (updated), its contributions counted `weight` times; false where
+        // the path ends. Sets d, next and intoHead.
         SceneHit next;
-        if (!intoHead) {
-            ++r.rays;
-            next = ctx.scene.intersect(o, d, 0.f, kInf, onHead ? RayStart{} : start);
-        }
-        if (bsdfSampling || skyBsdfSampling) {
-            // The lights and sky this ray reaches, seen as the light samples'
-            // shadow rays see them (hair blocks; from the head, the head does
-            // not), so that both estimates of each light agree for MIS.
-            float tLight = next.kind == SceneHit::Kind::None ? kInf : next.t;
-            if (onHead && (intoHead || next.kind == SceneHit::Kind::Head)) {
-                ++r.rays;
-                const SceneHit hair = ctx.scene.intersect(o, d, 0.f, kInf, kFromHead);
-                tLight = hair.kind == SceneHit::Kind::None ? kInf : hair.t;
-            }
-            if (!s.shadows) tLight = kInf;
-            Vec3f found = Vec3f::Zero();
-            for (const SampledLight& light : ctx.lights) {
-                if (firstHitLight(light) || !bsdfSampling) continue;
-                Vec3f le;
-                float pdfL;
-                if (light.hit(o, d, tLight, &le, &pdfL))
-                    found += le * (lightSampling ? powerHeuristic(bs.pdf, pdfL) : 1.f);
-            }
-            if (env.active() && skyBsdfSampling && std::isinf(tLight))
-                found += env.radiance(d) * (skyLightSampling ? powerHeuristic(bs.pdf, env.pdf(d)) : 1.f);
-            if (found.maxCoeff() > 0.f) {
-                r.radiance += beta.cwiseProduct(found);
-                if (bounce == 0 && s.diffuseSpecularLayers) {
-                    // The R lobe's share of what this direction brought.
-                    float pdfB;
-                    Vec3f spec;
-                    const Vec3f f = bsdf.eval(d, &pdfB, &spec);
-                    for (int c = 0; c < 3; ++c)
-                        if (f[c] > 0.f) r.specular[c] += beta[c] * found[c] * spec[c] / f[c];
+        bool intoHead = false;
+        auto step = [&](Vec3f& throughput, float weight) -> bool {
+            const Vec2f u0 = sampler.next2D(), u1 = sampler.next2D();
+            const VertexSample bs = bsdf.sample(u0, u1);
+            if (!bs.valid) return false;
+            throughput = throughput.cwiseProduct(bs.weight);
+            // Russian roulette from the second bounce on (as pbrt-v4: the first
+            // bounces carry most of the picture and cost little): continue with
+            // probability max(β) (≤ 1) and reweight, which is unbiased and stops
+            // the many paths that dark hair has already absorbed.
+            if (!last && bounce >= 1) {
+                const float survive = std::min(1.f, throughput.maxCoeff());
+                const float ur = sampler.next1D();
+                if (survive < 1.f) {
+                    if (!(ur < survive)) return false;
+                    throughput /= survive;
                 }
             }
+            d = bs.wi;
+            // The path goes on with the head opaque: a bounce off the skin must
+            // not see hair through the neck. A direction into the head's surface
+            // (the wrap lobe past the terminator) ends it.
+            intoHead = onHead && !(d.dot(headNg) > 0.f);
+            next = SceneHit{};
+            if (!intoHead) {
+                ++r.rays;
+                next = ctx.scene.intersect(origin, d, 0.f, kInf, onHead ? RayStart{} : start);
+            }
+            if (bsdfSampling || skyBsdfSampling) {
+                // The lights and sky this ray reaches, seen as the light samples'
+                // shadow rays see them (hair blocks; from the head, the head does
+                // not), so that both estimates of each light agree for MIS.
+                float tLight = next.kind == SceneHit::Kind::None ? kInf : next.t;
+                if (onHead && (intoHead || next.kind == SceneHit::Kind::Head)) {
+                    ++r.rays;
+                    const SceneHit hair = ctx.scene.intersect(origin, d, 0.f, kInf, kFromHead);
+                    tLight = hair.kind == SceneHit::Kind::None ? kInf : hair.t;
+                }
+                if (!s.shadows) tLight = kInf;
+                Vec3f found = Vec3f::Zero();
+                for (const SampledLight& light : ctx.lights) {
+                    if (firstHitLight(light) || !bsdfSampling) continue;
+                    Vec3f le;
+                    float pdfL;
+                    if (light.hit(origin, d, tLight, &le, &pdfL))
+                        found += le * (lightSampling ? powerHeuristic(bs.pdf, pdfL) : 1.f);
+                }
+                if (env.active() && skyBsdfSampling && std::isinf(tLight))
+                    found += env.radiance(d) * (skyLightSampling ? powerHeuristic(bs.pdf, env.pdf(d)) : 1.f);
+                if (found.maxCoeff() > 0.f) {
+                    r.radiance += weight * throughput.cwiseProduct(found);
+                    if (bounce == 0 && s.diffuseSpecularLayers) {
+                        // The R lobe's share of what this direction brought.
+                        float pdfB;
+                        Vec3f spec;
+                        const Vec3f f = bsdf.eval(d, &pdfB, &spec);
+                        for (int c = 0; c < 3; ++c)
+                            if (f[c] > 0.f) r.specular[c] += weight * throughput[c] * found[c] * spec[c] / f[c];
+                    }
+                }
+            }
+            return true;
+        };
+        // Splitting (ReferenceSettings::bounceSplits): several independent
+        // continuations of the camera hit, each counted 1/N: an estimate of
+        // the indirect light with 1/N of one's variance, without paying again
+        // for the camera ray, the first hit's shading and its direct light.
+        const int splits = bounce == 0 ? std::max(1, s.bounceSplits) : 1;
+        if (splits > 1) {
+            const float w = 1.f / float(splits);
+            for (int k = 0; k < splits; ++k) {
+                Vec3f b = beta;
+                if (!step(b, w) || intoHead || next.kind == SceneHit::Kind::None || last) continue;
+                const SampleResult sub = tracePhysical(ctx, origin, d, next, sampler, b, bounce + 1);
+                r.radiance += w * sub.radiance;
+                r.rays += sub.rays;
+            }
+            break;
         }
+        if (!step(beta, 1.f)) break;
+        o = origin;
         hit = next;
         if (intoHead || hit.kind == SceneHit::Kind::None || last) break;
     }

@@ -14,12 +14,14 @@
 //                   [--melanin 1.3] [--shadow-roulette 0.03125 (0: off)] [--seed 1]
 //                   [--noise-threshold T (adaptive; 0: --spp fixed)] [--min-samples 16]
 //                   [--max-samples 1024] [--time-limit S] [--filter gaussian|box]
-//                   [--seeds A,B]
+//                   [--seeds A,B] [--sampler zsobol|independent] [--bounce-splits 1]
 //
 // B-converge (docs/benchmarks.md): with --seeds A,B every render is made with
 // both sampler seeds and the two images are compared on the hair mask (FLIP,
 // SSIM: render/compare/compare.h), the noise figure that needs no
-// higher-sample image; the time column is then one render's.
+// higher-sample image (and rmse2, the RMSE between the two on the mask:
+// √2 times each one's RMSE against the converged image); the time column is
+// then one render's.
 #include "render/compare/compare.h"
 #include "render/reference/reference.h"
 #include "sim/strands/head.h"
@@ -65,7 +67,7 @@ double median(std::vector<double> v) {
 
 int main(int argc, char** argv) {
     std::vector<std::string> strandCounts{"10000", "100000"}, modes{"physical", "kajiya-kay"};
-    int width = 1920, height = 1080, spp = 16, bounces = 4, repeat = 1, threads = 2;
+    int width = 1920, height = 1080, spp = 16, bounces = 4, repeat = 1, threads = 2, bounceSplits = 1;
     bool withHead = true, shadows = true;
     float melanin = 1.3f;
     float shadowRoulette = ReferenceSettings{}.shadowRouletteThreshold;
@@ -75,6 +77,7 @@ int main(int argc, char** argv) {
     int minSamples = 16, maxSamples = 1024;
     double timeLimit = 0.0;
     PixelFilterType filter = PixelFilterType::Gaussian;
+    sampling::SamplerType sampler = ReferenceSettings{}.sampler;
     std::string out;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -91,6 +94,7 @@ int main(int argc, char** argv) {
         else if (a == "--height") height = std::stoi(next());
         else if (a == "--spp") spp = std::stoi(next());
         else if (a == "--bounces") bounces = std::stoi(next());
+        else if (a == "--bounce-splits") bounceSplits = std::stoi(next());
         else if (a == "--repeat") repeat = std::max(1, std::stoi(next()));
         else if (a == "--threads") threads = std::stoi(next());
         else if (a == "--out") out = next();
@@ -104,6 +108,8 @@ int main(int argc, char** argv) {
         else if (a == "--min-samples") minSamples = std::stoi(next());
         else if (a == "--max-samples") maxSamples = std::stoi(next());
         else if (a == "--time-limit") timeLimit = std::stod(next());
+        else if (a == "--sampler")
+            sampler = next() == "independent" ? sampling::SamplerType::Independent : sampling::SamplerType::ZSobol;
         else if (a == "--filter") filter = next() == "box" ? PixelFilterType::Box : PixelFilterType::Gaussian;
         else {
             std::fprintf(stderr, "unknown option %s (see the comment at the top of bench_reference.cpp)\n", a.c_str());
@@ -118,16 +124,17 @@ int main(int argc, char** argv) {
     const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 32, 64);
 
     std::printf("# bench_reference: %dx%d, %s, %d bounces (physical), %d threads, head %s, shadow roulette %g, "
-                "%s filter, synthetic hair\n",
+                "%s filter, %s sampler, synthetic hair\n",
                 width, height,
                 noiseThreshold > 0.f ? ("noise threshold " + std::to_string(noiseThreshold) + ", spp " +
                                         std::to_string(minSamples) + ".." + std::to_string(maxSamples))
                                            .c_str()
                                      : (std::to_string(spp) + " spp").c_str(),
-                bounces, threads, withHead ? "on" : "off", shadowRoulette, pixelFilterName(filter));
-    std::printf("%-8s %-11s %8s %9s %9s %9s %8s %8s %8s %10s %10s %9s %8s %8s %7s %7s\n", "strands", "mode", "build_s",
+                bounces, threads, withHead ? "on" : "off", shadowRoulette, pixelFilterName(filter),
+                sampling::samplerName(sampler));
+    std::printf("%-8s %-11s %8s %9s %9s %9s %8s %8s %8s %10s %10s %9s %8s %8s %7s %7s %8s\n", "strands", "mode", "build_s",
                 "render_s", "frame_s", "spread_s", "bcpu_s", "rcpu_s", "rays/spl", "embree_MB", "emb_peakMB", "rss_MB",
-                "spp_mean", "spp_max", "flip2", "ssim2");
+                "spp_mean", "spp_max", "flip2", "ssim2", "rmse2");
     if (seeds.empty()) seeds.push_back(std::to_string(seed));
     ReferenceRenderer renderer;
     for (const std::string& count : strandCounts) {
@@ -140,12 +147,14 @@ int main(int argc, char** argv) {
             s.mode = modeName == "physical" ? ReferenceMode::Physical : ReferenceMode::KajiyaKay;
             s.samplesPerPixel = spp;
             s.bounces = bounces;
+            s.bounceSplits = bounceSplits;
             s.frame = 1;
             s.noiseThreshold = noiseThreshold;
             s.minSamples = minSamples;
             s.maxSamples = maxSamples;
             s.timeLimit = timeLimit;
             s.filter.type = filter;
+            s.sampler = sampler;
             if (filter == PixelFilterType::Box) s.filter.radius = 0.5f;
             s.shadows = shadows;
             s.fiber.sigmaA = hairAbsorptionFromMelanin(melanin, 0.f);
@@ -166,21 +175,21 @@ int main(int argc, char** argv) {
                 }
                 images.push_back(std::move(image));
             }
-            double flip2 = -1.0, ssim2 = -1.0;
+            double flip2 = -1.0, ssim2 = -1.0, rmse2 = -1.0;
             if (images.size() >= 2) {
                 CompareSettings cs;
                 cs.mask = MaskMode::Hair;
                 const FrameMetrics m = compareImages(images[0], images[1], cs).metrics;
-                flip2 = m.flip, ssim2 = m.ssim;
+                flip2 = m.flip, ssim2 = m.ssim, rmse2 = m.rmse;
             }
             const Image& image = images.front();
             const double spread = *std::max_element(frame.begin(), frame.end()) -
                                   *std::min_element(frame.begin(), frame.end());
-            std::printf("%-8s %-11s %8.2f %9.2f %9.2f %9.2f %8.2f %8.2f %8.2f %10.1f %10.1f %9.0f %8.1f %8d %7.4f %7.4f\n",
+            std::printf("%-8s %-11s %8.2f %9.2f %9.2f %9.2f %8.2f %8.2f %8.2f %10.1f %10.1f %9.0f %8.1f %8d %7.4f %7.4f %8.5f\n",
                         count.c_str(), modeName.c_str(), median(build), median(render), median(frame), spread,
                         median(bcpu), median(rcpu), double(st.rays) / (double(width) * height * st.meanSamples),
                         double(st.sceneBytes) / (1 << 20), double(st.peakBytes) / (1 << 20), peakRssMiB(),
-                        st.meanSamples, st.maxSamples, flip2, ssim2);
+                        st.meanSamples, st.maxSamples, flip2, ssim2, rmse2);
             std::fflush(stdout);
             if (!out.empty()) {
                 std::filesystem::create_directories(out);
