@@ -24,8 +24,7 @@ layout(std140, binding = 0) uniform Frame {
     vec4 uWind;         // xyz wind, w gust strength
     vec4 uFurTime;      // time (s), gust frequency (Hz), gust wavelength (m), inner level
     vec4 uFurLevels;    // outer level
-    vec4 uLobeShape[4]; // fitted lobes R, TRT, TT, back (render/view/view.h HairLobe): exponent, shift (rad),
-                        // azimuth power m, azimuth sign * norm w(m)
+    vec4 uLobeShape[4]; // fitted lobes R, TRT, TT, back (render/view/view.h HairLobe): exponent, shift (rad), -, -
     vec4 uLobeStrength[36]; // lobe k's strength table: [9k + node], rgb, at |thetaO| = node * 11.25 deg
     vec4 uShadowColor;  // rgb optical depth per unit of C (1 - T, or 1 - a_f fitted), w: beta_f^2 per unit of C
     mat4 uSlotClip[4];  // per shadow slot (a shadowed light, render/preview/light_grid.h): world -> light clip
@@ -33,6 +32,8 @@ layout(std140, binding = 0) uniform Frame {
     vec4 uSlotMap[4];   // scale.xy, offset.xy
     vec4 uSlotDepth[4]; // near depth, far depth, perspective (0/1), voxel resolution
     ivec4 uCounts;      // light count, shadow slots, flags (kFlag*), hair model (kHair*)
+    vec4 uLobeAzimuth[81]; // lobe k's N (1/rad) at |thetaO| = a * 11.25 deg, |phi| = b * 22.5 deg:
+                           // float 81k + 9a + b, four to a vec4
 };
 
 const int kFlagVoxels = 1;

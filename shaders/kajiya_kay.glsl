@@ -31,9 +31,15 @@ vec3 kajiyaKay(vec3 albedo, vec3 t, vec3 n, vec3 l, vec3 v) {
     return diffuse + specular;
 }
 
+// Fitted lobe k's N at |thetaO| node a, |phi| node b (render/view/view.h HairLobe::azimuth).
+float lobeAzimuth(int k, int a, int b) {
+    int index = (9 * k + a) * 9 + b;
+    return uLobeAzimuth[index >> 2][index & 3];
+}
+
 // Fitted lobe k (render/view/view.cpp hairLobe): strength(|thetaO|) * cos(thetaI + thetaO - shift)^n'
-// * sqrt(n'/n) / sqrt(cos thetaI cos thetaO) * N(phi), N = w(m) ((1 + sign cos phi)/2)^m, with
-// 1/n' = 1/n + spread (rad^2): light spread by the fibres it crossed.
+// * sqrt(n'/n) / sqrt(cos thetaI cos thetaO) * N(|phi|), strength and N tabulated (linear between
+// nodes), with 1/n' = 1/n + spread (rad^2): light spread by the fibres it crossed.
 vec3 hairLobe(int k, vec3 t, vec3 l, vec3 v, float spread) {
     vec4 shape = uLobeShape[k];
     float si = clamp(dot(t, l), -1.0, 1.0), so = clamp(dot(t, v), -1.0, 1.0);
@@ -44,11 +50,17 @@ vec3 hairLobe(int k, vec3 t, vec3 l, vec3 v, float spread) {
     float longitudinal = sqrt(n / shape.x) * pow(c, n) * inversesqrt(max(ci * co, 0.01));
     vec3 lp = l - si * t, vp = v - so * t;
     float norms = sqrt(dot(lp, lp) * dot(vp, vp));
-    float azimuthal = norms > 1e-12 ? abs(shape.w) * pow(max(0.0, 0.5 * (1.0 + sign(shape.w) * dot(lp, vp) / norms)), shape.z)
-                                    : 0.15915494;
     float x = clamp(asin(abs(so)) * (16.0 / 3.14159265), 0.0, 8.0);  // |thetaO| in node units (11.25 deg)
     int i = min(int(x), 7);
     vec3 strength = mix(uLobeStrength[9 * k + i].rgb, uLobeStrength[9 * k + i + 1].rgb, x - float(i));
+    float azimuthal = 0.15915494;  // along the fibre phi is undefined: N's mean, 1 / (2 pi)
+    if (norms > 1e-12) {
+        float y = acos(clamp(dot(lp, vp) / norms, -1.0, 1.0)) * (8.0 / 3.14159265);  // |phi| in node units (22.5 deg)
+        int j = min(int(y), 7);
+        float g = y - float(j);
+        azimuthal = mix(mix(lobeAzimuth(k, i, j), lobeAzimuth(k, i, j + 1), g),
+                        mix(lobeAzimuth(k, i + 1, j), lobeAzimuth(k, i + 1, j + 1), g), x - float(i));
+    }
     return strength * (longitudinal * azimuthal);
 }
 

@@ -112,17 +112,66 @@ TEST_P(HairFit, ReproducesTheAzimuthallyIntegratedPhysicalResponse) {
     std::printf("melanin %.2f + %.2f: relative L1 (%.3f, %.3f, %.3f), forward share physical %.3f fitted %.3f\n",
                 c.eumelanin, c.pheomelanin, e.relativeL1.x(), e.relativeL1.y(), e.relativeL1.z(), e.forwardShare[0],
                 e.forwardShare[1]);
-    std::printf("  R k %.3f n %.1f shift %.2f deg m %.2f | TRT k (%.3f %.3f %.3f) n %.1f shift %.2f m %.2f sign %.0f | "
-                "TT k (%.3f %.3f %.3f) n %.1f shift %.2f m %.2f sign %.0f | diffuse (%.4f %.4f %.4f)\n",
-                m.r.strength[0].x(), m.r.exponent, m.r.shift * 180 / kPi, m.r.azimuthPower, m.trt.strength[0].x(),
-                m.trt.strength[0].y(), m.trt.strength[0].z(), m.trt.exponent, m.trt.shift * 180 / kPi, m.trt.azimuthPower,
-                m.trt.azimuthSign, m.tt.strength[0].x(), m.tt.strength[0].y(), m.tt.strength[0].z(), m.tt.exponent,
-                m.tt.shift * 180 / kPi, m.tt.azimuthPower, m.tt.azimuthSign, m.color.x(), m.color.y(), m.color.z());
+    std::printf("  R k %.3f n %.1f shift %.2f deg | TRT k (%.3f %.3f %.3f) n %.1f shift %.2f | "
+                "TT k (%.3f %.3f %.3f) n %.1f shift %.2f | diffuse (%.4f %.4f %.4f)\n",
+                m.r.strength[0].x(), m.r.exponent, m.r.shift * 180 / kPi, m.trt.strength[0].x(), m.trt.strength[0].y(),
+                m.trt.strength[0].z(), m.trt.exponent, m.trt.shift * 180 / kPi, m.tt.strength[0].x(), m.tt.strength[0].y(),
+                m.tt.strength[0].z(), m.tt.exponent, m.tt.shift * 180 / kPi, m.color.x(), m.color.y(), m.color.z());
     std::printf("  dual: a_f (%.3f %.3f %.3f) beta_f^2 %.4f back k (%.3f %.3f %.3f) n %.1f\n", m.dual.forward.x(),
                 m.dual.forward.y(), m.dual.forward.z(), m.dual.forwardVariance, m.dual.back.strength[0].x(),
                 m.dual.back.strength[0].y(), m.dual.back.strength[0].z(), m.dual.back.exponent);
     for (int ch = 0; ch < 3; ++ch) EXPECT_LT(e.relativeL1[ch], 0.15) << "channel " << ch;
     EXPECT_NEAR(e.forwardShare[1], e.forwardShare[0], 0.1);
+}
+
+/// A lit head of hair seen at `angle` from the light: the mean, over fibre
+/// directions spread evenly on the sphere (a Fibonacci lattice) and hit
+/// offsets h, of the light the fibre sends the viewer per unit irradiance,
+/// physical (HairBsdf) and fitted (kajiyaKay()); per colour channel.
+void viewedAtAngle(const HairFiberParams& f, const HairMaterial& m, double angle, Eigen::Vector3d* physical,
+                   Eigen::Vector3d* fitted) {
+    const HairModel model(f);
+    const Vec3f v = Vec3f::UnitZ(), l(float(std::sin(angle)), 0.f, float(std::cos(angle)));
+    *physical = *fitted = Eigen::Vector3d::Zero();
+    constexpr int kFibres = 2000;
+    const double golden = kPi * (3.0 - std::sqrt(5.0));
+    for (int s = 0; s < kFibres; ++s) {
+        const double z = 1.0 - (s + 0.5) * 2.0 / kFibres, r = std::sqrt(1.0 - z * z);
+        const Vec3f t(float(r * std::cos(golden * s)), float(r * std::sin(golden * s)), float(z));
+        // The fibre's frame as the reference builds it (vertex_bsdf.h fiberFrame): x along t, z toward the viewer.
+        Vec3f n = v - v.dot(t) * t;
+        if (n.squaredNorm() < 1e-10f) continue;
+        n.normalize();
+        const Vec3f y = n.cross(t);
+        auto local = [&](const Vec3f& w) { return Vec3f(w.dot(t), w.dot(y), w.dot(n)); };
+        for (int k = 0; k < kHs; ++k)
+            *physical += HairBsdf(model, float(-1.0 + (k + 0.5) * 2.0 / kHs)).eval(local(v), local(l)).cast<double>() / kHs;
+        *fitted += kajiyaKay(m, t, n, l, v).cast<double>();
+    }
+}
+
+// Where the light falls matters as much as how much is scattered: the rig's
+// key lights the hair 73° from the view, the fill 56°, the rim 141°. Bounds
+// from the measured ratios (printed) with a margin: fitted over physical
+// within 16% at every angle from 30° to 150° and melanin 0.1 to 1.3
+// (measured 0.85-1.13: 1.13 at 110°, the blue of dark hair 0.85 at 150°;
+// 0.98-1.05 at the key's and fill's angles). One N(φ) for every θo (the
+// 45° row) fails it, 1.11-1.16 at 73°, and so did the power
+// ((1 ± cos φ)/2)^m matched to each lobe's mean cos φ fitted before (1.22).
+TEST_P(HairFit, SendsTheViewerThePhysicalLightAtEveryAngleFromTheLight) {
+    const Case c = GetParam();
+    if (c.eumelanin > 2.f) GTEST_SKIP() << "black hair: R alone, covered by the integrated response";
+    const HairFiberParams f = fibre(c.eumelanin, c.pheomelanin);
+    HairMaterial m;
+    fitHairMaterial(f, &m);
+    for (double degrees : {30.0, 56.0, 73.0, 110.0, 141.0, 150.0}) {
+        Eigen::Vector3d p, q;
+        viewedAtAngle(f, m, degrees * kPi / 180.0, &p, &q);
+        const Eigen::Vector3d ratio = q.cwiseQuotient(p);
+        std::printf("melanin %.2f + %.2f, %3.0f deg from the light: fitted / physical (%.3f %.3f %.3f)\n", c.eumelanin,
+                    c.pheomelanin, degrees, ratio.x(), ratio.y(), ratio.z());
+        for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(ratio[ch], 1.0, 0.16) << degrees << " deg, channel " << ch;
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(MelaninRange, HairFit,
@@ -141,8 +190,9 @@ TEST(HairFitLobes, ShiftsAndColoursFollowTheFibre) {
     EXPECT_GT(m.r.strength[kHairLobeNodes - 2].x(), 2.f * m.r.strength[0].x());
     EXPECT_LT(m.r.shift, 0.f);
     EXPECT_GT(m.trt.shift, 0.f);
-    EXPECT_LT(m.tt.azimuthSign, 0.f);
-    EXPECT_GT(m.r.azimuthSign, 0.f);
+    // TT goes on through the fibre (φ = π), R comes back (φ = 0), at every |θo|.
+    for (const auto& row : m.tt.azimuth) EXPECT_GT(row[kHairLobeNodes - 1], 2.f * row[0]);
+    for (const auto& row : m.r.azimuth) EXPECT_GT(row[0], row[kHairLobeNodes - 1]);
     // Darker hair forwards less light through each fibre (the coloured shadow).
     HairMaterial dark;
     fitHairMaterial(fibre(8.f, 0.f), &dark);

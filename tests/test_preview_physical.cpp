@@ -106,10 +106,12 @@ TEST(PreviewPhysical, FittedPreviewPredictsThePhysicalRender) {
               << mPlain.luminanceRatio << ", fitted single scattering " << mSingle.flip << " / "
               << mSingle.luminanceRatio << ", fitted dual scattering " << mFitted.flip << " / "
               << mFitted.luminanceRatio << "\n";
-    // Measured: fitted with dual scattering FLIP 0.041, hair luminance 0.98 of
-    // the physical; without dual scattering (Kajiya-Kay's grey shadows)
-    // 0.042 / 0.97; the plain Kajiya-Kay preview 0.42 / 9.6 (its hand-set
-    // specular and the old convention, several times too bright).
+    // Measured: fitted with dual scattering FLIP 0.038, hair luminance 0.93 of
+    // the physical (0.041 / 0.98 with one azimuthal N for every θo, which
+    // made the default shot's hair 17% too bright); without dual scattering
+    // (Kajiya-Kay's grey shadows) 0.039 / 0.92; the plain Kajiya-Kay preview
+    // 0.42 / 9.5 (its hand-set specular and the old convention, several
+    // times too bright).
     EXPECT_LT(mFitted.flip, 0.06);
     EXPECT_NEAR(mFitted.luminanceRatio, 1.0, 0.1);
     EXPECT_LT(mFitted.flip, 0.5 * mPlain.flip);

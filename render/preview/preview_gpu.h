@@ -42,6 +42,9 @@ struct FrameUniforms {
     float slotMap[kMaxShadowedLights][4];
     float slotDepth[kMaxShadowedLights][4];
     int counts[4];
+    /// The fitted lobes' N(|φ|; |θo|) tables (HairLobe::azimuth), lobe k's
+    /// [a][b] at float k·81 + 9a + b (packed four to a vec4).
+    float lobeAzimuth[kHairLobeNodes * kHairLobeNodes][4];  // 4 lobes x 81 floats = 81 vec4
 };
 
 inline constexpr int kFlagVoxels = 1;

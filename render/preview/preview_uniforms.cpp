@@ -79,9 +79,14 @@ void fillFrameUniforms(FrameUniforms& u, const UniformInputs& in) {
     const HairLobe* lobes[4] = {&h.r, &h.trt, &h.tt, &h.dual.back};
     for (int k = 0; k < 4; ++k) {
         const HairLobe& lobe = *lobes[k];
-        set4(u.lobeShape[k], lobe.exponent, lobe.shift, lobe.azimuthPower, lobe.azimuthSign * lobe.azimuthNorm);
+        set4(u.lobeShape[k], lobe.exponent, lobe.shift, 0.f, 0.f);
         for (int node = 0; node < kHairLobeNodes; ++node)
             set3(u.lobeStrength[k * kHairLobeNodes + node], lobe.strength[size_t(node)], 0.f);
+        for (int a = 0; a < kHairLobeNodes; ++a)
+            for (int b = 0; b < kHairLobeNodes; ++b) {
+                const int index = (k * kHairLobeNodes + a) * kHairLobeNodes + b;
+                u.lobeAzimuth[index / 4][index % 4] = lobe.azimuth[size_t(a)][size_t(b)];
+            }
     }
     set4(u.tess, float(std::clamp(settings.tessellationLevel, 1, 64)), settings.tessellationPixels * float(ss),
          settings.curve == CurveType::BSpline ? 1.f : 0.f, settings.minPixelWidth * float(ss));

@@ -30,13 +30,10 @@ double luminance(const Rgb& c) { return 0.2126 * c.x() + 0.7152 * c.y() + 0.0722
 /// The physical fibre integrated over φ and averaged over h, lobe by lobe.
 struct Tables {
     Rgb integrated[kLobes][kTheta][kTheta];  ///< A_p(θi, θo) = ∫ S_p dφ (1/sr)
-    double cosPhiRow[kLobes][kTheta], weightRow[kLobes][kTheta];  ///< per θi: Σ w Y cos φ, Σ w Y
-    double cosPhiSum[kLobes] = {}, weightSum[kLobes] = {};
+    double phiCell[kLobes][kTheta][kTheta][kPhi];  ///< per θi, θo, φ: w Y(S_p)
+    double phiSum[kLobes][kTheta][kPhi] = {};       ///< ... summed over θi
     Rgb forward[kLobes][kTheta], back[kLobes][kTheta];  ///< ∫ S_p dω_o over |φ| > π/2, < π/2, per θi
 };
-
-/// w(m) = 1 / ∫ ((1 + cos φ)/2)^m dφ = Γ(m+1) / (2√π Γ(m+½)).
-float azimuthNorm(double m) { return float(std::exp(std::lgamma(m + 1.0) - std::lgamma(m + 0.5)) / (2.0 * std::sqrt(kPi))); }
 
 void tabulate(const HairFiberParams& fiber, Tables* t) {
     const HairModel model(fiber);
@@ -45,7 +42,6 @@ void tabulate(const HairFiberParams& fiber, Tables* t) {
         const double ti = thetaAt(i);
         for (int p = 0; p < kLobes; ++p) {
             t->forward[p][i] = t->back[p][i] = Rgb::Zero();
-            t->cosPhiRow[p][i] = t->weightRow[p][i] = 0.0;
         }
         for (int o = 0; o < kTheta; ++o) {
             const double to = thetaAt(o);
@@ -63,9 +59,7 @@ void tabulate(const HairFiberParams& fiber, Tables* t) {
                 }
                 for (int p = 0; p < kLobes; ++p) {
                     sum[p] += atPhi[p] * dPhi;
-                    const double wy = std::cos(ti) * std::cos(to) * luminance(atPhi[p]);
-                    t->cosPhiRow[p][i] += wy * std::cos(phi);
-                    t->weightRow[p][i] += wy;
+                    t->phiCell[p][i][o][j] = std::cos(ti) * std::cos(to) * luminance(atPhi[p]);
                     // By reciprocity's symmetry in the two directions, the
                     // share of incident light going forward (φ away from the
                     // light's side) is ∫ S dω over that half.
@@ -75,9 +69,11 @@ void tabulate(const HairFiberParams& fiber, Tables* t) {
             for (int p = 0; p < kLobes; ++p) t->integrated[p][i][o] = sum[p];
         }
     });
-    // Mean cos φ of each lobe, summed in a fixed order.
+    // Each lobe's azimuthal distribution, summed in a fixed order.
     for (int p = 0; p < kLobes; ++p)
-        for (int i = 0; i < kTheta; ++i) t->cosPhiSum[p] += t->cosPhiRow[p][i], t->weightSum[p] += t->weightRow[p][i];
+        for (int i = 0; i < kTheta; ++i)
+            for (int o = 0; o < kTheta; ++o)
+                for (int j = 0; j < kPhi; ++j) t->phiSum[p][o][j] += t->phiCell[p][i][o][j];
 }
 
 /// Index of |θo|'s bin: the grid's θo midpoints pair up as ±θo.
@@ -151,11 +147,38 @@ HairLobe fitLobe(const Rgb (&a)[kTheta][kTheta]) {
     return lobe;
 }
 
-void setAzimuth(HairLobe* lobe, double meanCosPhi) {
-    const double c = std::clamp(std::abs(meanCosPhi), 0.0, 0.98);
-    lobe->azimuthSign = meanCosPhi < 0.0 ? -1.f : 1.f;
-    lobe->azimuthPower = float(c / (1.0 - c));
-    lobe->azimuthNorm = azimuthNorm(lobe->azimuthPower);
+/// The lobe's azimuthal distribution N(|φ|; |θo|) from the physical fibre's
+/// (luminance, weights cos θi cos θo, summed over θi and h): at each node
+/// (|θo|_a, |φ|_b) the table's rows take the physical response under hats of
+/// the nodes' spacing (the least-squares weights of bilinear interpolation),
+/// each row then scaled so that its piecewise-linear N integrates to 1 over
+/// (−π, π]. One N for all θo, a power ((1 ± cos φ)/2)^m matched to the mean
+/// cos φ as fitted before, spread the transmission over the sides: lit from
+/// the side (the rig's key, 73° from the view) the fitted fibre sent the
+/// viewer 22% more light than the physical one, TT alone 5.5 times its
+/// share; with N per θo, 5% (docs/rendering.md).
+void setAzimuth(HairLobe* lobe, const double (&phiSum)[kTheta][kPhi]) {
+    const double thetaStep = 0.5 * kPi / (kHairLobeNodes - 1), phiStep = kPi / (kHairLobeNodes - 1);
+    auto hat = [](double x, double step) { return std::max(0.0, 1.0 - std::abs(x) / step); };
+    for (int a = 0; a < kHairLobeNodes; ++a) {
+        std::array<float, kHairLobeNodes>& row = lobe->azimuth[size_t(a)];
+        double integral = 0.0;
+        for (int b = 0; b < kHairLobeNodes; ++b) {
+            double sum = 0.0, weight = 0.0;
+            for (int j = 0; j < kPhi; ++j) {
+                const double hp = hat(std::abs(phiAt(j)) - b * phiStep, phiStep);
+                if (hp <= 0.0) continue;
+                weight += hp;
+                for (int o = 0; o < kTheta; ++o) sum += hat(std::abs(thetaAt(o)) - a * thetaStep, thetaStep) * hp * phiSum[o][j];
+            }
+            row[size_t(b)] = float(weight > 0.0 ? sum / weight : 0.0);
+            integral += (b == 0 || b == kHairLobeNodes - 1 ? 1.0 : 2.0) * row[size_t(b)] * phiStep;
+        }
+        if (integral > 0.0)
+            for (float& n : row) n = float(n / integral);
+        else
+            row.fill(float(0.5 / kPi));
+    }
 }
 
 HairMaterial fitted(const HairFiberParams& fiber) {
@@ -165,7 +188,7 @@ HairMaterial fitted(const HairFiberParams& fiber) {
     HairLobe* lobes[3] = {&m.r, &m.tt, &m.trt};
     for (int p = 0; p < 3; ++p) {
         *lobes[p] = fitLobe(t->integrated[p]);
-        setAzimuth(lobes[p], t->weightSum[p] > 0.0 ? t->cosPhiSum[p] / t->weightSum[p] : 0.0);
+        setAzimuth(lobes[p], t->phiSum[p]);
     }
     // R is Fresnel reflection off the cuticle: white by construction.
     for (Vec3f& k : m.r.strength) k = Vec3f::Constant(k.mean());
@@ -218,9 +241,7 @@ HairMaterial fitted(const HairFiberParams& fiber) {
     back.exponent = float(1.0 / sigmaB2);
     back.shift = 0.f;
     back.setStrength((kDualBackDensity * Ab * std::sqrt(1.0 / (sigmaB2 * 2.0 * kPi))).cast<float>());
-    back.azimuthSign = 1.f;
-    back.azimuthPower = 1.f;
-    back.azimuthNorm = azimuthNorm(1.0);
+    back.setAzimuthPower(1.f, 1.f);
     m.dual.forward = af.cast<float>().cwiseMin(Vec3f::Ones());
     m.dual.forwardVariance = float(betaF2);
     m.shading = HairShading::Fitted;

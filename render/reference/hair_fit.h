@@ -14,8 +14,10 @@
 // and residual parts). Each lobe's integrated response A_p(θi, θo) is fitted
 // by k cos(θi + θo − shift)^n (least squares over an exponent x shift grid,
 // weights cos θi cos θo, k in closed form per colour channel); the residual
-// by the diffuse kd·color·cos θi. The azimuthal power m of each lobe matches
-// its mean cos φ: for N ∝ ((1 ± cos φ)/2)^m, |E[cos φ]| = m / (m + 1).
+// by the diffuse kd·color·cos θi. Each lobe's azimuthal distribution
+// N(|φ|; |θo|) is tabulated from the physical lobe at 9 x 9 nodes (one N for
+// all θo spread the transmission peak over the sides: the rig's key light
+// came out 22% too bright).
 // A per-material fit was chosen over lookup tables because the fitted terms
 // stay the Kajiya-Kay family's few uniforms (the preview's cost does not
 // change) and the fit is cheap enough to run at scene load for any melanin,

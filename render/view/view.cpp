@@ -144,6 +144,29 @@ Vec3f HairLobe::strengthAt(float absThetaO) const {
     return (1.f - f) * strength[size_t(i)] + f * strength[size_t(i) + 1];
 }
 
+float HairLobe::azimuthAt(float absThetaO, float absPhi) const {
+    const float x = std::clamp(absThetaO / float(0.5 * M_PI), 0.f, 1.f) * float(kHairLobeNodes - 1);
+    const float y = std::clamp(absPhi / float(M_PI), 0.f, 1.f) * float(kHairLobeNodes - 1);
+    const int i = std::min(int(x), kHairLobeNodes - 2), j = std::min(int(y), kHairLobeNodes - 2);
+    const float f = x - float(i), g = y - float(j);
+    auto row = [&](int a) { return (1.f - g) * azimuth[size_t(a)][size_t(j)] + g * azimuth[size_t(a)][size_t(j) + 1]; };
+    return (1.f - f) * row(i) + f * row(i + 1);
+}
+
+void HairLobe::setAzimuthPower(float m, float sign) {
+    // ∫ over (−π, π] of the piecewise-linear table: 2 Σ (N_i + N_i+1)/2 Δφ.
+    const double step = M_PI / (kHairLobeNodes - 1);
+    std::array<float, kHairLobeNodes> row;
+    double integral = 0.0;
+    for (int i = 0; i < kHairLobeNodes; ++i) {
+        const double c = std::cos(i * step);
+        row[size_t(i)] = float(std::pow(std::max(0.0, 0.5 * (1.0 + sign * c)), double(m)));
+        integral += (i == 0 || i == kHairLobeNodes - 1 ? 1.0 : 2.0) * row[size_t(i)] * step;
+    }
+    for (float& a : row) a = integral > 0.0 ? float(a / integral) : 0.f;
+    azimuth.fill(row);
+}
+
 Vec3f hairLobe(const HairLobe& lobe, const Vec3f& t, const Vec3f& l, const Vec3f& v, float extraVariance) {
     const float si = std::clamp(t.dot(l), -1.f, 1.f), so = std::clamp(t.dot(v), -1.f, 1.f);
     const float ci = std::sqrt(1.f - si * si), co = std::sqrt(1.f - so * so);
@@ -158,11 +181,10 @@ Vec3f hairLobe(const HairLobe& lobe, const Vec3f& t, const Vec3f& l, const Vec3f
     // normal plane; along the fibre the azimuth is undefined and N its mean.
     const Vec3f lp = l - si * t, vp = v - so * t;
     const float norms = std::sqrt(lp.squaredNorm() * vp.squaredNorm());
-    const float azimuthal =
-        norms > 1e-12f ? lobe.azimuthNorm * std::pow(std::max(0.f, 0.5f * (1.f + lobe.azimuthSign * lp.dot(vp) / norms)),
-                                                     lobe.azimuthPower)
-                       : 0.5f / float(M_PI);
-    return lobe.strengthAt(std::asin(std::abs(so))) * (longitudinal * azimuthal);
+    const float absThetaO = std::asin(std::abs(so));
+    const float azimuthal = norms > 1e-12f ? lobe.azimuthAt(absThetaO, std::acos(std::clamp(lp.dot(vp) / norms, -1.f, 1.f)))
+                                           : 0.5f / float(M_PI);
+    return lobe.strengthAt(absThetaO) * (longitudinal * azimuthal);
 }
 
 Vec3f kajiyaKay(const HairMaterial& m, const Vec3f& t, const Vec3f& n, const Vec3f& l, const Vec3f& v,

@@ -138,22 +138,31 @@ inline constexpr int kHairLobeNodes = 9;
 /// Bessel I0(x) ≈ e^x/√(2πx)) and k(|θo|) the lobe's attenuation (Fresnel,
 /// absorption along the refracted path), which depends on θo alone in Chiang
 /// et al. 2016, tabulated at kHairLobeNodes angles and interpolated linearly.
-/// N(φ) = w(m) ((1 + sign cos φ)/2)^m is normalised to ∫ N dφ = 1 (sign +1:
-/// back toward the light, −1: forward, through the fibre; m = 1/2 is a smooth
-/// fibre's reflection |cos(φ/2)|/4). θ are angles to the fibre's normal plane
-/// (sin θ = t·w), φ the azimuth between light and view around the fibre.
+/// N(|φ|; |θo|) is a table too, each row (one |θo|) normalised to ∫ N dφ = 1
+/// over (−π, π]: the lobe's azimuthal distribution as the fit measures it at
+/// that θo (a smooth fibre's reflection is |cos(φ/2)|/4; its transmission
+/// peaks at φ = π and spreads toward the sides as the refracted path
+/// steepens with |θo|, Chiang et al. 2016's γt(θo)), as real-time hair
+/// shading tabulates Marschner's N(φ, θd) (Nguyen and Donnelly 2005, "Hair
+/// Animation and Rendering in the Nalu Demo", GPU Gems 2). θ are angles to
+/// the fibre's normal plane (sin θ = t·w), φ the azimuth between light and
+/// view around the fibre (0: back toward the light).
 struct HairLobe {
     std::array<Vec3f, kHairLobeNodes> strength{};  ///< k (1/sr) at |θo| = 90° i / (nodes − 1)
+    /// N (1/rad): [a][b] at |θo| = 90° a / (nodes − 1), |φ| = 180° b / (nodes − 1).
+    std::array<std::array<float, kHairLobeNodes>, kHairLobeNodes> azimuth{};
     float exponent = 1.f;
     float shift = 0.f;               ///< radians, peak at θi + θo = shift
-    float azimuthPower = 0.f;        ///< m
-    float azimuthSign = 1.f;         ///< +1 backward, −1 forward
-    float azimuthNorm = 0.f;         ///< w(m) = Γ(m+1) / (2√π Γ(m+½))
 
     bool empty() const;
     /// k at |θo| = `absThetaO` (radians), linear between the nodes.
     Vec3f strengthAt(float absThetaO) const;
     void setStrength(const Vec3f& k) { strength.fill(k); }
+    /// N at |θo| = `absThetaO`, |φ| = `absPhi` (radians), bilinear between the nodes.
+    float azimuthAt(float absThetaO, float absPhi) const;
+    /// Every row N ∝ ((1 + sign cos φ)/2)^m (sign +1: back toward the light),
+    /// sampled at the nodes and scaled so that the piecewise-linear row integrates to 1.
+    void setAzimuthPower(float m, float sign);
 };
 
 /// Zinke, Yuksel, Weber and Keyser 2008's dual-scattering constants of a
