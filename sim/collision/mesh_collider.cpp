@@ -1,6 +1,7 @@
 #include "sim/collision/mesh_collider.h"
 
 #include "core/errors.h"
+#include "core/union_find.h"
 
 #include <algorithm>
 #include <array>
@@ -13,21 +14,11 @@ namespace hp {
 
 std::vector<uint32_t> weldVertices(const std::vector<Vec3f>& positions, float tolerance) {
     const size_t n = positions.size();
-    std::vector<uint32_t> parent(n);
-    std::iota(parent.begin(), parent.end(), 0u);
-    if (n == 0) return parent;
+    UnionFind sets(n);  // the root of a set is its lowest index
+    if (n == 0) return {};
     Eigen::AlignedBox3f box;
     for (const Vec3f& p : positions) box.extend(p);
     const float eps = std::max(tolerance * box.diagonal().norm(), std::numeric_limits<float>::min());
-    // Union-find whose root is the lowest index of its set.
-    auto find = [&](uint32_t i) {
-        while (parent[i] != i) i = parent[i] = parent[parent[i]];
-        return i;
-    };
-    auto unite = [&](uint32_t a, uint32_t b) {
-        a = find(a), b = find(b);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    };
     // A hash grid of cell size eps: copies lie in the same or a neighbouring cell.
     auto cellOf = [&](const Vec3f& p) {
         const Vec3f c = ((p - box.min()) / eps).array().floor();
@@ -43,10 +34,9 @@ std::vector<uint32_t> weldVertices(const std::vector<Vec3f>& positions, float to
                     if (it == cells.end()) continue;
                     for (uint32_t i : members)
                         for (uint32_t j : it->second)
-                            if (i < j && (positions[i] - positions[j]).norm() <= eps) unite(i, j);
+                            if (i < j && (positions[i] - positions[j]).norm() <= eps) sets.unite(i, j);
                 }
-    for (uint32_t i = 0; i < n; ++i) parent[i] = find(i);
-    return parent;
+    return sets.roots();
 }
 
 MeshCollider::MeshCollider(const TriangleMesh& mesh, std::vector<uint32_t> weld)

@@ -1,6 +1,7 @@
 #include "sim/collision/mesh_parts.h"
 
 #include "core/errors.h"
+#include "core/union_find.h"
 #include "sim/collision/mesh_collider.h"
 
 #include <limits>
@@ -23,19 +24,10 @@ MeshPartition partitionMesh(const TriangleMesh& mesh, const std::vector<uint32_t
     if (weld.size() != mesh.positions.size())
         throw Error(cat("partitionMesh: weld map has ", weld.size(), " entries for ", mesh.positions.size(), " vertices"));
     // Union-find over welded vertices: a triangle joins its three corners.
-    std::vector<uint32_t> parent(mesh.positions.size());
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto find = [&](uint32_t i) {
-        while (parent[i] != i) i = parent[i] = parent[parent[i]];
-        return i;
-    };
-    auto unite = [&](uint32_t a, uint32_t b) {
-        a = find(a), b = find(b);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    };
+    UnionFind sets(mesh.positions.size());
     for (const Tri& t : mesh.triangles) {
-        unite(weld[t[0]], weld[t[1]]);
-        unite(weld[t[0]], weld[t[2]]);
+        sets.unite(weld[t[0]], weld[t[1]]);
+        sets.unite(weld[t[0]], weld[t[2]]);
     }
     MeshPartition out;
     out.triangleParts.resize(mesh.triangles.size());
@@ -43,7 +35,7 @@ MeshPartition partitionMesh(const TriangleMesh& mesh, const std::vector<uint32_t
     std::vector<uint32_t> local(mesh.positions.size(), std::numeric_limits<uint32_t>::max());
     for (size_t t = 0; t < mesh.triangles.size(); ++t) {
         const Tri& tri = mesh.triangles[t];
-        uint32_t& k = partOfRoot[find(weld[tri[0]])];
+        uint32_t& k = partOfRoot[sets.find(weld[tri[0]])];
         if (k == std::numeric_limits<uint32_t>::max()) {
             k = uint32_t(out.vertices.size());
             out.vertices.emplace_back();
@@ -53,7 +45,7 @@ MeshPartition partitionMesh(const TriangleMesh& mesh, const std::vector<uint32_t
     }
     // Each part's vertices ascending, then its triangles over local indices.
     for (uint32_t v = 0; v < mesh.positions.size(); ++v) {
-        const uint32_t k = partOfRoot[find(weld[v])];
+        const uint32_t k = partOfRoot[sets.find(weld[v])];
         if (k == std::numeric_limits<uint32_t>::max()) continue;  // a vertex no triangle uses
         local[v] = uint32_t(out.vertices[k].size());
         out.vertices[k].push_back(v);
