@@ -24,11 +24,6 @@ float smin(float a, float b, float k) {
     return b + (a - b) * h - k * h * (1.f - h);
 }
 
-float smoothstep(float e0, float e1, float x) {
-    const float t = std::clamp((x - e0) / (e1 - e0), 0.f, 1.f);
-    return t * t * (3.f - 2.f * t);
-}
-
 const Vec3f kSkull(0.f, 0.015f, -0.01f), kSkullRadii(0.075f, 0.092f, 0.098f);
 const Vec3f kEarRadii(0.012f, 0.027f, 0.017f);
 const Vec3f kNeckJoint(0.f, -0.235f, -0.018f);  // world bind positions: the neck pivots at its base
@@ -218,12 +213,7 @@ HeadRig makeDefaultHead(const DefaultHeadOptions& o) {
         // The head bone carries everything above the jaw, the neck bone the
         // base of the neck, blended smoothly in between.
         m.influenceStart.push_back(0);
-        for (const Vec3f& p : m.positions) {
-            const float head = smoothstep(-0.15f, -0.05f, p.y());
-            if (head < 1.f) m.influenceBone.push_back(0), m.influenceWeight.push_back(1.f - head);
-            if (head > 0.f) m.influenceBone.push_back(1), m.influenceWeight.push_back(head);
-            m.influenceStart.push_back(uint32_t(m.influenceBone.size()));
-        }
+        for (const Vec3f& p : m.positions) appendNeckHeadInfluence(m, smoothstep(-0.15f, -0.05f, p.y()));
         rig.meshes.push_back(std::move(m));
     }
 
@@ -277,6 +267,17 @@ HeadRig makeDefaultBody(const DefaultHeadOptions& o) {
     rig.meshes.push_back(std::move(m));
     addClips(rig, o);
     return rig;
+}
+
+float smoothstep(float e0, float e1, float x) {
+    const float t = std::clamp((x - e0) / (e1 - e0), 0.f, 1.f);
+    return t * t * (3.f - 2.f * t);
+}
+
+void appendNeckHeadInfluence(RigMesh& m, float head) {
+    if (head < 1.f) m.influenceBone.push_back(0), m.influenceWeight.push_back(1.f - head);
+    if (head > 0.f) m.influenceBone.push_back(1), m.influenceWeight.push_back(head);
+    m.influenceStart.push_back(uint32_t(m.influenceBone.size()));
 }
 
 }  // namespace hp

@@ -48,4 +48,11 @@ float defaultBodyField(const Vec3f& p);
 /// True above the hairline: the scalp the default scene grows hair on.
 float defaultHeadHairMask(const Vec3f& p);
 
+/// Hermite smoothstep: 0 below e0, 1 above e1, 3t² − 2t³ between.
+float smoothstep(float e0, float e1, float x);
+
+/// Appends one vertex's skin weights on a neck (bone 0) and head (bone 1)
+/// rig: `head` on the head bone, 1 − head on the neck, zero weights left out.
+void appendNeckHeadInfluence(RigMesh& m, float head);
+
 }  // namespace hp

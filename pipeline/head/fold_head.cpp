@@ -1,5 +1,7 @@
 #include "pipeline/head/fold_head.h"
 
+#include "pipeline/head/default_head.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -9,11 +11,6 @@ namespace {
 
 const Vec3f kNeckBase(0.f, kFoldNeckTop - kFoldNeckLength, 0.f);  // the Neck bone: the neck pivots at its base
 const Vec3f kHeadJoint(0.f, -0.09f, 0.f);  // the Head bone: where the neck's side enters the sphere
-
-float smoothstep(float e0, float e1, float x) {
-    const float t = std::clamp((x - e0) / (e1 - e0), 0.f, 1.f);
-    return t * t * (3.f - 2.f * t);
-}
 
 /// The neck: a closed cylinder about +Y, wound counter-clockwise seen from
 /// outside (the sphere's convention: direction (cos φ, 0, -sin φ)), its side
@@ -150,12 +147,9 @@ HeadRig makeFoldHead(const FoldHeadOptions& o) {
     m.boneNodes = {2, 3};
     m.boneOffsets = {Affine3f(Eigen::Translation3f(-kNeckBase)), Affine3f(Eigen::Translation3f(-kHeadJoint))};
     m.influenceStart.push_back(0);
-    for (size_t v = 0; v < m.positions.size(); ++v) {
-        const float head = v < sphere.positions.size() ? 1.f : smoothstep(-0.15f, kHeadJoint.y(), m.positions[v].y());
-        if (head < 1.f) m.influenceBone.push_back(0), m.influenceWeight.push_back(1.f - head);
-        if (head > 0.f) m.influenceBone.push_back(1), m.influenceWeight.push_back(head);
-        m.influenceStart.push_back(uint32_t(m.influenceBone.size()));
-    }
+    for (size_t v = 0; v < m.positions.size(); ++v)
+        appendNeckHeadInfluence(
+            m, v < sphere.positions.size() ? 1.f : smoothstep(-0.15f, kHeadJoint.y(), m.positions[v].y()));
     rig.meshes.push_back(std::move(m));
     addClips(rig, o);
     return rig;
