@@ -195,18 +195,26 @@ void depositTrilinear(TileBuffer<C>& tile, const Segment& s, const SegmentVeloci
             const double mid = 0.5 * (t + t1), h = 0.5 * (t1 - t);
             const double bx = ax - cell[0], by = ay - cell[1], bz = az - cell[2];
             double q[8][C] = {};  // corner (x-major: ix·4 + iy·2 + iz) × channel
+            // Gauss point g of the piece: its parameter, weight k·h·w_g·r²
+            // and fractional position in the dual cell.
+            struct GaussPoint {
+                double t, w, fx, fy, fz;
+            };
+            auto at = [&](int g) {
+                const double tg = mid + h * kGaussX[g];
+                const double r = r0 + dr * tg;
+                return GaussPoint{tg, k * h * kGaussW[g] * r * r, std::min(std::max(bx + dx * tg, 0.0), 1.0),
+                                  std::min(std::max(by + dy * tg, 0.0), 1.0),
+                                  std::min(std::max(bz + dz * tg, 0.0), 1.0)};
+            };
             if constexpr (C == 1) {
                 // Density only: the z pair of each (x, y) corner as one SSE2
                 // packet, (w · X_i · Y_j) · (Z_0, Z_1).
                 Eigen::Array2d pair[4] = {Eigen::Array2d::Zero(), Eigen::Array2d::Zero(), Eigen::Array2d::Zero(),
                                           Eigen::Array2d::Zero()};
                 for (int g = 0; g < 3; ++g) {
-                    const double tg = mid + h * kGaussX[g];
-                    const double r = r0 + dr * tg;
-                    const double w = k * h * kGaussW[g] * r * r;
-                    const double fx = std::min(std::max(bx + dx * tg, 0.0), 1.0);
-                    const double fy = std::min(std::max(by + dy * tg, 0.0), 1.0);
-                    const double fz = std::min(std::max(bz + dz * tg, 0.0), 1.0);
+                    const GaussPoint p = at(g);
+                    const double w = p.w, fx = p.fx, fy = p.fy, fz = p.fz;
                     const double wx0 = w * (1 - fx), wx1 = w * fx;
                     const Eigen::Array2d z(1 - fz, fz);
                     pair[0] += (wx0 * (1 - fy)) * z;
@@ -220,12 +228,8 @@ void depositTrilinear(TileBuffer<C>& tile, const Segment& s, const SegmentVeloci
                 }
             } else {
                 for (int g = 0; g < 3; ++g) {
-                    const double tg = mid + h * kGaussX[g];
-                    const double r = r0 + dr * tg;
-                    const double w = k * h * kGaussW[g] * r * r;
-                    const double fx = std::min(std::max(bx + dx * tg, 0.0), 1.0);
-                    const double fy = std::min(std::max(by + dy * tg, 0.0), 1.0);
-                    const double fz = std::min(std::max(bz + dz * tg, 0.0), 1.0);
+                    const GaussPoint p = at(g);
+                    const double tg = p.t, w = p.w, fx = p.fx, fy = p.fy, fz = p.fz;
                     const double wx[2] = {w * (1 - fx), w * fx};
                     const double y[2] = {1 - fy, fy}, z[2] = {1 - fz, fz};
                     const Vec3d v = sv->v0.cast<double>() + (sv->v1 - sv->v0).cast<double>() * tg;
