@@ -25,12 +25,19 @@
 // collision world (sim/collision/collision_world.h), in one run.
 //
 //   bench_stress --colliders [--guides 94,845] [--threads 2]
+//
+// --worst (a head that folds into itself): per frame, the deepest guide and
+// follower vertex, with each part's signed distance at it, at its parent
+// and at its strand's root, the parts the strand ignores, and whether it is
+// pinned (followers).
+#include "pipeline/batch/strand_cache.h"
 #include "pipeline/scene/scene.h"
 #include "pipeline/stages/shot_simulation.h"
 #include "sim/collision/collision_world.h"
 #include "sim/strands/fibonacci.h"
 #include "sim/guides/guides.h"
 #include "sim/collision/mesh_collider.h"
+#include "sim/collision/mesh_parts.h"
 
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -38,6 +45,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <optional>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -68,7 +76,37 @@ std::vector<float> segmentLengths(const StrandFrame& f) {
     return out;
 }
 
-int stress(const std::string& path, const std::vector<std::string>& overrides, bool perFrame) {
+/// --worst: the deepest free vertex of strands [begin, end) of `f` by the
+/// documented definition, and what holds it there: each part's signed
+/// distance at the vertex, its parent and the strand's root, the parts the
+/// strand ignores, whether it is a pinned follower vertex.
+void explainWorst(const char* what, const StrandFrame& f, size_t begin, size_t end, const PartsCollider& parts,
+                  const std::vector<uint32_t>& ignore, const std::vector<FollowerPin>& pins) {
+    float worst = 0.f;
+    size_t strand = 0;
+    uint32_t vertex = 0;
+    for (size_t s = begin; s < end; ++s)
+        for (uint32_t i = f.first(s) + 1; i < f.offsets[s + 1]; ++i) {
+            const float d = -parts.signedDistanceIgnoring(f.positions[i], nullptr, ignore[s]);
+            if (d > worst) worst = d, strand = s, vertex = i;
+        }
+    if (worst <= 0.f) return;
+    auto distances = [&](const Vec3f& p) {
+        std::string out;
+        for (size_t k = 0; k < parts.count(); ++k) out += cat(k ? " " : "", 1e3 * parts.part(k).signedDistance(p));
+        return out;
+    };
+    const uint32_t block = vertex - f.offsets[f.guideCount];
+    const bool pinned = strand >= f.guideCount &&
+                        std::any_of(pins.begin(), pins.end(), [&](const FollowerPin& p) { return p.vertex == block; });
+    std::printf("  deepest %s: strand %zu vertex %u, %.3f mm; parts' distance mm at it [%s], parent [%s], root [%s]; "
+                "ignores %#x%s\n",
+                what, strand, vertex - f.first(strand), 1e3 * worst, distances(f.positions[vertex]).c_str(),
+                distances(f.positions[vertex - 1]).c_str(), distances(f.positions[f.first(strand)]).c_str(),
+                ignore[strand], pinned ? ", pinned" : "");
+}
+
+int stress(const std::string& path, const std::vector<std::string>& overrides, bool perFrame, bool worstVertex) {
     const Scene scene = Scene::load(path, overrides);
     const std::vector<int>& frames = scene.frames("frames");
     const double fps = scene.number("fps");
@@ -120,6 +158,14 @@ int stress(const std::string& path, const std::vector<std::string>& overrides, b
                         st.guides.pinnedCount,
                         st.followerProjected, st.followers.bent, st.followers.pinned, st.followers.penetrationCount,
                         1e3 * st.followers.maxPenetration);
+        }
+        const auto* parts = dynamic_cast<const PartsCollider*>(collider);
+        if (worstVertex && parts) {
+            const std::optional<CachedGuides> cached = sim.cachedGuides();
+            const std::vector<FollowerPin> none;
+            std::printf("frame %d:\n", frame);
+            explainWorst("guide", f, 0, guides, *parts, ignore, none);
+            explainWorst("follower", f, guides, f.strandCount(), *parts, ignore, cached ? cached->current.pins : none);
         }
     }
     std::printf("| steps/s | worst stretch guides (frame) | worst stretch followers (frame) | worst depth mm (frame) "
@@ -195,7 +241,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> overrides;
     std::vector<size_t> counts{94, 845};
     int threads = 2;
-    bool colliderMode = false, perFrame = false;
+    bool colliderMode = false, perFrame = false, worstVertex = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string {
@@ -210,6 +256,7 @@ int main(int argc, char** argv) {
         else if (a == "--threads") threads = std::stoi(next());
         else if (a == "--colliders") colliderMode = true;
         else if (a == "--per-frame") perFrame = true;
+        else if (a == "--worst") worstVertex = true;
         else if (a == "--guides") {
             counts.clear();
             const std::string list = next();
@@ -226,7 +273,7 @@ int main(int argc, char** argv) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     std::printf("threads: %d\n", threads);
     try {
-        return colliderMode ? colliders(counts) : stress(scenePath, overrides, perFrame);
+        return colliderMode ? colliders(counts) : stress(scenePath, overrides, perFrame, worstVertex);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_stress: %s\n", e.what());
         return 1;
