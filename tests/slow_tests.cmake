@@ -43,6 +43,7 @@ set(_hp_slow_tests
   test_camera:CameraAuto.StressClipIsReframedAtItsSceneCut
   test_camera:CameraAuto.RenderedBorderHasNoCoverage            # 3 Embree frames
   test_camera:CameraAuto.RunSimulatesTheClipFirstAndChunksFrameAlike  # 3 hairpipe runs
+  test_mesh_parts:MeshParts.FollowersIgnoreThePartsTheirRootsLieInside  # followers pinned deep inside a sphere
 )
 foreach(_entry IN LISTS _hp_slow_tests)
   string(REPLACE ":" ";" _parts "${_entry}")

@@ -4,9 +4,11 @@
 // the spheres' analytic distances |p - c| - r: the union's is their minimum.
 #include "sim/collision/mesh_collider.h"
 #include "sim/collision/mesh_parts.h"
+#include "sim/followers/followers.h"
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <random>
 
 using namespace hp;
@@ -100,4 +102,77 @@ TEST(MeshParts, RootsInsideAnotherPartIgnoreIt) {
         inside += expected ? 1 : 0;
     }
     EXPECT_GT(inside, 10u) << "the buried caps carry roots";
+}
+
+// Followers take the guides' rule (sim/followers/followers.h FollowerStep::
+// ignoreParts): hair rooted on B's cap where it lies inside A, standing 2 cm
+// along its normal, stays inside A and outside B. Ignoring A (the mask
+// partsAroundRoots gives its root), no follower vertex is projected, bent or
+// pinned, and every one is exactly where it is without collision: outside
+// B, the only part such a strand collides with. Handed no masks, the same
+// followers are pushed toward A's outside, which they cannot reach at their
+// lengths (the failure the rule removes). Serial and parallel agree.
+TEST(MeshParts, FollowersIgnoreThePartsTheirRootsLieInside) {
+    const TriangleMesh mesh = twoSpheres();
+    const MeshPartition parts = partitionMesh(mesh, weldVertices(mesh.positions));
+    const PartsCollider collider = partsOf(mesh, parts);
+    // Roots on every 12th of B's triangles at least 5 mm inside A, every
+    // 6th of them a guide (few: a follower caught without its mask costs
+    // hundreds of queries deep inside A).
+    std::vector<SurfacePoint> guideRoots, followerRoots;
+    size_t n = 0;
+    for (uint32_t t = 0; t < mesh.triangles.size(); t += 12) {
+        if (parts.triangleParts[t] != 1) continue;
+        const SurfacePoint r{t, 1.f / 3.f, 1.f / 3.f};
+        if (sphereA(evaluate(mesh, r).position) > -0.005f) continue;
+        (n++ % 6 == 0 ? guideRoots : followerRoots).push_back(r);
+    }
+    ASSERT_GT(guideRoots.size(), 10u);
+    const std::vector<uint32_t> masks = partsAroundRoots(parts, mesh, followerRoots);
+    for (uint32_t m : masks) ASSERT_EQ(m, 1u) << "every root lies inside A";
+
+    const int vertices = 6;
+    const float length = 0.02f;
+    FollowerGroom groom;
+    for (const SurfacePoint& r : guideRoots) groom.guideRoots.push_back(evaluate(mesh, r));
+    for (const SurfacePoint& r : followerRoots) groom.followerRoots.push_back(evaluate(mesh, r));
+    groom.guideShapes = RestShapes::straight(guideRoots.size(), vertices, length);
+    groom.followerVertices = {uint32_t(vertices)};
+    groom.followerLengths = {length};
+    StrandFrame guides;  // at rest: straight along their root normals
+    for (size_t g = 0; g < groom.guideRoots.size(); ++g) {
+        std::vector<Vec3f> p;
+        for (int k = 0; k < vertices; ++k)
+            p.push_back(groom.guideRoots[g].position + (length * float(k) / float(vertices - 1)) * groom.guideRoots[g].normal);
+        const std::vector<float> radii(p.size(), 6e-5f);
+        guides.addStrand(uint32_t(g), p.data(), radii.data(), p.size(), nullptr);
+    }
+    guides.guideCount = uint32_t(groom.guideRoots.size());
+
+    FollowerSettings loose, serial;
+    loose.collide = false;
+    serial.parallel = false;
+    StrandFrame free, seen, seenSerial, blind;
+    Followers(groom, loose).update({guides, groom.guideRoots, groom.followerRoots, &collider}, free);
+    const FollowerStats s =
+        Followers(groom, {}).update({guides, groom.guideRoots, groom.followerRoots, &collider, 0.0, masks.data()}, seen);
+    Followers(groom, serial).update({guides, groom.guideRoots, groom.followerRoots, &collider, 0.0, masks.data()},
+                                    seenSerial);
+    EXPECT_EQ(s.projected, 0u);
+    EXPECT_EQ(s.bent, 0u);
+    EXPECT_EQ(s.pinned, 0u);
+    EXPECT_TRUE(seen.positions == free.positions) << "no follower vertex moved by the part over its root";
+    EXPECT_TRUE(seen.positions == seenSerial.positions) << "serial and parallel differ";
+    float deepest = -1.f, deepestInA = 0.f;
+    for (size_t k = seen.guideCount; k < seen.strandCount(); ++k)
+        for (uint32_t i = seen.first(k) + 1; i < seen.offsets[k + 1]; ++i) {
+            deepest = std::max(deepest, -collider.signedDistanceIgnoring(seen.positions[i], nullptr, 1u));
+            deepestInA = std::max(deepestInA, -sphereA(seen.positions[i]));
+        }
+    EXPECT_LE(deepest, 0.f) << "outside B, analytically within the tessellation";
+    EXPECT_GT(deepestInA, 0.005f) << "the followers stand inside A, which they ignore";
+    const FollowerStats b = Followers(groom, {}).update({guides, groom.guideRoots, groom.followerRoots, &collider}, blind);
+    EXPECT_GT(b.projected, 0u) << "without the masks the followers fight A";
+    std::printf("%zu guides, %zu followers; without masks %zu projected, %zu bent, %zu pinned\n", guideRoots.size(),
+                followerRoots.size(), b.projected, b.bent, b.pinned);
 }

@@ -259,6 +259,11 @@ void ShotSimulation::updateIgnoredParts(const TriangleMesh& mesh) {
     ignoredParts_.insert(ignoredParts_.end(), followers.begin(), followers.end());
 }
 
+const uint32_t* ShotSimulation::followerIgnoredParts() const {
+    if (head_.motion->partition().count() < 2) return nullptr;
+    return ignoredParts_.data() + roots_.guides.size();
+}
+
 void ShotSimulation::initializeGuides(const GuideSettings& settings, const ImportedGroom* imported,
                                       const SettleCache& settleCache) {
     if (usesCurlyWetModel(scene_)) {
@@ -370,7 +375,9 @@ void ShotSimulation::produceFrame(double time) {
     StrandFrame guides;
     model_->solver.write(guides, time);
     const auto followerStart = std::chrono::steady_clock::now();
-    FollowerStats fs = followers_->update({guides, guideFrames_, followerFrames_, pose_.collider.get(), dt}, strands_);
+    FollowerStats fs =
+        followers_->update({guides, guideFrames_, followerFrames_, pose_.collider.get(), dt, followerIgnoredParts()},
+                           strands_);
     strands_.frame = frame_;
     strands_.time = time;
     // What rebuilds this frame's followers (strand cache version 2): the
@@ -421,9 +428,11 @@ void ShotSimulation::rebuildOne(const FollowerSource& source, bool previousInBuf
     pose_ = head_.motion->sample(source.guides.time);
     evaluateRoots(pose_.mesh, roots_.guides, guideFrames_);
     evaluateRoots(pose_.mesh, roots_.followers, followerFrames_);
+    if (head_.motion->partition().count() > 1) updateIgnoredParts(pose_.mesh);
     if (source.dt > 0.0 && !previousInBuffer) followers_->adoptPins(strands_, source.pins);
     const FollowerStats fs = followers_->update(
-        {source.guides, guideFrames_, followerFrames_, pose_.collider.get(), source.dt}, strands_);
+        {source.guides, guideFrames_, followerFrames_, pose_.collider.get(), source.dt, followerIgnoredParts()},
+        strands_);
     strands_.frame = source.guides.frame;
     strands_.time = source.guides.time;
     // The simulation's pins come back only when every input is the same: a

@@ -88,8 +88,8 @@ class ShotSimulation {
     /// parts it ignores (bit k: part k; sim/collision/mesh_parts.h), those
     /// its root lies inside at this frame's pose. Depth "inside" is measured
     /// with pose().collider->signedDistanceIgnoring(p, nullptr, mask). The
-    /// guides (rod) collide so, with the masks of each step's pose;
-    /// followers collide with every part.
+    /// guides (rod) collide so, with the masks of each step's pose, and so
+    /// do the followers, with the masks of the frame's pose.
     const std::vector<uint32_t>& ignoredParts() const { return ignoredParts_; }
 
     /// False for models whose state cannot be restored bit for bit (the rigid
@@ -126,6 +126,8 @@ class ShotSimulation {
     void produceFrame(double time);
     /// ignoredParts() at the pose `mesh`; hands the guides theirs.
     void updateIgnoredParts(const TriangleMesh& mesh);
+    /// The followers' block of ignoredParts() (null on a head of one part).
+    const uint32_t* followerIgnoredParts() const;
     /// The guides' rest shape at t0: imported, combed or straight, settled.
     void initializeGuides(const GuideSettings& settings, const struct ImportedGroom* imported,
                           const SettleCache& settleCache);

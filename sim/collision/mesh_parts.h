@@ -62,6 +62,26 @@ class PartsCollider final : public Collider {
     std::vector<std::shared_ptr<const Collider>> parts_;
 };
 
+/// @brief A collider seen by one strand: `collider` without the parts the
+/// strand ignores (`ignoreParts`, the mask partsAroundRoots gives its root).
+/// A view (borrows the collider); with a mask of 0 it is the collider itself.
+/// For code written against a plain Collider (projection, bending, pinning
+/// of follower vertices) to collide by the rule above.
+class IgnoringParts final : public Collider {
+  public:
+    IgnoringParts(const Collider& collider, uint32_t ignoreParts) : collider_(collider), ignore_(ignoreParts) {}
+    float signedDistance(const Vec3f& p, Vec3f* normal = nullptr) const override {
+        return ignore_ ? collider_.signedDistanceIgnoring(p, normal, ignore_) : collider_.signedDistance(p, normal);
+    }
+    float signedDistanceIgnoring(const Vec3f& p, Vec3f* normal, uint32_t ignoreParts) const override {
+        return collider_.signedDistanceIgnoring(p, normal, ignore_ | ignoreParts);
+    }
+
+  private:
+    const Collider& collider_;
+    uint32_t ignore_;
+};
+
 /// @brief Per root, the parts it lies inside: bit k set when φ_k(root) <
 /// -tolerance for a part k other than the part of the root's triangle,
 /// measured exactly (MeshCollider of each part) on `mesh`, the pose it is

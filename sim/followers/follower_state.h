@@ -202,6 +202,7 @@ struct StepContext {
     Vec3f* velocities;
     bool difference;           ///< finite-difference velocities
     float invDt;
+    const uint32_t* ignoreParts;  ///< per follower: the head's parts it ignores (null: none)
 };
 
 struct Counters {

@@ -29,6 +29,7 @@
 //   bits; within one machine every follower runs the same code in whatever
 //   lane, packet or thread, which is the determinism the project needs
 //   (bits identical across CPU generations are not promised).
+#include "sim/collision/mesh_parts.h"
 #include "sim/followers/follower_pinch.h"
 #include "sim/followers/follower_simd.h"
 #include "sim/followers/follower_state.h"
@@ -118,14 +119,16 @@ struct VelocityRows {
 /// followers): a vertex the bound cannot clear is queried; one inside is
 /// projected out keeping its segment's length (slid along the surface, or
 /// where that fails bent or pinned: follower_pinch.h), and every later vertex
-/// moves by the same shift, so segment directions are kept elsewhere. `last`:
-/// the lane's vertices in the previous frame (null when there is none).
+/// moves by the same shift, so segment directions are kept elsewhere.
+/// `collider`: the head as this follower sees it (without the parts its root
+/// lies inside). `last`: the lane's vertices in the previous frame (null
+/// when there is none).
 /// `cleared[v]` is the vector pass's bound test of the unshifted vertex,
 /// valid until the first projection (and `uncleared`, bit v, the same for
 /// vertices 1..31); after it shifted vertices are tested again.
-void collideLane(const StepContext& ctx, const FollowerClass& c, uint32_t guide1, const i8* cleared,
-                 uint32_t uncleared, int k, const OwnRestSlot* ownRest, float segmentLength, const Vec3f* last, f8* pos,
-                 Counters& counters) {
+void collideLane(const StepContext& ctx, const Collider& collider, const FollowerClass& c, uint32_t guide1,
+                 const i8* cleared, uint32_t uncleared, int k, const OwnRestSlot* ownRest, float segmentLength,
+                 const Vec3f* last, f8* pos, Counters& counters) {
     const float *gX = c.cold.row(guide1, ColdRow::X), *gY = c.cold.row(guide1, ColdRow::Y),
                 *gZ = c.cold.row(guide1, ColdRow::Z), *bound = c.cold.row(guide1, ColdRow::Bound);
     float sx = 0.f, sy = 0.f, sz = 0.f;
@@ -135,9 +138,9 @@ void collideLane(const StepContext& ctx, const FollowerClass& c, uint32_t guide1
     auto query = [&](uint32_t v, float qx, float qy, float qz) {
         ++counters.queries;
         Vec3f p(qx, qy, qz), normal;
-        float d = ctx.collider->signedDistance(p);
+        float d = collider.signedDistance(p);
         if (!(d < c.radii[v])) return;
-        d = ctx.collider->signedDistance(p, &normal);
+        d = collider.signedDistance(p, &normal);
         const Vec3f previous(pos[3 * v - 3][k], pos[3 * v - 2][k], pos[3 * v - 1][k]);
         float length = segmentLength;
         if (ownRest) {
@@ -145,10 +148,10 @@ void collideLane(const StepContext& ctx, const FollowerClass& c, uint32_t guide1
             length = std::sqrt(r.x[k] * r.x[k] + r.y[k] * r.y[k] + r.z[k] * r.z[k]);
         }
         const Vec3f wanted = p;
-        float after = projectSegmentOut(*ctx.collider, previous, length, c.radii[v], d, normal, p);
+        float after = projectSegmentOut(collider, previous, length, c.radii[v], d, normal, p);
         if (after < 0.f) {
             // The slide could not bring it out: bend, else pin (follower_pinch.h).
-            const PinchPlace place = placePinched(*ctx.collider, previous, length, c.radii[v], wanted,
+            const PinchPlace place = placePinched(collider, previous, length, c.radii[v], wanted,
                                                   last ? last + v : nullptr);
             p = place.position;
             after = place.distance;
@@ -363,7 +366,12 @@ template <FollowerMode M, bool Own>
             if (!clear[k]) {
                 // The lane's previous output, where a pinned vertex is held (still in `positions` until written below).
                 const Vec3f* last = ctx.difference ? ctx.positions + pk.vertexOffset[k] : nullptr;
-                collideLane(ctx, c, pk.guide1[k], cleared, uncleared[k], int(k), ownRest, pk.scale[k], last, pos, counters);
+                // The head as this follower sees it: without the parts its
+                // root lies inside (sim/collision/mesh_parts.h), as a guide.
+                const uint32_t ignore = ctx.ignoreParts ? ctx.ignoreParts[pk.follower[k]] : 0u;
+                const IgnoringParts own(*ctx.collider, ignore);
+                collideLane(ctx, ignore ? static_cast<const Collider&>(own) : *ctx.collider, c, pk.guide1[k], cleared,
+                            uncleared[k], int(k), ownRest, pk.scale[k], last, pos, counters);
             }
     }
 

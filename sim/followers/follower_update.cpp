@@ -67,6 +67,9 @@ void fillGuide(Impl& im, const FollowerStep& step, const Collider* collider, siz
         q[y][3] = r.z;
         speed[y] = v ? 0.5f * (v[y] + v[y + 1]).norm() : 0.f;
     }
+    // The union of every part: a lower bound of what any follower sees
+    // (ignoring parts never brings a surface nearer), so the bound below
+    // stays safe for followers that ignore parts their guide does not.
     for (uint32_t k = 0; k <= gs; ++k)
         clearance[k] = collider ? collider->signedDistance(x[k]) : std::numeric_limits<float>::max();
 
@@ -205,7 +208,7 @@ FollowerStats Followers::update(const FollowerStep& step, StrandFrame& out) {
     };
     follower::StepContext ctx{&im, step.followerRoots.data(), collider, out.positions.data() + guideVertices,
                               out.velocities.data() + guideVertices, stats.differenceVelocities,
-                              step.dt > 0.0 ? float(1.0 / step.dt) : 0.f};
+                              step.dt > 0.0 ? float(1.0 / step.dt) : 0.f, step.ignoreParts};
     std::atomic<size_t> projected{0}, queries{0}, inside{0}, bent{0}, pinned{0};
     std::atomic<uint32_t> depthBits{0};  // a non-negative float's bits order like the float
     std::mutex pinsMutex;

@@ -155,6 +155,11 @@ struct FollowerStep {
     /// Seconds since the previous update into the same `out`; 0 = no previous
     /// (first step, cut). See update() for velocities.
     double dt = 0.0;
+    /// Per follower (followerCount() entries; null: none), the head's parts
+    /// it ignores: those its root lies inside at this step's pose
+    /// (sim/collision/mesh_parts.h partsAroundRoots, the guides' rule). Its
+    /// vertices collide with the collider's signedDistanceIgnoring(p, n, mask).
+    const uint32_t* ignoreParts = nullptr;
 };
 
 /// A follower vertex pinned in a pinch (sim/followers/follower_pinch.h)

@@ -25,12 +25,22 @@
 // collision world (sim/collision/collision_world.h), in one run.
 //
 //   bench_stress --colliders [--guides 94,845] [--threads 2]
+//
+// --worst (a head that folds into itself): per frame, the deepest guide and
+// follower vertex, with each part's signed distance at it, at its parent
+// and at its strand's root, the parts the strand ignores, and whether it is
+// pinned (followers), the posed parts' winding numbers there; and how many
+// vertices are more than 1 mm inside, how many of them on strands whose own
+// root is more than 1 mm inside.
+#include "pipeline/batch/strand_cache.h"
+#include "pipeline/head/animated_head.h"
 #include "pipeline/scene/scene.h"
 #include "pipeline/stages/shot_simulation.h"
 #include "sim/collision/collision_world.h"
 #include "sim/strands/fibonacci.h"
 #include "sim/guides/guides.h"
 #include "sim/collision/mesh_collider.h"
+#include "sim/collision/mesh_parts.h"
 
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -38,6 +48,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <optional>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -68,7 +79,79 @@ std::vector<float> segmentLengths(const StrandFrame& f) {
     return out;
 }
 
-int stress(const std::string& path, const std::vector<std::string>& overrides, bool perFrame) {
+/// The generalized winding number of the closed surface `mesh` at q
+/// (Jacobson et al. 2013, "Robust inside-outside segmentation using
+/// generalized winding numbers"): w(q) = Σ_t Ω_t(q) / 4π, with the solid
+/// angle of triangle (a, b, c) seen from q (Van Oosterom & Strackee 1983,
+/// "The solid angle of a plane triangle"), for a = a - q etc.:
+///   tan(Ω/2) = a·(b × c) / (|a||b||c| + (a·b)|c| + (b·c)|a| + (c·a)|b|).
+/// 1 inside, 0 outside a surface that does not cross itself; where it
+/// folds through itself, the number of layers around q. Exact and O(T):
+/// a diagnostic, not a collider.
+double windingNumber(const TriangleMesh& mesh, const Vec3f& q) {
+    double w = 0;
+    for (const Tri& t : mesh.triangles) {
+        const Eigen::Vector3d a = (mesh.positions[t[0]] - q).cast<double>(), b = (mesh.positions[t[1]] - q).cast<double>(),
+                              c = (mesh.positions[t[2]] - q).cast<double>();
+        const double la = a.norm(), lb = b.norm(), lc = c.norm();
+        w += 2 * std::atan2(a.dot(b.cross(c)), la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
+    }
+    return w / (4 * M_PI);
+}
+
+/// --worst: the deepest free vertex of strands [begin, end) of `f` by the
+/// documented definition, and what holds it there: each part's signed
+/// distance at the vertex, its parent and the strand's root, the parts the
+/// strand ignores, whether it is a pinned follower vertex. Also how many
+/// vertices are more than 1 mm inside, and how many of those belong to
+/// strands whose root is itself more than 1 mm inside a part they collide
+/// with (a collider that is not where the posed mesh is).
+void explainWorst(const char* what, const StrandFrame& f, size_t begin, size_t end, const PartsCollider& parts,
+                  const std::vector<TriangleMesh>& posedParts, const std::vector<uint32_t>& ignore,
+                  const std::vector<FollowerPin>& pins) {
+    float worst = 0.f;
+    size_t strand = 0, deep = 0, rootInside = 0;
+    uint32_t vertex = 0;
+    for (size_t s = begin; s < end; ++s) {
+        // Is the root itself more than 1 mm inside a part the strand collides with?
+        const float root = parts.signedDistanceIgnoring(f.positions[f.first(s)], nullptr, ignore[s]);
+        for (uint32_t i = f.first(s) + 1; i < f.offsets[s + 1]; ++i) {
+            const float d = -parts.signedDistanceIgnoring(f.positions[i], nullptr, ignore[s]);
+            if (d > worst) worst = d, strand = s, vertex = i;
+            if (d > 1e-3f) ++deep, rootInside += root < -1e-3f;
+        }
+    }
+    if (worst <= 0.f) return;
+    std::printf("  %s vertices more than 1 mm inside: %zu, %zu of them on strands whose root lies more than 1 mm "
+                "inside a part they collide with\n",
+                what, deep, rootInside);
+    auto distances = [&](const Vec3f& p) {
+        std::string out;
+        for (size_t k = 0; k < parts.count(); ++k) out += cat(k ? " " : "", 1e3 * parts.part(k).signedDistance(p));
+        return out;
+    };
+    auto windings = [&](const Vec3f& p) {
+        std::string out;
+        for (size_t k = 0; k < posedParts.size(); ++k)
+            out += cat(k ? " " : "", std::round(100 * windingNumber(posedParts[k], p)) / 100);
+        return out;
+    };
+    const uint32_t block = vertex - f.offsets[f.guideCount];
+    const bool pinned = strand >= f.guideCount &&
+                        std::any_of(pins.begin(), pins.end(), [&](const FollowerPin& p) { return p.vertex == block; });
+    std::printf("  deepest %s: strand %zu vertex %u, %.3f mm; parts' distance mm at it [%s], parent [%s], root [%s]; "
+                "ignores %#x%s\n",
+                what, strand, vertex - f.first(strand), 1e3 * worst, distances(f.positions[vertex]).c_str(),
+                distances(f.positions[vertex - 1]).c_str(), distances(f.positions[f.first(strand)]).c_str(),
+                ignore[strand], pinned ? ", pinned" : "");
+    // On the surface the number is ambiguous: taken 0.1 mm up the strand.
+    const Vec3f root = f.positions[f.first(strand)], up = f.positions[f.first(strand) + 1] - root;
+    std::printf("    posed parts' winding numbers at it [%s], parent [%s], 0.1 mm above the root [%s]\n",
+                windings(f.positions[vertex]).c_str(), windings(f.positions[vertex - 1]).c_str(),
+                windings(root + 1e-4f * up.normalized()).c_str());
+}
+
+int stress(const std::string& path, const std::vector<std::string>& overrides, bool perFrame, bool worstVertex) {
     const Scene scene = Scene::load(path, overrides);
     const std::vector<int>& frames = scene.frames("frames");
     const double fps = scene.number("fps");
@@ -120,6 +203,18 @@ int stress(const std::string& path, const std::vector<std::string>& overrides, b
                         st.guides.pinnedCount,
                         st.followerProjected, st.followers.bent, st.followers.pinned, st.followers.penetrationCount,
                         1e3 * st.followers.maxPenetration);
+        }
+        const auto* parts = dynamic_cast<const PartsCollider*>(collider);
+        if (worstVertex && parts) {
+            const std::optional<CachedGuides> cached = sim.cachedGuides();
+            const std::vector<FollowerPin> none;
+            std::printf("frame %d:\n", frame);
+            const MeshPartition& partition = sim.head().motion->partition();
+            std::vector<TriangleMesh> posed;
+            for (size_t k = 0; k < partition.count(); ++k) posed.push_back(partition.part(sim.pose().mesh, k));
+            explainWorst("guide", f, 0, guides, *parts, posed, ignore, none);
+            explainWorst("follower", f, guides, f.strandCount(), *parts, posed, ignore,
+                         cached ? cached->current.pins : none);
         }
     }
     std::printf("| steps/s | worst stretch guides (frame) | worst stretch followers (frame) | worst depth mm (frame) "
@@ -195,7 +290,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> overrides;
     std::vector<size_t> counts{94, 845};
     int threads = 2;
-    bool colliderMode = false, perFrame = false;
+    bool colliderMode = false, perFrame = false, worstVertex = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string {
@@ -210,6 +305,7 @@ int main(int argc, char** argv) {
         else if (a == "--threads") threads = std::stoi(next());
         else if (a == "--colliders") colliderMode = true;
         else if (a == "--per-frame") perFrame = true;
+        else if (a == "--worst") worstVertex = true;
         else if (a == "--guides") {
             counts.clear();
             const std::string list = next();
@@ -226,7 +322,7 @@ int main(int argc, char** argv) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     std::printf("threads: %d\n", threads);
     try {
-        return colliderMode ? colliders(counts) : stress(scenePath, overrides, perFrame);
+        return colliderMode ? colliders(counts) : stress(scenePath, overrides, perFrame, worstVertex);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_stress: %s\n", e.what());
         return 1;
