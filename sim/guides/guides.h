@@ -112,7 +112,7 @@ struct GuideSettings : StepSettings {
     float preloadReach = 0.001f;    ///< rod: a vertex within collisionRadius + this of the head leans on it, m
     /// rod: the pre-load changes joint j's rest curvature by at most this many
     /// times 1/ℓ_b (ℓ_b the bending length; rod::limitPreload); ≤ 0: no bound.
-    float preloadLimit = 1.f;
+    float preloadLimit = 1.5f;
 
     // Joint limits (Gomes 2024: ±30° about the bending axes, ±10° twist, soft).
     float bendLimit = 30.f;         ///< deg
