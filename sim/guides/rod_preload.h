@@ -65,10 +65,11 @@ struct PreloadContact {
 /// hair on its own. A strand combed up and over the crown and held in place
 /// wholly by rest curvature (a cantilever) has a second, standing
 /// equilibrium beside the groom, and a nod or a shake throws it there
-/// (docs/physics.md, "Pre-load"). Twigg and Kačić-Alesić ("Optimization for
-/// sag-free simulations", 2011) likewise trade an exact sag-free rest state
-/// for bounded rest-state changes; where the bound binds, the groom sags
-/// (onto the head, which then carries it: Derouet-Jourdan et al. 2013).
+/// (docs/physics.md, "Pre-load"). The exact sag-free rest state (Twigg and
+/// Kačić-Alesić, "Optimization for sag-free simulations", 2011) is given up
+/// where the bound binds: there the groom sags, onto the head, which then
+/// carries it (as Derouet-Jourdan et al. 2013 let the head carry what lies
+/// on it).
 /// limit ≤ 0: no bound. Returns how many joints the bound clipped.
 int limitPreload(const RodStrand& s, const Vec2f* c0, float gravity, float limit, Vec2f* c);
 
