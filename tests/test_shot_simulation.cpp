@@ -84,29 +84,50 @@ float largestDistance(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b) 
     return d;
 }
 
+float meanDistance(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b) {
+    double d = 0;
+    for (size_t i = 0; i < a.size(); ++i) d += double((a[i] - b[i]).norm());
+    return float(d / double(std::max<size_t>(1, a.size())));
+}
+
 }  // namespace
 
 TEST(ShotSimulation, HairHangsUnderGravityAndSwingsWithTheHead) {
     const Scene scene = smallDefaultScene({"frames=1-120"});
     const float length = float(scene.number("hair.guides.length"));
-    // Hangs: the settled, pre-loaded groom is an equilibrium under gravity.
-    // On a head held still (clip_speed 0) it stays where it is; without the
-    // pre-load the same groom sags, so the test can tell the two apart.
-    auto drift = [&](const char* preload) {
-        ShotSimulation still(smallDefaultScene({"head.clip_speed=0", std::string("simulation.preload=") + preload}),
-                             24.0, 1);
-        const std::vector<Vec3f> at1 = guidesInHeadFrame(still.advanceTo(1), still.pose());
-        return largestDistance(at1, guidesInHeadFrame(still.advanceTo(24), still.pose()));
+    // Hangs: the settled groom, pre-loaded without a bound
+    // (simulation.preload_limit 0), is an equilibrium under gravity: on a
+    // head held still (clip_speed 0) it stays where it is; without the
+    // pre-load the same groom sags, so the test can tell the two apart. The
+    // default bound (1.5/ℓ_b per joint) lets the crown strands that the
+    // settling left standing fall onto the head and the rest sag part way:
+    // the guide vertices' mean motion in 1 s is measured at 7.8 mm against
+    // the unloaded groom's 25.8 mm; the test asks for at most half of it, so
+    // a bound that held little would fail.
+    struct Drift {
+        float largest, mean;
     };
-    const float held = drift("true"), sagged = drift("false");
-    RecordProperty("still_head_drift_um", int(held * 1e6f));
-    RecordProperty("no_preload_sag_um", int(sagged * 1e6f));
+    auto drift = [&](std::vector<std::string> sets) {
+        sets.push_back("head.clip_speed=0");
+        ShotSimulation still(smallDefaultScene(sets), 24.0, 1);
+        const std::vector<Vec3f> at1 = guidesInHeadFrame(still.advanceTo(1), still.pose());
+        const std::vector<Vec3f> at24 = guidesInHeadFrame(still.advanceTo(24), still.pose());
+        return Drift{largestDistance(at1, at24), meanDistance(at1, at24)};
+    };
+    const Drift exact = drift({"simulation.preload_limit=0"}), bounded = drift({}),
+                sagged = drift({"simulation.preload=false"});
+    RecordProperty("still_head_drift_um", int(exact.largest * 1e6f));
+    RecordProperty("bounded_mean_drift_um", int(bounded.mean * 1e6f));
+    RecordProperty("bounded_largest_drift_um", int(bounded.largest * 1e6f));
+    RecordProperty("no_preload_sag_um", int(sagged.largest * 1e6f));
+    RecordProperty("no_preload_mean_sag_um", int(sagged.mean * 1e6f));
     // Held: less than the clearance the solver keeps from the head
-    // (hair.guides.collision_radius, 1 mm; measured 0.30 mm). Sagged: the
+    // (hair.guides.collision_radius, 1 mm; measured 0.04 mm). Sagged: the
     // unbalanced weight bends the groom by centimetres (measured 55 mm).
     const float clearance = float(scene.number("hair.guides.collision_radius"));
-    EXPECT_LT(held, clearance) << "pre-loaded hair on a still head, 1 s";
-    EXPECT_GT(sagged, 10.f * clearance) << "without the pre-load the groom sags under gravity";
+    EXPECT_LT(exact.largest, clearance) << "pre-loaded hair on a still head, 1 s";
+    EXPECT_GT(sagged.largest, 10.f * clearance) << "without the pre-load the groom sags under gravity";
+    EXPECT_LT(bounded.mean, 0.5f * sagged.mean) << "the bounded pre-load no longer holds the groom";
     // And it hangs: the guides' tips are, on average, more than half their
     // length below their roots (measured 0.71 L; a groom standing up or
     // lying flat would be at ≤ 0).

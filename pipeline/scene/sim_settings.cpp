@@ -33,6 +33,7 @@ GuideSettings guideSettings(const Scene& scene) {
         {"simulation.preload", &GuideSettings::preload},
         {"simulation.preload_contact", &GuideSettings::preloadContact},
         {"simulation.preload_reach", &GuideSettings::preloadReach},
+        {"simulation.preload_limit", &GuideSettings::preloadLimit},
         {"simulation.head_collision", &GuideSettings::headCollision},
         {"simulation.strand_collision", &GuideSettings::strandCollision},
         {"simulation.strands_per_world", &GuideSettings::strandsPerWorld},

@@ -62,6 +62,7 @@ void GuideSettings::validate() const {
     check(rodSubsteps >= 1, "rod substeps must be ≥ 1");
     check(preloadProbes >= 0, "pre-load probes must be ≥ 0");
     check(preloadReach >= 0.f, "pre-load reach must be ≥ 0");
+    check(preloadLimit >= 0.f, "pre-load limit must be ≥ 0");
     check(friction >= 0.f, "friction must be ≥ 0");
     check(bendLimit > 0.f && bendLimit < 180.f, "bend limit must be in (0, 180) degrees");
     check(twistLimit > 0.f && twistLimit < 90.f, "twist limit must be in (0, 90) degrees");

@@ -110,6 +110,9 @@ struct GuideSettings : StepSettings {
     /// every vertex's full weight goes into rest curvature.
     bool preloadContact = false;
     float preloadReach = 0.001f;    ///< rod: a vertex within collisionRadius + this of the head leans on it, m
+    /// rod: the pre-load changes joint j's rest curvature by at most this many
+    /// times 1/ℓ_b (ℓ_b the bending length; rod::limitPreload); ≤ 0: no bound.
+    float preloadLimit = 1.5f;
 
     // Joint limits (Gomes 2024: ±30° about the bending axes, ±10° twist, soft).
     float bendLimit = 30.f;         ///< deg

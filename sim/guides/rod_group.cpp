@@ -143,7 +143,8 @@ class RodGroup final : public GuideGroup {
         rod::Vec2f* c = &curvature_[(g - begin_) * size_t(set_.segments)];
         rod::restCurvature(s, x.data(), R, c);
         if (preloadStep > 0.f)
-            rod::preload(s, x.data(), R, set_.settings.gravity, preloadStep, set_.settings.preloadProbes, contact, c,
+            rod::preload(s, x.data(), R, set_.settings.gravity, preloadStep, set_.settings.preloadProbes, contact,
+                         set_.settings.preloadLimit, c,
                          scratch_);
     }
 

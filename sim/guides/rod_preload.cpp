@@ -4,6 +4,7 @@
 #include <Eigen/QR>
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 namespace hp::rod {
@@ -110,9 +111,30 @@ double preloadOffset(const RodStrand& s, const Vec3f* x, const Mat3f& R, const V
     return carried;
 }
 
-void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gravity, float h, int probes,
-             const PreloadContact& contact, Vec2f* c, RodScratch& sc) {
+int limitPreload(const RodStrand& s, const Vec2f* c0, float gravity, float limit, Vec2f* c) {
+    const int S = s.vertices - 1;
+    if (limit <= 0.f || S < 1 || gravity <= 0.f) return 0;
+    double mass = 0, length = 0;
+    for (int i = 1; i <= S; ++i) mass += s.invMass[i] > 0.f ? 1.0 / double(s.invMass[i]) : 0.0;
+    for (int j = 0; j < S; ++j) length += double(s.restLength[j]);
+    const double weightPerLength = mass / std::max(length, 1e-12) * double(gravity);  // μ·|g|, N/m
+    int clipped = 0;
+    for (int j = 0; j < S; ++j) {
+        const double bendingLength = std::cbrt(stiffnessAt(s, j) / weightPerLength);
+        const float bound = float(double(limit) * double(voronoiLength(s, j)) / bendingLength);
+        const Vec2f d = c[j] - c0[j];
+        const float norm = d.norm();
+        if (norm <= bound) continue;
+        c[j] = c0[j] + d * (bound / norm);
+        ++clipped;
+    }
+    return clipped;
+}
+
+int preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gravity, float h, int probes,
+            const PreloadContact& contact, float limit, Vec2f* c, RodScratch& sc) {
     const int n = s.vertices;
+    const std::vector<Vec2f> c0(c, c + (n - 1));  // the groom's own curvatures
     std::vector<Vec3f> f(size_t(n), Vec3f::Zero()), xt(size_t(n), Vec3f::Zero()), vt(size_t(n), Vec3f::Zero());
     std::vector<Vec3f> normal(size_t(n), Vec3f::Zero());
     const bool leans = contact.head && contact.head->collider &&
@@ -140,6 +162,7 @@ void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gr
         for (int i = 1; i < n; ++i) f[size_t(i)] = (xt[size_t(i)] - x[i]) / (s.invMass[i] * h * h);
         preloadOffset(s, x, R, f.data(), leaning, c);
     }
+    return limitPreload(s, c0.data(), gravity.norm(), limit, c);
 }
 
 }  // namespace hp::rod

@@ -54,6 +54,25 @@ struct PreloadContact {
     float reach = 0.f;                        ///< a vertex with φ < radius + reach may lean on the head, m
 };
 
+/// Bounds what the pre-load adds to the rest curvature, joint by joint
+/// (c0: the curvatures before the pre-load, the groom's own shape):
+///   ℓ_b,j = (EI_j/(μ·|g|))^(1/3)          the bending length; μ the strand's
+///                                          mean mass per length
+///   |c_j - c0_j| ≤ limit · l̄_j / ℓ_b,j   (c is a turn per joint: a
+///                                          curvature times l̄_j)
+/// Why: a pre-load is the curvature that holds the groom's weight up, and
+/// one that curls a joint more than 1/ℓ_b lifts about a bending length of
+/// hair on its own. A strand combed up and over the crown and held in place
+/// wholly by rest curvature (a cantilever) has a second, standing
+/// equilibrium beside the groom, and a nod or a shake throws it there
+/// (docs/physics.md, "Pre-load"). The exact sag-free rest state (Twigg and
+/// Kačić-Alesić, "Optimization for sag-free simulations", 2011) is given up
+/// where the bound binds: there the groom sags, onto the head, which then
+/// carries it (as Derouet-Jourdan et al. 2013 let the head carry what lies
+/// on it).
+/// limit ≤ 0: no bound. Returns how many joints the bound clipped.
+int limitPreload(const RodStrand& s, const Vec2f* c0, float gravity, float limit, Vec2f* c);
+
 /// Pre-loads c (holding the rest curvatures) so that x is a static
 /// equilibrium of rodStep with step h under gravity and the head's contact:
 /// preloadOffset for the weights, leaning on the head where x lies within
@@ -61,8 +80,10 @@ struct PreloadContact {
 /// cancelling the drift left (GuideSettings::preloadProbes); where the
 /// strand leans on the head the probes step with the head (as the
 /// simulation will), and may lean on it again. Without contact (or
-/// contact.head null) the weights go wholly into rest curvature.
-void preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gravity, float h, int probes,
-             const PreloadContact& contact, Vec2f* c, RodScratch& scratch);
+/// contact.head null) the weights go wholly into rest curvature. Last, the
+/// change is bounded by limitPreload(limit) (≤ 0: unbounded, an exact
+/// equilibrium). Returns how many joints the bound clipped.
+int preload(const RodStrand& s, const Vec3f* x, const Mat3f& R, const Vec3f& gravity, float h, int probes,
+            const PreloadContact& contact, float limit, Vec2f* c, RodScratch& scratch);
 
 }  // namespace hp::rod

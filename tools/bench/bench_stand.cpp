@@ -6,6 +6,9 @@
 // head tips. The strands are those the strand cache and `export-usd` hold
 // (guides first, then followers), counted together and apart.
 //
+// The last column is the guides' mean tip drop since the first frame: with
+// the head held still (--set head.clip_speed=0) it is the groom's sag.
+//
 //   bench_stand [--scene scenes/default.yaml] [--frames 1,36,84] [--threads 2] [--rise 0.02] [--set key=value ...]
 //
 // Compare:  bench_stand --set simulation.preload=true
@@ -63,9 +66,10 @@ int main(int argc, char** argv) {
     std::printf("strands whose highest vertex stands more than %.0f mm above their root (world up), %s", 1e3 * rise,
                 path.c_str());
     for (const std::string& o : overrides) std::printf(" --set %s", o.c_str());
-    std::printf("\n\n| frame | all strands | guides | followers | highest rise mm | of them standing on the first frame too |\n"
-                "|---:|---:|---:|---:|---:|---:|\n");
+    std::printf("\n\n| frame | all strands | guides | followers | highest rise mm | of them standing on the first frame too | guides' mean tip drop mm |\n"
+                "|---:|---:|---:|---:|---:|---:|---:|\n");
     std::vector<char> firstStanding;
+    std::vector<float> firstTip;  // the guides' tip heights on the first frame
     for (int frame : frames) {
         const StrandFrame& f = sim.advanceTo(frame);
         size_t standing[2] = {0, 0}, count[2] = {0, 0}, again = 0;
@@ -105,11 +109,18 @@ int main(int argc, char** argv) {
                             1e3 * head.closest(f.positions[top]).distance, near, n - 1);
             }
         }
+        // How far the guides' tips fell since the first frame (with the head
+        // held still, `--set head.clip_speed=0`, the groom's sag).
+        if (firstTip.empty())
+            for (size_t g = 0; g < guides; ++g) firstTip.push_back(f.positions[f.first(g) + f.vertexCount(g) - 1].y());
+        double drop = 0;
+        for (size_t g = 0; g < guides; ++g) drop += firstTip[g] - f.positions[f.first(g) + f.vertexCount(g) - 1].y();
+        drop /= double(std::max<size_t>(1, guides));
         auto pct = [](size_t a, size_t b) { return b ? 100.0 * double(a) / double(b) : 0.0; };
-        std::printf("| %d | %.2f%% (%zu of %zu) | %.2f%% | %.2f%% | %.1f | %zu |\n", frame,
+        std::printf("| %d | %.2f%% (%zu of %zu) | %.2f%% | %.2f%% | %.1f | %zu | %.2f |\n", frame,
                     pct(standing[0] + standing[1], count[0] + count[1]), standing[0] + standing[1],
                     count[0] + count[1], pct(standing[0], count[0]), pct(standing[1], count[1]), 1e3 * highest,
-                    isFirst ? standing[0] + standing[1] : again);
+                    isFirst ? standing[0] + standing[1] : again, 1e3 * drop);
         std::fflush(stdout);
     }
     return 0;
