@@ -68,9 +68,27 @@ vec3 slotGrid(int s, vec3 world) { return gridCoordinates(uSlotView[s], uSlotMap
 // Light i's shadow slot, -1 for an unshadowed light.
 int shadowSlot(int i) { return int(uLightRad[i].w); }
 
-// Unit direction from p toward light i, and its radiance there (render/view/view.cpp Light::toLight).
-vec3 toLight(int i, vec3 p, out vec3 radiance) {
-    if (uLightVec[i].w < 0.5) {
+// The hair programs are compiled for their frame's lights and flags
+// (render/preview/preview_uniforms.cpp hairShadingDefines): llvmpipe's
+// vertex stages run both sides of every branch under a mask, even where the
+// condition is uniform, so a branch on a uniform costs both of its sides on
+// every vertex. HAIR_FLAGS and HAIR_MODEL make those conditions constants;
+// without them (the head's programs) the uniforms decide.
+#ifdef HAIR_FLAGS
+#define SHADE_FLAGS HAIR_FLAGS
+#else
+#define SHADE_FLAGS uCounts.z
+#endif
+#ifdef HAIR_MODEL
+#define SHADE_MODEL HAIR_MODEL
+#else
+#define SHADE_MODEL uCounts.w
+#endif
+
+// Unit direction from p toward light i, and its radiance there (render/view/view.cpp Light::toLight);
+// `point`: light i is a point light (uLightVec[i].w = 1).
+vec3 toLightOfType(int i, bool point, vec3 p, out vec3 radiance) {
+    if (!point) {
         radiance = uLightRad[i].rgb;
         return uLightVec[i].xyz;
     }
@@ -79,3 +97,5 @@ vec3 toLight(int i, vec3 p, out vec3 radiance) {
     radiance = uLightRad[i].rgb / r2;
     return d / sqrt(r2);
 }
+
+vec3 toLight(int i, vec3 p, out vec3 radiance) { return toLightOfType(i, uLightVec[i].w >= 0.5, p, radiance); }

@@ -19,6 +19,49 @@
 // share of forward-scattered light that meets the next fibre of a chain.
 const float kForwardDensity = 0.7;
 
+// Light i's share, its shadow slot s (-1 none) and type given: constants
+// when the program is compiled for its lights (HAIR_LIGHTS below).
+vec3 shadeLight(int i, int s, bool point, vec3 world, vec3 t, vec3 n, vec3 v, vec3 albedo, float firstColumn) {
+    vec3 radiance;
+    vec3 l = toLightOfType(i, point, world, radiance);
+    if (SHADE_MODEL != kHairFitted) return kajiyaKay(albedo, t, n, l, v) * radiance * slotVisibility(s, world);
+    vec3 af = vec3(1.0) - uShadowColor.rgb;
+    if (!voxelsOn(s)) {
+        // A light without a grid (unshadowed: it reaches every fibre, as
+        // in the reference). The fibres toward it are lit too and pass on
+        // what they scatter forward: n fibres deep a_f^n, spread n beta_f^2.
+        // Summed over n = 1..N with N Poisson of mean C_h, half of slot
+        // 0's column here (the hair's half thickness, the grid's one
+        // measure of it; without a grid the infinite sum), times Zinke's d_f:
+        //   d_f a_f (1 - exp(-(1 - a_f) C_h)) / (1 - a_f),
+        // spread at the series' mean depth 1 / (1 - a_f), capped by C_h.
+        float column = firstColumn;
+        vec3 deep = af / max(vec3(1.0) - af, vec3(0.05));
+        float meanDepth = 1.0 / max(1.0 - dot(af, vec3(0.2126, 0.7152, 0.0722)), 0.05);
+        vec3 chain = kForwardDensity * deep;
+        float reach = meanDepth;
+        if (column >= 0.0) {
+            float half_ = 0.5 * column;
+            chain = kForwardDensity * deep * (vec3(1.0) - exp(-(vec3(1.0) - af) * half_));
+            reach = min(meanDepth, max(half_, 1.0));
+        }
+        float spreadU = uShadowColor.w * reach;
+        vec3 f = fittedHair(albedo, t, l, v, 0.0) + chain * fittedHair(albedo, t, l, v, spreadU) +
+                 hairLobe(3, t, l, v, spreadU) * (column >= 0.0 ? vec3(1.0) - exp(-(vec3(1.0) - af * af) * 0.5 * column) : vec3(1.0));
+        return f * radiance * headVisibility(s, world);
+    }
+    // A shadowed light: forward transmittance and spread through the
+    // C fibres in front, back-scatter from the C_b = column - C behind.
+    // Zinke's A_b sums paths into a half-space of hair; through C_b
+    // fibres the round trips a_f^2k stop after about C_b, the factor
+    // 1 - exp(-(1 - a_f^2) C_b) (Poisson mean of 1 - a_f^(2n)).
+    vec2 c = hairColumn(s, world);
+    float spread = uShadowColor.w * c.x;
+    vec3 depthFactor = vec3(1.0) - exp(-(vec3(1.0) - af * af) * (c.y - c.x));
+    vec3 f = fittedHair(albedo, t, l, v, spread) + hairLobe(3, t, l, v, spread) * depthFactor;
+    return f * radiance * exp(-uShadowColor.rgb * c.x) * headVisibility(s, world);
+}
+
 vec3 shadeHair(vec3 world, vec3 tangent, vec3 albedo) {
     vec3 t = normalize(tangent);
     vec3 v = normalize(uEye.xyz - world);
@@ -27,56 +70,19 @@ vec3 shadeHair(vec3 world, vec3 tangent, vec3 albedo) {
     vec3 n = v - dot(v, t) * t;
     n = dot(n, n) > 1e-12 ? normalize(n) : vec3(0.0);
     vec3 color = vec3(0.0);
-    bool fitted = uCounts.w == kHairFitted;
     // Lights without a shadow slot take the hair's thickness from slot 0's
     // column through the point (once for all of them).
     float firstColumn = -1.0;
-    if (fitted && (uCounts.z & kFlagUnshadowedLights) != 0 && voxelsOn(uCounts.y > 0 ? 0 : -1))
+    if (SHADE_MODEL == kHairFitted && (SHADE_FLAGS & kFlagUnshadowedLights) != 0 && voxelsOn(uCounts.y > 0 ? 0 : -1))
         firstColumn = hairColumn(0, world).y;
-    vec3 af = vec3(1.0) - uShadowColor.rgb;
-    for (int i = 0; i < uCounts.x; ++i) {
-        vec3 radiance;
-        vec3 l = toLight(i, world, radiance);
-        if (!fitted) {
-            color += kajiyaKay(albedo, t, n, l, v) * radiance * lightVisibility(i, world);
-            continue;
-        }
-        int s = shadowSlot(i);
-        if (!voxelsOn(s)) {
-            // A light without a grid (unshadowed: it reaches every fibre, as
-            // in the reference). The fibres toward it are lit too and pass on
-            // what they scatter forward: n fibres deep a_f^n, spread n beta_f^2.
-            // Summed over n = 1..N with N Poisson of mean C_h, half of slot
-            // 0's column here (the hair's half thickness, the grid's one
-            // measure of it; without a grid the infinite sum), times Zinke's d_f:
-            //   d_f a_f (1 - exp(-(1 - a_f) C_h)) / (1 - a_f),
-            // spread at the series' mean depth 1 / (1 - a_f), capped by C_h.
-            float column = firstColumn;
-            vec3 deep = af / max(vec3(1.0) - af, vec3(0.05));
-            float meanDepth = 1.0 / max(1.0 - dot(af, vec3(0.2126, 0.7152, 0.0722)), 0.05);
-            vec3 chain = kForwardDensity * deep;
-            float reach = meanDepth;
-            if (column >= 0.0) {
-                float half_ = 0.5 * column;
-                chain = kForwardDensity * deep * (vec3(1.0) - exp(-(vec3(1.0) - af) * half_));
-                reach = min(meanDepth, max(half_, 1.0));
-            }
-            float spreadU = uShadowColor.w * reach;
-            vec3 f = fittedHair(albedo, t, l, v, 0.0) + chain * fittedHair(albedo, t, l, v, spreadU) +
-                     hairLobe(3, t, l, v, spreadU) * (column >= 0.0 ? vec3(1.0) - exp(-(vec3(1.0) - af * af) * 0.5 * column) : vec3(1.0));
-            color += f * radiance * headVisibility(i, world);
-            continue;
-        }
-        // A shadowed light: forward transmittance and spread through the
-        // C fibres in front, back-scatter from the C_b = column - C behind.
-        // Zinke's A_b sums paths into a half-space of hair; through C_b
-        // fibres the round trips a_f^2k stop after about C_b, the factor
-        // 1 - exp(-(1 - a_f^2) C_b) (Poisson mean of 1 - a_f^(2n)).
-        vec2 c = hairColumn(s, world);
-        float spread = uShadowColor.w * c.x;
-        vec3 depthFactor = vec3(1.0) - exp(-(vec3(1.0) - af * af) * (c.y - c.x));
-        vec3 f = fittedHair(albedo, t, l, v, spread) + hairLobe(3, t, l, v, spread) * depthFactor;
-        color += f * radiance * exp(-uShadowColor.rgb * c.x) * headVisibility(i, world);
-    }
+#ifdef HAIR_LIGHTS
+    // HAIR_LIGHTS(F) is F(i, slot, point) for each light, in order
+    // (hairShadingDefines): one inlined call per light, with constants.
+#define HAIR_SHADE_ONE(i, s, point) color += shadeLight(i, s, point, world, t, n, v, albedo, firstColumn);
+    HAIR_LIGHTS(HAIR_SHADE_ONE)
+#else
+    for (int i = 0; i < uCounts.x; ++i)
+        color += shadeLight(i, shadowSlot(i), uLightVec[i].w >= 0.5, world, t, n, v, albedo, firstColumn);
+#endif
     return color;
 }

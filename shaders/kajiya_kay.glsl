@@ -25,7 +25,7 @@ vec3 kajiyaKay(vec3 albedo, vec3 t, vec3 n, vec3 l, vec3 v) {
     vec3 diffuse = uHairColor.w * sinBetween(t, l) * albedo;
     vec3 specular = uSpecColor.w * pow(sinBetween(shiftedTangent(t, n, uHairShape.z), h), uHairShape.x) *
                     uSpecColor.rgb;
-    if (uCounts.w == kHairKajiyaKayTwoLobes)
+    if (SHADE_MODEL == kHairKajiyaKayTwoLobes)
         specular += uSecondColor.w * pow(sinBetween(shiftedTangent(t, n, uHairShape.w), h), uHairShape.y) *
                     uSecondColor.rgb;
     return diffuse + specular;

@@ -40,18 +40,17 @@ float shadowMapVisibility(int s, vec3 world) {
 // dynamically uniform, as GLSL 4 requires for indexing sampler arrays: it
 // comes from a uniform.)
 float voxelDensityAt(int s, vec3 g) {
-    if ((uCounts.z & kFlagVoxelFilter) == 0 || s > 0) return texture(uDensity[s], g).r;
+    if ((SHADE_FLAGS & kFlagVoxelFilter) == 0 || s > 0) return texture(uDensity[s], g).r;
     float h = 0.75 / uSlotDepth[s].w;
     return 0.25 * (texture(uDensity[s], g + vec3(-h, -h, 0.0)).r + texture(uDensity[s], g + vec3(h, -h, 0.0)).r +
                    texture(uDensity[s], g + vec3(-h, h, 0.0)).r + texture(uDensity[s], g + vec3(h, h, 0.0)).r);
 }
 
-bool voxelsOn(int s) { return s >= 0 && (uCounts.z & kFlagVoxels) != 0; }
+bool voxelsOn(int s) { return s >= 0 && (SHADE_FLAGS & kFlagVoxels) != 0; }
 
-// Expected hair crossings C in front of a point toward light i (0 for an
-// unshadowed light or without the voxel grid).
-float hairCrossings(int light, vec3 world) {
-    int s = shadowSlot(light);
+// Expected hair crossings C in front of a point toward the light of shadow
+// slot s (0 for an unshadowed light, s = -1, or without the voxel grid).
+float slotCrossings(int s, vec3 world) {
     if (!voxelsOn(s)) return 0.0;
     return voxelDensityAt(s, slotGrid(s, world) - vec3(0.0, 0.0, 0.5 / uSlotDepth[s].w));
 }
@@ -65,10 +64,9 @@ vec2 hairColumn(int s, vec3 world) {
     return vec2(front, max(voxelDensityAt(s, vec3(g.xy, 1.0 - half_)), front));
 }
 
-// The head's shadow map toward light i (1 unshadowed).
-float headVisibility(int light, vec3 world) {
-    int s = shadowSlot(light);
-    if (s < 0 || (uCounts.z & kFlagShadowMap) == 0) return 1.0;
+// The head's shadow map toward the light of slot s (1 unshadowed).
+float headVisibility(int s, vec3 world) {
+    if (s < 0 || (SHADE_FLAGS & kFlagShadowMap) == 0) return 1.0;
     return shadowMapVisibility(s, world);
 }
 
@@ -78,6 +76,7 @@ float headVisibility(int light, vec3 world) {
 // Coloured: exp(-k C) per channel, k = uShadowColor.rgb (1 - T for
 // Kajiya-Kay, 1 - a_f for the fitted hair: the light fibres scatter forward
 // reaches the skin, Zinke 2008's forward transmittance).
-vec3 hairOnlyVisibility(int light, vec3 world) { return exp(-uShadowColor.rgb * hairCrossings(light, world)); }
+vec3 hairOnlyVisibility(int light, vec3 world) { return exp(-uShadowColor.rgb * slotCrossings(shadowSlot(light), world)); }
 
-vec3 lightVisibility(int light, vec3 world) { return hairOnlyVisibility(light, world) * headVisibility(light, world); }
+// Hair and head toward the light of slot s (the hair's Kajiya-Kay visibility).
+vec3 slotVisibility(int s, vec3 world) { return exp(-uShadowColor.rgb * slotCrossings(s, world)) * headVisibility(s, world); }

@@ -300,5 +300,58 @@ TEST(PreviewShadows, SharedTessellationFillsEveryLightsGrid) {
     EXPECT_EQ(shared[0].summed, own[0].summed);
 }
 
+// The hair programs are compiled for the lights, flags and hair model they
+// shade (render/preview/preview_uniforms.cpp hairShadingDefines). They give
+// the bytes of the one program that reads all of these from uniforms
+// (PreviewSettings::specializeShading false), for views that differ in each;
+// and one renderer drawing these views one after the other gives each view
+// the bytes a renderer made for that view alone gives it (a program kept
+// from the view before would shade with its lights).
+TEST(PreviewShadows, EachViewIsShadedWithItsOwnLights) {
+    HP_REQUIRE_GL();
+    test::HairOnHead h = test::hairOnHead(96, 72);
+    h.view.head.ambient = 0.f;
+    std::vector<View> views(4, h.view);  // 0: the one light, shadowed, Kajiya-Kay
+    views[1].lights = threePointRig();   // 1: three lights, the rim unshadowed
+    views[1].lights[2].castsShadows = false;
+    views[2] = views[1];                 // 2: the same, fitted hair, and a point light
+    fitHairMaterial(HairFiberParams{}, &views[2].hair);
+    Light point;
+    point.type = LightType::Point;
+    point.position = Vec3f(0.4f, 0.3f, 0.6f);
+    point.intensity = 0.2f;
+    point.castsShadows = false;
+    views[2].lights.push_back(point);
+    views[3] = views[2];                 // 3: no light shadowed
+    for (Light& l : views[3].lights) l.castsShadows = false;
+    PreviewSettings s;
+    s.shadow.resolution = 32;
+    s.shadow.otherResolution = 16;
+    PreviewRenderer renderer(s);
+    PreviewFrame frame;
+    frame.strands = &h.strands;
+    frame.head = &h.head;
+    auto differing = [](const Image& a, const Image& b) {
+        size_t n = 0;
+        for (size_t p = 0; p < a.pixels.size() && p < b.pixels.size(); ++p) n += a.pixels[p] != b.pixels[p];
+        return n;
+    };
+    std::vector<Image> alone;
+    for (const View& v : views) alone.push_back(renderOnce(s, v, h.strands, &h.head));
+    for (size_t i = 1; i < views.size(); ++i)
+        ASSERT_GT(differing(alone[i], alone[i - 1]), 100u) << "views " << i - 1 << " and " << i << " look different";
+    PreviewSettings generic = s;
+    generic.specializeShading = false;
+    for (size_t i = 0; i < views.size(); ++i)
+        EXPECT_EQ(differing(renderOnce(generic, views[i], h.strands, &h.head), alone[i]), 0u) << "view " << i;
+    int previous = -1;
+    for (int i : {0, 1, 2, 3, 2, 1, 0, 3, 0}) {  // each change both ways
+        const Image shared = renderer.render(views[size_t(i)], frame);
+        ASSERT_EQ(shared.pixels.size(), alone[size_t(i)].pixels.size());
+        EXPECT_EQ(differing(shared, alone[size_t(i)]), 0u) << "view " << i << " drawn after view " << previous;
+        previous = i;
+    }
+}
+
 }  // namespace
 }  // namespace hp

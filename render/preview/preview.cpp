@@ -85,6 +85,7 @@ struct PreviewRenderer::Impl {
     bool thickStrands = true;  ///< some strand may be wider than the line path's width (the ribbon pass runs)
     bool strandsVisible = false, headVisible = false, furVisible = false;  // what this frame draws
     bool shadedPerFragment = false;
+    std::vector<std::string> hairDefines, compiledHairDefines;  ///< this frame's lights and flags (hairShadingDefines)
     std::vector<ShadowSlot> slots;   ///< this frame's shadowed lights
     int slotResolution[kMaxShadowedLights] = {};
 
@@ -144,13 +145,17 @@ struct PreviewRenderer::Impl {
         if (query) glDeleteQueries(1, &query);
     }
 
-    /// The hair programs are specialised for the strand patch size and the
-    /// shading rate; recompiled when either changes.
+    /// The hair programs are specialised for the strand patch size, the
+    /// shading rate and the frame's lights and flags (hairDefines);
+    /// recompiled when any changes.
     void compileHairPrograms(int patchSize) {
         const bool perFragment = settings.shadePerFragment;
-        if (patchSize == strandPatchSize && perFragment == shadedPerFragment && strand.id()) return;
-        const std::vector<std::string> shading = perFragment ? std::vector<std::string>{"SHADE_PER_FRAGMENT"}
-                                                             : std::vector<std::string>{};
+        if (patchSize == strandPatchSize && perFragment == shadedPerFragment && hairDefines == compiledHairDefines &&
+            strand.id())
+            return;
+        std::vector<std::string> shading = perFragment ? std::vector<std::string>{"SHADE_PER_FRAGMENT"}
+                                                       : std::vector<std::string>{};
+        shading.insert(shading.end(), hairDefines.begin(), hairDefines.end());
         const Files stages = {{ShaderStage::Vertex, "strand.vert"},
                               {ShaderStage::TessControl, "strand.tesc"},
                               {ShaderStage::TessEvaluation, "strand.tese"}};
@@ -177,6 +182,7 @@ struct PreviewRenderer::Impl {
                         shading);
         strandPatchSize = patchSize;
         shadedPerFragment = perFragment;
+        compiledHairDefines = hairDefines;
     }
 
     /// Thin strands are drawn as lines of the minimum width when the
@@ -434,7 +440,6 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
         for (const Vec3f& p : frame.strands->positions) bounds.extend(p);
     }
     strandsVisible = drawStrandsNow;
-    compileHairPrograms(strandPatchSize);  // follows a changed shading rate
     std::vector<uint8_t> types;
     if (headNow) {
         if (settings.generated.enabled) {
@@ -502,6 +507,8 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
     thickStrands = drawStrandsNow && mayHaveThickStrands(*frame.strands, Eigen::Map<const Mat4f>(u.viewProj),
                                                          u.eye[3], lineWidth > 0.f ? u.tess[3] : 0.f);
     glNamedBufferSubData(cameraUbo, 0, sizeof(u), &u);
+    hairDefines = settings.specializeShading ? hairShadingDefines(u) : std::vector<std::string>{};
+    compileHairPrograms(strandPatchSize);  // follows a changed shading rate, lights or hair model
     if (voxelsOn || mapOn) {
         for (size_t k = 0; k < slots.size(); ++k) {
             FrameUniforms l = u;

@@ -131,6 +131,10 @@ struct PreviewSettings {
     /// piece end). Per vertex is several times faster on llvmpipe; per
     /// fragment resolves sharp highlights and shadow edges along a strand.
     bool shadePerFragment = false;
+    /// Compile the hair programs for each frame's lights, flags and hair
+    /// model (llvmpipe pays both sides of a branch on a uniform); false: one
+    /// program that reads them from uniforms (the same pixels; tests).
+    bool specializeShading = true;
     PreviewShadowSettings shadow;
     GeneratedHairSettings generated;
     bool drawHead = true;

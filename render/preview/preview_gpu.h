@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace hp {
@@ -74,6 +75,11 @@ struct UniformInputs {
 /// The camera pass's uniforms: camera, lights (lightRad[i].w = light i's
 /// shadow slot, -1 none), materials, each slot's grid, counts and flags.
 void fillFrameUniforms(FrameUniforms& u, const UniformInputs& in);
+/// The defines that compile the hair programs for the lights and flags of
+/// `u` (shaders/common.glsl HAIR_FLAGS, HAIR_MODEL, shaders/hair_shading.glsl
+/// HAIR_LIGHTS): the same shading, with every per-light branch decided at
+/// compile time.
+std::vector<std::string> hairShadingDefines(const FrameUniforms& u);
 /// Points the pass fields (viewProj, lightView, gridMap, gridDepth,
 /// viewport) at one slot's grid, for its shadow map and voxelization.
 void setPassGrid(FrameUniforms& u, const LightGrid& grid, int resolution);

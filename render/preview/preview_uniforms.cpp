@@ -2,6 +2,8 @@
 // `Frame`): camera, lights, materials and every shadowed light's grid.
 #include "render/preview/preview_gpu.h"
 
+#include "core/errors.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -102,6 +104,17 @@ void fillFrameUniforms(FrameUniforms& u, const UniformInputs& in) {
     u.counts[2] = (in.voxels ? kFlagVoxels : 0) | (in.shadowMap ? kFlagShadowMap : 0) |
                   (in.voxels && sh.filter ? kFlagVoxelFilter : 0) | (unshadowed ? kFlagUnshadowedLights : 0);
     u.counts[3] = fittedHair ? kHairFitted : h.twoLobes ? kHairKajiyaKayTwoLobes : kHairKajiyaKay;
+}
+
+std::vector<std::string> hairShadingDefines(const FrameUniforms& u) {
+    // Mesa's llvmpipe (gallivm) runs both sides of a branch under an
+    // execution mask even when its condition is uniform: every shaded
+    // vertex paid the fitted and the Kajiya-Kay model, and for each light
+    // both the shadowed and the unshadowed path (docs/benchmarks.md).
+    std::string lights = "HAIR_LIGHTS(F)";
+    for (int i = 0; i < std::clamp(u.counts[0], 0, 16); ++i)
+        lights += cat(" F(", i, ", ", int(u.lightRad[i][3]), ", ", u.lightVec[i][3] >= 0.5f ? "true" : "false", ")");
+    return {cat("HAIR_FLAGS ", u.counts[2]), cat("HAIR_MODEL ", u.counts[3]), lights};
 }
 
 }  // namespace hp
