@@ -74,8 +74,8 @@ struct ReferenceSettings {
     float noiseThreshold = 0.f;
     int minSamples = 16;         ///< adaptive: first pass (a power of two)
     int maxSamples = 1024;       ///< adaptive: no pixel goes past this (a power of two)
-    /// Seconds from the start of render() after which no further pass or
-    /// tile starts (0 = none). Pixels keep the samples they have; the image
+    /// Seconds from the start of sampling (after the scene's build) after
+    /// which no further pass or tile starts (0 = none). Pixels keep the samples they have; the image
     /// then depends on the machine's speed.
     double timeLimit = 0.0;
     PixelFilter filter;          ///< Gaussian σ 0.5 px, radius 1.5 px (pbrt-v4's default)
