@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <tuple>
 
@@ -170,6 +171,33 @@ TEST(Reference, SameBitsForOneAndTwoThreads) {
         s.frame = 2;
         const Image other = ReferenceRenderer().render(shot.view, &shot.strands, &shot.head, s);
         EXPECT_NE(0, std::memcmp(one.pixels.data(), other.pixels.data(), one.pixels.size() * sizeof(float)));
+    }
+}
+
+TEST(Reference, OneBuiltSceneRendersBothModesBitForBit) {
+    // The stage builds a frame's scene once for the physical reference and
+    // its Kajiya-Kay companion: each render from the shared scene must be the
+    // image a render that builds its own scene gives, in either order.
+    HairOnHead shot = hairOnHead(48, 36);
+    ReferenceSettings physical;
+    physical.mode = ReferenceMode::Physical;
+    physical.samplesPerPixel = 4;
+    physical.bounces = 2;
+    ReferenceSettings kk = physical;
+    kk.mode = ReferenceMode::KajiyaKay;
+    ReferenceRenderer renderer;
+    const auto geometry = renderer.build(&shot.strands, &shot.head);
+    ReferenceStats shared;
+    const Image p1 = renderer.render(shot.view, *geometry, physical, &shared);
+    const Image k1 = renderer.render(shot.view, *geometry, kk);
+    const Image p2 = renderer.render(shot.view, *geometry, physical);
+    EXPECT_GT(shared.segments, size_t(0));
+    EXPECT_GT(shared.sceneBytes, 0);
+    for (const auto& [image, s] : {std::pair{&p1, physical}, std::pair{&k1, kk}, std::pair{&p2, physical}}) {
+        const Image own = ReferenceRenderer().render(shot.view, &shot.strands, &shot.head, s);
+        ASSERT_EQ(own.pixels.size(), image->pixels.size());
+        EXPECT_EQ(0, std::memcmp(own.pixels.data(), image->pixels.data(), own.pixels.size() * sizeof(float)))
+            << referenceModeName(s.mode);
     }
 }
 

@@ -138,7 +138,10 @@ class ReferenceStage final : public FrameStage {
         view.camera = cameraAt(data.frame, data.strands);
         view.camera.width = std::max(1, int(std::lround(view.camera.width * scale_)));
         view.camera.height = std::max(1, int(std::lround(view.camera.height * scale_)));
-        for (const ReferenceOutput& s : sequences_) render(view, s, data, head);
+        // One Embree scene for the physical reference and its Kajiya-Kay
+        // companion: the BVH of the frame's hair is built once.
+        const auto geometry = renderer_.build(data.strands, head);
+        for (const ReferenceOutput& s : sequences_) render(view, s, data, *geometry);
     }
 
   private:
@@ -147,7 +150,8 @@ class ReferenceStage final : public FrameStage {
         if (!s.png.empty()) out.push_back(shot_.outputDir / expandFrame(s.png, frame));
     }
 
-    void render(const View& view, const ReferenceOutput& sequence, const FrameData& data, const TriangleMesh* head) {
+    void render(const View& view, const ReferenceOutput& sequence, const FrameData& data,
+                const ReferenceGeometry& geometry) {
         ReferenceSettings settings = sequence.settings;
         settings.frame = data.frame;
         int lastDecile = 0;
@@ -164,9 +168,9 @@ class ReferenceStage final : public FrameStage {
                            "% of pixels still sampling");
         };
         ReferenceStats stats;
-        const Image image = renderer_.render(view, data.strands, head, settings, &stats);
+        const Image image = renderer_.render(view, geometry, settings, &stats);
         logVerbose("reference: frame ", data.frame, ": ", stats.strands, " strands, ", referenceModeName(settings.mode),
-                   ", ", samplesText(settings, stats), ", build ", fixed(stats.buildSeconds, 2), " s, render ",
+                   ", ", samplesText(settings, stats), ", build ", fixed(stats.buildSeconds, 2), " s (", fixed(stats.buildCpuSeconds, 1), " CPU-s), render ",
                    fixed(stats.renderSeconds, 2), " s (", fixed(stats.renderCpuSeconds, 1), " CPU-s, ",
                    fixed(double(stats.rays) / std::max(1.0, stats.meanSamples * double(image.width) * image.height), 1),
                    " rays a sample), Embree ", stats.sceneBytes / (1 << 20), " MiB");

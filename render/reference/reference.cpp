@@ -183,22 +183,44 @@ Image resolve(const Film& film, const ReferenceSettings& s) {
 
 }  // namespace
 
-Image ReferenceRenderer::render(const View& shotView, const StrandFrame* strands, const TriangleMesh* head,
+ReferenceGeometry::~ReferenceGeometry() = default;
+
+std::unique_ptr<ReferenceGeometry> ReferenceRenderer::build(const StrandFrame* strands, const TriangleMesh* head) {
+    EmbreeDevice& device = impl_->device;
+    device.resetPeak();  // the renders' peaks then cover this build too
+    const int64_t before = device.bytesInUse();
+    const auto t0 = Clock::now();
+    const std::clock_t c0 = std::clock();
+    std::unique_ptr<ReferenceGeometry> g(new ReferenceGeometry);
+    g->scene_ = std::make_unique<EmbreeScene>(device, strands, head);
+    g->buildSeconds = secondsSince(t0);
+    g->buildCpuSeconds = cpuSecondsSince(c0);
+    g->sceneBytes = device.bytesInUse() - before;
+    return g;
+}
+
+Image ReferenceRenderer::render(const View& view, const StrandFrame* strands, const TriangleMesh* head,
+                                const ReferenceSettings& settings, ReferenceStats* stats) {
+    checkSettings(view, settings);  // before the build: a bad setting costs no BVH
+    return render(view, *build(strands, head), settings, stats);
+}
+
+Image ReferenceRenderer::render(const View& shotView, const ReferenceGeometry& geometry,
                                 const ReferenceSettings& settings, ReferenceStats* stats) {
     View view = shotView;
     view.lights = shotView.worldLights();  // a camera-relative rig follows this frame's camera
     checkSettings(view, settings);
     EmbreeDevice& device = impl_->device;
+    const int64_t idle = device.bytesInUse() - geometry.sceneBytes;
+    const int64_t peakBefore = device.peakBytes();
     device.resetPeak();
-    const int64_t idle = device.bytesInUse();
 
-    const auto t0 = Clock::now();
-    const std::clock_t c0 = std::clock();
-    const EmbreeScene scene(device, strands, head);
+    const auto t0 = Clock::now();  // the time limit counts from here
+    const EmbreeScene& scene = *geometry.scene_;
     ReferenceStats st;
-    st.buildSeconds = secondsSince(t0);
-    st.buildCpuSeconds = cpuSecondsSince(c0);
-    st.sceneBytes = device.bytesInUse() - idle;
+    st.buildSeconds = geometry.buildSeconds;
+    st.buildCpuSeconds = geometry.buildCpuSeconds;
+    st.sceneBytes = geometry.sceneBytes;
     st.strands = scene.strandCount();
     st.segments = scene.segmentCount();
 
@@ -271,7 +293,7 @@ Image ReferenceRenderer::render(const View& shotView, const StrandFrame* strands
     st.renderSeconds = secondsSince(t1);
     st.renderCpuSeconds = cpuSecondsSince(c1);
     st.rays = rays.load();
-    st.peakBytes = device.peakBytes() - idle;
+    st.peakBytes = std::max(peakBefore, device.peakBytes()) - idle;
     if (stats) *stats = st;
     return image;
 }

@@ -74,8 +74,8 @@ struct ReferenceSettings {
     float noiseThreshold = 0.f;
     int minSamples = 16;         ///< adaptive: first pass (a power of two)
     int maxSamples = 1024;       ///< adaptive: no pixel goes past this (a power of two)
-    /// Seconds from the start of render() after which no further pass or
-    /// tile starts (0 = none). Pixels keep the samples they have; the image
+    /// Seconds from the start of sampling (after the scene's build) after
+    /// which no further pass or tile starts (0 = none). Pixels keep the samples they have; the image
     /// then depends on the machine's speed.
     double timeLimit = 0.0;
     PixelFilter filter;          ///< Gaussian σ 0.5 px, radius 1.5 px (pbrt-v4's default)
@@ -139,8 +139,30 @@ struct ReferenceStats {
 /// of the nearest sample, camera.farClip where nothing was hit.
 std::vector<std::string> referenceChannels(const ReferenceSettings& settings);
 
-/// Renders frames; keeps one Embree device alive across them. Each render
-/// builds the frame's scene and releases it before returning.
+class EmbreeScene;
+
+/// One frame's geometry as the renderer traces it (the Embree scene of its
+/// strands and head), built once for several renders of that frame: the
+/// physical reference and its Kajiya-Kay companion trace the same scene.
+/// Made by ReferenceRenderer::build; must not outlive that renderer.
+class ReferenceGeometry {
+  public:
+    ~ReferenceGeometry();
+    ReferenceGeometry(const ReferenceGeometry&) = delete;
+    ReferenceGeometry& operator=(const ReferenceGeometry&) = delete;
+
+    double buildSeconds = 0.0, buildCpuSeconds = 0.0;
+    int64_t sceneBytes = 0;  ///< Embree memory the scene holds
+
+  private:
+    friend class ReferenceRenderer;
+    ReferenceGeometry() = default;
+    std::unique_ptr<EmbreeScene> scene_;
+};
+
+/// Renders frames; keeps one Embree device alive across them. A render
+/// given the strands and head builds the frame's scene and releases it
+/// before returning; build() keeps one for several renders.
 class ReferenceRenderer {
   public:
     ReferenceRenderer();
@@ -153,6 +175,14 @@ class ReferenceRenderer {
     /// (NaN vertices, negative radii) or invalid settings.
     Image render(const View& view, const StrandFrame* strands, const TriangleMesh* head,
                  const ReferenceSettings& settings, ReferenceStats* stats = nullptr);
+
+    /// The frame's geometry, for render(view, geometry, ...); same inputs
+    /// and errors as render(view, strands, head, ...). Rendering from it
+    /// gives the same bits as rendering from the strands and head.
+    std::unique_ptr<ReferenceGeometry> build(const StrandFrame* strands, const TriangleMesh* head);
+    /// Renders a built frame; the stats' build figures are the geometry's.
+    Image render(const View& view, const ReferenceGeometry& geometry, const ReferenceSettings& settings,
+                 ReferenceStats* stats = nullptr);
 
     /// Bytes Embree holds between renders (should return to its idle value).
     int64_t embreeBytesInUse() const;
