@@ -88,6 +88,13 @@ class AnimatedHead final : public HeadMotion {
     /// strand can ignore the parts its root lies inside.
     const MeshPartition& partition() const { return parts_; }
 
+    /// Part k's own rigid motion rest -> `mesh` (a pose of this head): the
+    /// least-squares rigid fit of its fit vertices (those of the fit
+    /// triangles in it, or all of its vertices when fewer than 3 are). The
+    /// `rigid` collider carries each part's rest grid by it, so a neck that
+    /// stays while the head bone tips keeps its grid where it is.
+    Eigen::Isometry3f partTransform(const TriangleMesh& mesh, size_t k) const;
+
   private:
     TriangleMesh posed(double time) const;
 
@@ -96,6 +103,8 @@ class AnimatedHead final : public HeadMotion {
     TriangleMesh rest_;
     std::vector<uint32_t> weld_;       ///< rest-pose vertex weld, shared by per-frame colliders
     std::vector<uint32_t> fitVertices_;
+    std::vector<std::vector<uint32_t>> partFit_;  ///< per part (parts_.count() > 1): the vertices its rigid fit uses
+    void setPartFit(const std::vector<uint8_t>& fitVertex);
     mutable std::once_flag gridOnce_;
     mutable std::shared_ptr<const LevelSet> grid_;
     mutable std::shared_ptr<const MeshCollider> restExact_;
