@@ -176,9 +176,18 @@ std::shared_ptr<const Collider> AnimatedHead::headCollider(const HeadPose& pose)
             if (settings_.collider == ColliderMethod::Rigid) {
                 // Each part's grid rides its own rigid motion, not the
                 // head's: the skinned neck stays while the head bone tips.
-                parts.push_back(
-                    std::make_shared<LevelSetCollider>(partGrids_[k], partTransform(pose.mesh, k), partExact_[k]));
-                continue;
+                // A part its rigid fit misses by more than half a voxel (a
+                // neck bent over its blend) gets a grid of its posed mesh:
+                // below that the carried grid errs no more than its own
+                // trilinear interpolation does (≲ voxel/2 at sharp features).
+                const Eigen::Isometry3f t = partTransform(pose.mesh, k);
+                float miss = 0.f;
+                for (uint32_t v : parts_.vertices[k])
+                    miss = std::max(miss, (t * rest_.positions[v] - pose.mesh.positions[v]).norm());
+                if (miss <= 0.5f * settings_.levelSet.voxelSize) {
+                    parts.push_back(std::make_shared<LevelSetCollider>(partGrids_[k], t, partExact_[k]));
+                    continue;
+                }
             }
             const TriangleMesh part = parts_.part(pose.mesh, k);
             auto exact = std::make_shared<const MeshCollider>(part, parts_.welds[k]);
