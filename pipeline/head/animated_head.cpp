@@ -83,6 +83,7 @@ AnimatedHead::AnimatedHead(std::shared_ptr<const HeadRig> rig, HeadAnimationSett
     std::vector<uint32_t> all(rest_.positions.size());
     for (uint32_t i = 0; i < all.size(); ++i) all[i] = i;
     fitVertices_ = thinned(std::move(all));
+    setPartFit(std::vector<uint8_t>(rest_.positions.size(), 1));
     if (!settings_.colliders.empty()) {
         std::vector<ColliderShape> shapes;
         for (const ExtraCollider& c : settings_.colliders) shapes.push_back(c.shape);
@@ -111,6 +112,26 @@ void AnimatedHead::setFitTriangles(const std::vector<uint8_t>& mask) {
     for (uint32_t v = 0; v < used.size(); ++v)
         if (used[v]) vertices.push_back(v);
     if (vertices.size() >= 3) fitVertices_ = thinned(std::move(vertices));
+    setPartFit(used);
+}
+
+void AnimatedHead::setPartFit(const std::vector<uint8_t>& fitVertex) {
+    partFit_.clear();
+    if (parts_.count() < 2) return;
+    for (size_t k = 0; k < parts_.count(); ++k) {
+        std::vector<uint32_t> fit;
+        for (uint32_t v : parts_.vertices[k])
+            if (fitVertex[v]) fit.push_back(v);
+        // A part with no fit triangles (a neck under a scalp-only fit) is
+        // fitted on all of its vertices.
+        partFit_.push_back(thinned(fit.size() >= 3 ? std::move(fit) : parts_.vertices[k]));
+    }
+}
+
+Eigen::Isometry3f AnimatedHead::partTransform(const TriangleMesh& mesh, size_t k) const {
+    if (parts_.count() < 2) return fitRigidTransform(rest_.positions, mesh.positions, fitVertices_);
+    if (k >= partFit_.size()) throw Error(cat("AnimatedHead: no part ", k, " (", partFit_.size(), " parts)"));
+    return fitRigidTransform(rest_.positions, mesh.positions, partFit_[k]);
 }
 
 TriangleMesh AnimatedHead::posed(double time) const {
@@ -153,8 +174,20 @@ std::shared_ptr<const Collider> AnimatedHead::headCollider(const HeadPose& pose)
         std::vector<std::shared_ptr<const Collider>> parts;
         for (size_t k = 0; k < parts_.count(); ++k) {
             if (settings_.collider == ColliderMethod::Rigid) {
-                parts.push_back(std::make_shared<LevelSetCollider>(partGrids_[k], pose.transform, partExact_[k]));
-                continue;
+                // Each part's grid rides its own rigid motion, not the
+                // head's: the skinned neck stays while the head bone tips.
+                // A part its rigid fit misses by more than half a voxel (a
+                // neck bent over its blend) gets a grid of its posed mesh:
+                // below that the carried grid errs no more than its own
+                // trilinear interpolation does (≲ voxel/2 at sharp features).
+                const Eigen::Isometry3f t = partTransform(pose.mesh, k);
+                float miss = 0.f;
+                for (uint32_t v : parts_.vertices[k])
+                    miss = std::max(miss, (t * rest_.positions[v] - pose.mesh.positions[v]).norm());
+                if (miss <= 0.5f * settings_.levelSet.voxelSize) {
+                    parts.push_back(std::make_shared<LevelSetCollider>(partGrids_[k], t, partExact_[k]));
+                    continue;
+                }
             }
             const TriangleMesh part = parts_.part(pose.mesh, k);
             auto exact = std::make_shared<const MeshCollider>(part, parts_.welds[k]);

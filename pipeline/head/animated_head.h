@@ -17,7 +17,8 @@ namespace hp {
 
 /// How HeadPose::collider is made per frame.
 enum class ColliderMethod {
-    Rigid,     ///< the rest pose's distance grid moved by the rigid transform (built once, ~100 ns a query)
+    Rigid,     ///< the rest pose's distance grid moved by the rigid transform (built once, ~100 ns a query); with
+               ///< several parts, each part's by its own fit, rebuilt per pose where that fit misses by > voxel/2
     PerFrame,  ///< a distance grid of each frame's deformed mesh (exact for skinned necks, costs a build per frame)
     Exact,     ///< closest-triangle queries on the deformed mesh (~1 µs a query, a BVH built per frame)
     None,      ///< no collider
@@ -88,6 +89,15 @@ class AnimatedHead final : public HeadMotion {
     /// strand can ignore the parts its root lies inside.
     const MeshPartition& partition() const { return parts_; }
 
+    /// Part k's own rigid motion rest -> `mesh` (a pose of this head): the
+    /// least-squares rigid fit of its fit vertices (those of the fit
+    /// triangles in it, or all of its vertices when fewer than 3 are). The
+    /// `rigid` collider carries each part's rest grid by it, so a neck that
+    /// stays while the head bone tips keeps its grid where it is; a part
+    /// this fit misses by more than half a voxel at some vertex (a neck
+    /// bent over its blend) gets a grid of its posed mesh instead.
+    Eigen::Isometry3f partTransform(const TriangleMesh& mesh, size_t k) const;
+
   private:
     TriangleMesh posed(double time) const;
 
@@ -96,6 +106,8 @@ class AnimatedHead final : public HeadMotion {
     TriangleMesh rest_;
     std::vector<uint32_t> weld_;       ///< rest-pose vertex weld, shared by per-frame colliders
     std::vector<uint32_t> fitVertices_;
+    std::vector<std::vector<uint32_t>> partFit_;  ///< per part (parts_.count() > 1): the vertices its rigid fit uses
+    void setPartFit(const std::vector<uint8_t>& fitVertex);
     mutable std::once_flag gridOnce_;
     mutable std::shared_ptr<const LevelSet> grid_;
     mutable std::shared_ptr<const MeshCollider> restExact_;
