@@ -253,10 +253,12 @@ void ShotSimulation::updateIgnoredParts(const TriangleMesh& mesh) {
         ignoredParts_.assign(roots_.guides.size() + roots_.followers.size(), 0u);
         return;
     }
-    ignoredParts_ = partsAroundRoots(parts, mesh, roots_.guides);
-    model_->setIgnoredParts(ignoredParts_);
-    const std::vector<uint32_t> followers = partsAroundRoots(parts, mesh, roots_.followers);
-    ignoredParts_.insert(ignoredParts_.end(), followers.begin(), followers.end());
+    // One call for guides and followers: partsAroundRoots builds an exact
+    // collider of every part of this pose, once.
+    std::vector<SurfacePoint> roots = roots_.guides;
+    roots.insert(roots.end(), roots_.followers.begin(), roots_.followers.end());
+    ignoredParts_ = partsAroundRoots(parts, mesh, roots);
+    model_->setIgnoredParts({ignoredParts_.begin(), ignoredParts_.begin() + std::ptrdiff_t(roots_.guides.size())});
 }
 
 const uint32_t* ShotSimulation::followerIgnoredParts() const {
