@@ -10,10 +10,10 @@
 //   lies inside ignored);
 // - the strands are the same on both thread counts.
 // Not yet met: on the tip clip, where the sphere folds down onto the neck,
-// guide vertices end up to 13 mm and pinned follower vertices up to 56 mm
-// inside (200 guides, 5 000 followers; docs/benchmarks.md, B-sim-fold): the
-// neck's distance grid tips with the head while the skinned neck stays, and
-// the skinned neck folds through itself (docs/colliders.md, "What the tip
+// vertices still end up to 14.5 mm inside at 200 guides and 5 000 followers
+// (docs/benchmarks.md, B-sim-fold): strands pinched between the sphere and
+// the neck, and follower roots at the crease of the neck's fold, where its
+// posed grid is off by more than a voxel (docs/colliders.md, "What the tip
 // clip still leaves inside"). There the depth is recorded
 // (worst_*_depth_um) but not bounded. Followers ignore the parts their
 // roots lie inside as guides do (tests/test_mesh_parts.cpp checks it).

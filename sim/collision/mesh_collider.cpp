@@ -149,11 +149,18 @@ float LevelSetCollider::signedDistance(const Vec3f& p, Vec3f* normal) const {
     }
     if (d < 0.f && exact_) {
         // Deeper inside than the interior band: rare (a strand vertex far
-        // inside the head), so the exact query's cost does not matter.
+        // inside the head), so the exact query's cost does not matter. The
+        // depth is the closest triangle's distance; the side is the grid's.
+        // OpenVDB's flood fill from outside marks a pocket the surface
+        // encloses as inside, while the closest triangle's pseudonormal
+        // sign is exact only for a surface that does not cross itself: in a
+        // skinned neck folded through itself the closest triangle may be a
+        // buried sheet seen from its outside (docs/colliders.md). There the
+        // normal is turned to point away from that sheet, out of the inside.
         Vec3f n;
         const float e = exact_->signedDistance(r, normal ? &n : nullptr);
-        if (normal) *normal = rotation_ * n;
-        return e;
+        if (normal) *normal = rotation_ * (e < 0.f ? n : Vec3f(-n));
+        return -std::abs(e);
     }
     if (normal) {
         const Vec3f away = r - box.center();

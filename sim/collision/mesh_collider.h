@@ -54,8 +54,10 @@ class MeshCollider final : public Collider {
 /// distance (the band's values, or outside the band's box the distance to
 /// the box plus band - voxel), with the normal pointing away from the box
 /// centre, so far-away strand vertices cost no more than near ones. Deeper
-/// inside than the interior band it asks `exact` (the rest mesh's
-/// MeshCollider) when given.
+/// inside than the interior band it asks `exact` (the MeshCollider of the
+/// mesh the grid was built from) for the distance, when given, and keeps
+/// the grid's side: inside (a fold's pocket, whose closest triangle may
+/// face away from it).
 class LevelSetCollider final : public Collider {
   public:
     LevelSetCollider(std::shared_ptr<const LevelSet> grid, const Eigen::Isometry3f& restToWorld,

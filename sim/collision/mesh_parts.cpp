@@ -3,6 +3,7 @@
 #include "core/errors.h"
 #include "core/union_find.h"
 #include "sim/collision/mesh_collider.h"
+#include "sim/collision/winding_number.h"
 
 #include <limits>
 #include <numeric>
@@ -83,6 +84,17 @@ float PartsCollider::signedDistanceIgnoring(const Vec3f& p, Vec3f* normal, uint3
     return best;
 }
 
+bool buriedByOwnPart(const TriangleMesh& part, const MeshQuery& query, const TriangleMesh& mesh,
+                     const SurfacePoint& root) {
+    const Tri& t = mesh.triangles[root.triangle];
+    const Vec3f a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
+    const Vec3f n = (b - a).cross(c - a);
+    if (!(n.norm() > 0.f)) return false;  // a degenerate triangle has no outside to test
+    const Vec3f up = n.normalized();
+    const Vec3f q = evaluate(mesh, root).position + kBuriedRootOffset * up;
+    return windingNumber(part, query, q, up) > 0.5;
+}
+
 std::vector<uint32_t> partsAroundRoots(const MeshPartition& partition, const TriangleMesh& mesh,
                                        const std::vector<SurfacePoint>& roots, float tolerance) {
     std::vector<uint32_t> masks(roots.size(), 0u);
@@ -90,11 +102,15 @@ std::vector<uint32_t> partsAroundRoots(const MeshPartition& partition, const Tri
     std::vector<std::unique_ptr<MeshCollider>> parts;
     for (size_t k = 0; k < std::min<size_t>(partition.count(), kMaxIgnoredParts); ++k)
         parts.push_back(std::make_unique<MeshCollider>(partition.part(mesh, k), partition.welds[k]));
+    std::vector<TriangleMesh> posed;  // for the winding numbers of the roots' own parts
+    for (size_t k = 0; k < parts.size(); ++k) posed.push_back(partition.part(mesh, k));
     for (size_t r = 0; r < roots.size(); ++r) {
         const uint32_t own = partition.triangleParts[roots[r].triangle];
         const Vec3f p = evaluate(mesh, roots[r]).position;
         for (size_t k = 0; k < parts.size(); ++k)
             if (k != own && parts[k]->signedDistance(p) < -tolerance) masks[r] |= 1u << k;
+        if (own < parts.size() && buriedByOwnPart(posed[own], parts[own]->query(), mesh, roots[r]))
+            masks[r] |= 1u << own;
     }
     return masks;
 }

@@ -24,6 +24,8 @@
 
 namespace hp {
 
+class MeshQuery;
+
 /// Up to this many parts can be ignored by a strand (bit k of a mask: part
 /// k); parts beyond are never ignored.
 constexpr uint32_t kMaxIgnoredParts = 32;
@@ -82,10 +84,25 @@ class IgnoringParts final : public Collider {
     uint32_t ignore_;
 };
 
+/// How far outside its own triangle (along the posed face normal) a root's
+/// own part is asked whether it wraps the root, m: above rounding, far
+/// below a segment.
+constexpr float kBuriedRootOffset = 1e-4f;
+
+/// @brief Whether a root lies under its own part's fold: the generalized
+/// winding number of its own part (`part`, posed; `query` a BVH of it) at
+/// the point kBuriedRootOffset outside its triangle of `mesh` (the posed
+/// whole mesh) is above ½. On a surface that does not cross itself that
+/// point is outside (w = 0); where the part folds through itself and laps
+/// over the root, another layer wraps it (w = 1 or more).
+bool buriedByOwnPart(const TriangleMesh& part, const MeshQuery& query, const TriangleMesh& mesh,
+                     const SurfacePoint& root);
+
 /// @brief Per root, the parts it lies inside: bit k set when φ_k(root) <
 /// -tolerance for a part k other than the part of the root's triangle,
 /// measured exactly (MeshCollider of each part) on `mesh`, the pose it is
-/// asked for. All zero for a mesh of one part.
+/// asked for; and the bit of its own part when its own part's fold buries
+/// it (buriedByOwnPart). All zero for a mesh of one part.
 std::vector<uint32_t> partsAroundRoots(const MeshPartition& partition, const TriangleMesh& mesh,
                                        const std::vector<SurfacePoint>& roots, float tolerance = 1e-5f);
 

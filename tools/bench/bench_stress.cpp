@@ -41,6 +41,7 @@
 #include "sim/guides/guides.h"
 #include "sim/collision/mesh_collider.h"
 #include "sim/collision/mesh_parts.h"
+#include "sim/collision/winding_number.h"
 
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -79,26 +80,6 @@ std::vector<float> segmentLengths(const StrandFrame& f) {
     return out;
 }
 
-/// The generalized winding number of the closed surface `mesh` at q
-/// (Jacobson et al. 2013, "Robust inside-outside segmentation using
-/// generalized winding numbers"): w(q) = Σ_t Ω_t(q) / 4π, with the solid
-/// angle of triangle (a, b, c) seen from q (Van Oosterom & Strackee 1983,
-/// "The solid angle of a plane triangle"), for a = a - q etc.:
-///   tan(Ω/2) = a·(b × c) / (|a||b||c| + (a·b)|c| + (b·c)|a| + (c·a)|b|).
-/// 1 inside, 0 outside a surface that does not cross itself; where it
-/// folds through itself, the number of layers around q. Exact and O(T):
-/// a diagnostic, not a collider.
-double windingNumber(const TriangleMesh& mesh, const Vec3f& q) {
-    double w = 0;
-    for (const Tri& t : mesh.triangles) {
-        const Eigen::Vector3d a = (mesh.positions[t[0]] - q).cast<double>(), b = (mesh.positions[t[1]] - q).cast<double>(),
-                              c = (mesh.positions[t[2]] - q).cast<double>();
-        const double la = a.norm(), lb = b.norm(), lc = c.norm();
-        w += 2 * std::atan2(a.dot(b.cross(c)), la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
-    }
-    return w / (4 * M_PI);
-}
-
 /// --worst: the deepest free vertex of strands [begin, end) of `f` by the
 /// documented definition, and what holds it there: each part's signed
 /// distance at the vertex, its parent and the strand's root, the parts the
@@ -108,7 +89,7 @@ double windingNumber(const TriangleMesh& mesh, const Vec3f& q) {
 /// with (a collider that is not where the posed mesh is).
 void explainWorst(const char* what, const StrandFrame& f, size_t begin, size_t end, const PartsCollider& parts,
                   const std::vector<TriangleMesh>& posedParts, const std::vector<uint32_t>& ignore,
-                  const std::vector<FollowerPin>& pins) {
+                  const std::vector<FollowerPin>& pins, const MeshPartition& partition, const MeshCollider& posedMesh) {
     float worst = 0.f;
     size_t strand = 0, deep = 0, rootInside = 0;
     uint32_t vertex = 0;
@@ -149,6 +130,15 @@ void explainWorst(const char* what, const StrandFrame& f, size_t begin, size_t e
     std::printf("    posed parts' winding numbers at it [%s], parent [%s], 0.1 mm above the root [%s]\n",
                 windings(f.positions[vertex]).c_str(), windings(f.positions[vertex - 1]).c_str(),
                 windings(root + 1e-4f * up.normalized()).c_str());
+    // The root's own part and whether its fold buries the root (mesh_parts.h buriedByOwnPart).
+    const MeshPoint c = posedMesh.closest(root);
+    const Tri& t = posedMesh.query().triangle(c.point.triangle);
+    const Vec3f n = (posedMesh.query().vertex(t[1]) - posedMesh.query().vertex(t[0]))
+                        .cross(posedMesh.query().vertex(t[2]) - posedMesh.query().vertex(t[0]))
+                        .normalized();
+    std::printf("    root on part %u (%.3f mm from it); winding numbers 0.1 mm along its face normal [%s]\n",
+                partition.triangleParts[c.point.triangle], 1e3 * double(c.distance),
+                windings(c.position + kBuriedRootOffset * n).c_str());
 }
 
 int stress(const std::string& path, const std::vector<std::string>& overrides, bool perFrame, bool worstVertex) {
@@ -212,9 +202,10 @@ int stress(const std::string& path, const std::vector<std::string>& overrides, b
             const MeshPartition& partition = sim.head().motion->partition();
             std::vector<TriangleMesh> posed;
             for (size_t k = 0; k < partition.count(); ++k) posed.push_back(partition.part(sim.pose().mesh, k));
-            explainWorst("guide", f, 0, guides, *parts, posed, ignore, none);
+            const MeshCollider posedMesh(sim.pose().mesh);
+            explainWorst("guide", f, 0, guides, *parts, posed, ignore, none, partition, posedMesh);
             explainWorst("follower", f, guides, f.strandCount(), *parts, posed, ignore,
-                         cached ? cached->current.pins : none);
+                         cached ? cached->current.pins : none, partition, posedMesh);
         }
     }
     std::printf("| steps/s | worst stretch guides (frame) | worst stretch followers (frame) | worst depth mm (frame) "
