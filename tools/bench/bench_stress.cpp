@@ -26,8 +26,9 @@
 //
 //   bench_stress --colliders [--guides 94,845] [--threads 2]
 //
-// --worst (a head that folds into itself): per frame, the deepest guide and
-// follower vertex, with each part's signed distance at it, at its parent
+// --worst (a head that folds into itself): per frame, how many free vertices
+// the collider puts outside while a part's winding number puts them inside
+// (the definition's cross-check), the deepest guide and follower vertex, with each part's signed distance at it, at its parent
 // and at its strand's root, the parts the strand ignores, and whether it is
 // pinned (followers), the posed parts' winding numbers there; and how many
 // vertices are more than 1 mm inside, how many of them on strands whose own
@@ -49,6 +50,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <memory>
 #include <optional>
 #include <cmath>
 #include <cstdio>
@@ -87,6 +89,38 @@ std::vector<float> segmentLengths(const StrandFrame& f) {
 /// vertices are more than 1 mm inside, and how many of those belong to
 /// strands whose root is itself more than 1 mm inside a part they collide
 /// with (a collider that is not where the posed mesh is).
+/// --worst's cross-check of the definition: free vertices of strands
+/// [begin, end) that the collider puts outside every part the strand
+/// collides with, while a part's generalized winding number (exact,
+/// winding_number.h) puts them inside it; and the farthest of them from
+/// that part's surface. 0 means the collider's side hides no vertex the
+/// winding number counts inside.
+void crossCheck(const char* what, const StrandFrame& f, size_t begin, size_t end, const PartsCollider& parts,
+                const std::vector<TriangleMesh>& posedParts, const std::vector<std::unique_ptr<MeshCollider>>& posedExact,
+                const std::vector<uint32_t>& ignore) {
+    std::vector<size_t> count(end - begin, 0);
+    std::vector<float> far(end - begin, 0.f);
+    tbb::parallel_for(begin, end, [&](size_t s) {
+        for (uint32_t i = f.first(s) + 1; i < f.offsets[s + 1]; ++i) {
+            const Vec3f& p = f.positions[i];
+            if (parts.signedDistanceIgnoring(p, nullptr, ignore[s]) < 0.f) continue;
+            for (size_t k = 0; k < posedParts.size(); ++k) {
+                if ((ignore[s] >> k) & 1u) continue;
+                if (windingNumber(posedParts[k], posedExact[k]->query(), p, Vec3f::UnitY()) <= 0.5) continue;
+                ++count[s - begin];
+                far[s - begin] = std::max(far[s - begin], posedExact[k]->query().closest(p).distance);
+                break;
+            }
+        }
+    });
+    size_t n = 0;
+    float worst = 0.f;
+    for (size_t k = 0; k < count.size(); ++k) n += count[k], worst = std::max(worst, far[k]);
+    std::printf("  %s vertices outside by the collider but inside a part by its winding number: %zu (up to %.3f mm "
+                "from its surface)\n",
+                what, n, 1e3 * double(worst));
+}
+
 void explainWorst(const char* what, const StrandFrame& f, size_t begin, size_t end, const PartsCollider& parts,
                   const std::vector<TriangleMesh>& posedParts, const std::vector<uint32_t>& ignore,
                   const std::vector<FollowerPin>& pins, const MeshPartition& partition, const MeshCollider& posedMesh) {
@@ -203,6 +237,11 @@ int stress(const std::string& path, const std::vector<std::string>& overrides, b
             std::vector<TriangleMesh> posed;
             for (size_t k = 0; k < partition.count(); ++k) posed.push_back(partition.part(sim.pose().mesh, k));
             const MeshCollider posedMesh(sim.pose().mesh);
+            std::vector<std::unique_ptr<MeshCollider>> posedExact;
+            for (size_t k = 0; k < partition.count(); ++k)
+                posedExact.push_back(std::make_unique<MeshCollider>(posed[k], partition.welds[k]));
+            crossCheck("guide", f, 0, guides, *parts, posed, posedExact, ignore);
+            crossCheck("follower", f, guides, f.strandCount(), *parts, posed, posedExact, ignore);
             explainWorst("guide", f, 0, guides, *parts, posed, ignore, none, partition, posedMesh);
             explainWorst("follower", f, guides, f.strandCount(), *parts, posed, ignore,
                          cached ? cached->current.pins : none, partition, posedMesh);
