@@ -6,6 +6,7 @@
 #include "sim/guides/guides.h"
 #include "sim/strands/head.h"
 #include "sim/volume/hair_grid.h"
+#include "sim/volume/wisp_contact.h"
 
 #include <gtest/gtest.h>
 #include <tbb/parallel_for.h>
@@ -208,6 +209,141 @@ TEST(HairGrid, SameBitsOnAnyThreadCountAndChunkOrder) {
     }
 }
 
+// The wisp contact (sim/volume/wisp_contact.h): its kernel.
+namespace {
+
+/// Guides of `per` vertices, vertex 0 of each a root (mass 0), the rest
+/// scattered in a 3 cm box; x0 a slightly shifted copy (the substep's start).
+struct Wisps {
+    std::vector<Vec3f> x, x0;
+    std::vector<float> m;
+    size_t per;
+    Wisps(size_t guides, size_t perGuide, unsigned seed = 7) : per(perGuide) {
+        std::mt19937 rng(seed);
+        std::uniform_real_distribution<float> u(-1.f, 1.f);
+        for (size_t g = 0; g < guides; ++g)
+            for (size_t k = 0; k < per; ++k) {
+                x.push_back(0.015f * Vec3f(u(rng), u(rng), u(rng)));
+                x0.push_back(x.back() + 0.002f * Vec3f(u(rng), u(rng), u(rng)));
+                m.push_back(k == 0 ? 0.f : 1e-6f * (1.25f + 0.75f * u(rng)));
+            }
+    }
+    volume::ContactInput input(float d, float relax) {
+        volume::ContactInput in;
+        in.x = x.data();
+        in.x0 = x0.data();
+        in.mass = m.data();
+        in.count = x.size();
+        in.verticesPerGuide = per;
+        in.distance = d;
+        in.relax = relax;
+        in.iterations = 8;
+        return in;
+    }
+    /// Closest pair of vertices of different guides, one of them free
+    /// (two roots never move).
+    float closest() const {
+        float best = INFINITY;
+        for (size_t i = 0; i < x.size(); ++i)
+            for (size_t j = i + 1; j < x.size(); ++j)
+                if (i / per != j / per && (m[i] > 0.f || m[j] > 0.f)) best = std::min(best, (x[i] - x[j]).norm());
+        return best;
+    }
+};
+
+}  // namespace
+
+TEST(WispContact, WispRadiusPacksTheHairsAtTheTarget) {
+    // N hairs in a disc of radius r cross it at N/(πr²) per unit area.
+    const float r = volume::wispRadius(100.f, 223.f);
+    EXPECT_NEAR(100.0 / (M_PI * double(r) * r) * 1e-4, 223.0, 1e-3);
+}
+
+TEST(WispContact, PairsKeepMomentumAndRootsStay) {
+    Wisps w(60, 6);
+    const std::vector<Vec3f> before = w.x;
+    volume::WispContact contact;
+    const size_t touching = contact.apply(w.input(0.004f, 1.f), reversedFor);
+    EXPECT_GT(touching, 100u);
+    double moved = 0;
+    for (size_t i = 0; i < w.x.size(); ++i) {
+        const Eigen::Vector3d dx = (w.x[i] - before[i]).cast<double>();
+        moved += double(w.m[i]) * dx.norm();
+        if (w.m[i] == 0.f) {
+            EXPECT_EQ(w.x[i], before[i]) << "a root is kinematic";
+        }
+    }
+    // Roots take no share; a pair with a root moves the free vertex alone,
+    // so only free-free pairs are counted: measure them without roots.
+    Wisps free(60, 6);
+    for (float& m : free.m) m = std::max(m, 1e-6f);
+    const std::vector<Vec3f> fb = free.x;
+    volume::WispContact c2;
+    c2.apply(free.input(0.004f, 1.f), reversedFor);
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    double scale = 0;
+    for (size_t i = 0; i < free.x.size(); ++i) {
+        p += double(free.m[i]) * (free.x[i] - fb[i]).cast<double>();
+        scale += double(free.m[i]) * (free.x[i] - fb[i]).cast<double>().norm();
+    }
+    EXPECT_GT(moved, 0.0);
+    EXPECT_LT(p.norm(), 1e-5 * scale) << "Σ m Δx = 0: every pair keeps momentum";
+}
+
+TEST(WispContact, SeparatesToTheDistanceAndOnlyEasesStartOverlaps) {
+    const float d = 0.004f;
+    {
+        Wisps w(40, 5);
+        EXPECT_LT(w.closest(), 0.3f * d);
+        // κ = 1: start overlaps undone at once. Neighbours are found once a
+        // call (a substep), so a tangle this deep takes a few calls.
+        volume::WispContact contact;
+        for (int call = 0; call < 10; ++call) {
+            w.x0 = w.x;
+            contact.apply(w.input(d, 1.f), reversedFor);
+        }
+        EXPECT_GT(w.closest(), 0.9f * d);
+    }
+    {
+        // κ = 0: pairs closer than d at the start keep their start distance.
+        Wisps w(40, 5);
+        w.x0 = w.x;
+        const std::vector<Vec3f> before = w.x;
+        volume::WispContact contact;
+        contact.apply(w.input(d, 0.f), reversedFor);
+        for (size_t i = 0; i < w.x.size(); ++i) EXPECT_EQ(w.x[i], before[i]);
+    }
+}
+
+TEST(WispContact, ACrossedPairGoesBackToItsSide) {
+    // Vertex 1 (guide 0) passed vertex 3 (guide 1) along x within the substep.
+    std::vector<Vec3f> x0 = {{0, 1, 0}, {-0.003f, 0, 0}, {0, 1, 1}, {0, 0, 0}};
+    std::vector<Vec3f> x = {{0, 1, 0}, {0.001f, 0, 0}, {0, 1, 1}, {0, 0, 0}};
+    std::vector<float> m = {0.f, 1e-6f, 0.f, 1e-6f};
+    volume::ContactInput in;
+    in.x = x.data();
+    in.x0 = x0.data();
+    in.mass = m.data();
+    in.count = 4;
+    in.verticesPerGuide = 2;
+    in.distance = 0.004f;
+    in.iterations = 30;
+    volume::WispContact contact;
+    contact.apply(in, reversedFor);
+    EXPECT_LT(x[1].x(), x[3].x() - 0.0029f) << x[1].transpose() << " / " << x[3].transpose();
+}
+
+TEST(WispContact, SameBitsOnAnyThreadCountAndChunkOrder) {
+    std::vector<Wisps> runs(4, Wisps(2000, 6, 9));  // 12,000 vertices: the parallel passes run
+    const volume::ParallelFor fors[4] = {arenaFor(1, 1), arenaFor(2, 1), arenaFor(2, 64), reversedFor};
+    for (int r = 0; r < 4; ++r) {
+        volume::WispContact contact;
+        contact.apply(runs[r].input(0.002f, 0.5f), fors[r]);
+    }
+    for (int r = 1; r < 4; ++r)
+        EXPECT_EQ(0, std::memcmp(runs[r].x.data(), runs[0].x.data(), runs[0].x.size() * sizeof(Vec3f))) << r;
+}
+
 // The guide solver with the grid on.
 namespace {
 
@@ -363,9 +499,11 @@ struct CurtainRun {
 /// through, or it drapes over. A vertex of that part ends on the wrong side
 /// when it is nearer the wisp's root than the curtain strand beside it at
 /// its height (x below the curtain's x there, less 2 mm).
-CurtainRun swingThroughCurtain(bool grid, bool push = true) {
+CurtainRun swingThroughCurtain(bool grid, bool push = true, float contactScale = 0.f, int substeps = 1) {
     GuideSettings s = chainSettings(grid);
     if (!push) s.volume.relaxTime = 0.f;
+    s.volume.contactScale = contactScale;
+    s.substeps = substeps;
     s.segments = 15;
     s.length = kSegment * 15;
     s.hairsPerGuide = 100.f;
@@ -392,13 +530,6 @@ CurtainRun swingThroughCurtain(bool grid, bool push = true) {
     StrandFrame f;
     solver.write(f);
     run.energy0 = mechanicalEnergy(f, s, solver.measure(nullptr).kineticEnergy);
-    for (int k = 1; k <= 216; ++k) {
-        pose.time = solver.nextTime();
-        const StepStats st = solver.step(roots, pose);
-        run.nan += st.nanCount;
-        solver.write(f);
-        run.maxEnergyRise = std::max(run.maxEnergyRise, mechanicalEnergy(f, s, st.kineticEnergy) - run.energy0);
-    }
     // The curtain's x at height y beside z: its strand nearest in z, between
     // the two vertices that bracket y.
     auto curtainX = [&](float y, float z) {
@@ -415,24 +546,48 @@ CurtainRun swingThroughCurtain(bool grid, bool push = true) {
             }
         return p[n - 1].x();
     };
-    size_t wrong = 0, counted = 0;
-    for (size_t w = curtain; w < f.strandCount(); ++w)
-        for (uint32_t i = 6; i < f.vertexCount(w); ++i) {  // the vertices that started beyond x = 5 cm
-            const Vec3f& p = f.positions[f.first(w) + i];
-            ++counted;
-            if (p.x() < curtainX(p.y(), p.z()) - 0.002f) ++wrong;
-        }
-    run.wrongSide = double(wrong) / double(counted);
+    // Each outer vertex's side: behind the curtain (nearer the wisp's root
+    // than the curtain strand beside it at its height, by 2 mm) or not. Going
+    // over the curtain's top is a fair way round (the wisp's root is 3 cm
+    // above it): a vertex's allowed side is the one it had when last above
+    // the top (or within kOver below it). It ends on the wrong side when it
+    // reached its side through the curtain instead.
+    constexpr float kOver = 0.005f;
+    std::vector<char> allowed;
+    auto update = [&](bool final) {
+        size_t wrong = 0, counted = 0, k = 0;
+        allowed.resize(5 * 10, 0);  // all start in front of the curtain
+        for (size_t w = curtain; w < f.strandCount(); ++w)
+            for (uint32_t i = 6; i < f.vertexCount(w); ++i, ++k) {  // the vertices that started beyond x = 5 cm
+                const Vec3f& p = f.positions[f.first(w) + i];
+                const char behind = p.x() < curtainX(p.y(), p.z()) - 0.002f;
+                if (p.y() > f.positions[f.first(0)].y() - kOver && !final) allowed[k] = behind;
+                ++counted;
+                if (behind != allowed[k]) ++wrong;
+            }
+        return double(wrong) / double(counted);
+    };
+    for (int k = 1; k <= 216; ++k) {
+        pose.time = solver.nextTime();
+        const StepStats st = solver.step(roots, pose);
+        run.nan += st.nanCount;
+        solver.write(f);
+        run.maxEnergyRise = std::max(run.maxEnergyRise, mechanicalEnergy(f, s, st.kineticEnergy) - run.energy0);
+        update(false);
+    }
+    run.wrongSide = update(true);
     return run;
 }
 
 }  // namespace
 
-// Not met (issue 30 asks for under 1% with the grid on): the wisp swings
-// through the curtain with the grid on as with it off, 100% of its outer
-// vertices behind it after 3 s. Friction (the PIC blend) damps the relative
-// motion but holds no static load, and one volume push a substep (at most
-// c·Δ, millimetres) cannot stop a wisp moving centimetres a substep.
+// Not met (issue 30 asks for under 1% with the grid on, by default): the
+// grid alone (friction and the density push) lets the wisp through the
+// curtain, 100% of its outer vertices behind it after 3 s, as without it.
+// Friction (the PIC blend) damps the relative motion but holds no static
+// load, and one volume push a substep (at most c·Δ, millimetres) cannot
+// stop a wisp moving centimetres a substep. The wisp contact stops it
+// (Volume.WispContactKeepsCrossingWispsApart) but is off by default.
 // Disabled; run it with
 //   build/tests/test_hair_grid --gtest_also_run_disabled_tests --gtest_filter='*Crossing*'
 TEST(Volume, DISABLED_CrossingWispsDoNotPassThroughEachOther) {
@@ -442,6 +597,27 @@ TEST(Volume, DISABLED_CrossingWispsDoNotPassThroughEachOther) {
     EXPECT_EQ(on.nan, 0u);
     EXPECT_GT(off.wrongSide, 0.5) << "without the grid the wisp swings through";
     EXPECT_LT(on.wrongSide, 0.01);
+}
+
+TEST(Volume, WispContactKeepsCrossingWispsApart) {
+    // The wisp contact (sim/volume/wisp_contact.h) at 1.5 wisp diameters,
+    // the grid's density push and the contact's overlap easing off
+    // (relax_time 0): under 1% of the outer vertices through the curtain at
+    // 1, 2 and 4 substeps (measured 0%); without the grid 100/80/60%.
+    // Energy: not bounded here; the contact adds some (printed, docs/physics.md).
+    for (int sub : {1, 2, 4}) {
+        const CurtainRun off = swingThroughCurtain(false, true, 0.f, sub),
+                         on = swingThroughCurtain(true, false, 1.5f, sub);
+        GuideSettings s = chainSettings(true);
+        s.hairsPerGuide = 100.f;
+        const double released = 5 * 0.15 * s.guideMassPerLength() * 9.81 * 0.075;
+        std::printf("%d substeps: wisp's outer vertices through the curtain after 3 s: grid off %.1f%%, "
+                    "wisp contact %.1f%%; its largest energy rise %.0f%% of the %.3g J released\n",
+                    sub, 100 * off.wrongSide, 100 * on.wrongSide, 100 * on.maxEnergyRise / released, released);
+        EXPECT_EQ(on.nan, 0u);
+        EXPECT_GT(off.wrongSide, 0.5) << sub << " substeps: without the grid the wisp swings through";
+        EXPECT_LT(on.wrongSide, 0.01) << sub << " substeps";
+    }
 }
 
 TEST(Volume, EnergyDoesNotGrowWithTheGridOn) {
