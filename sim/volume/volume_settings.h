@@ -21,7 +21,8 @@ struct VolumeSettings {
     /// Wisps against wisps (sim/volume/wisp_contact.h): vertices of different
     /// guides kept this many wisp diameters apart (a wisp of hairsPerGuide
     /// hairs at targetDensity); 0: off. Off by default and not a scene key
-    /// yet: it stops the crossing wisps but adds energy (docs/physics.md).
+    /// yet: it stops the crossing wisps only with the grid's density push
+    /// off (relaxTime 0; docs/physics.md).
     float contactScale = 0.f;
     int contactIterations = 4;     ///< Jacobi sweeps of the wisp contact a substep
 

@@ -66,7 +66,6 @@ size_t WispContact::apply(const ContactInput& in, const ParallelFor& parallel) {
     for (size_t i = 0; i < n; ++i) order_[fill_[key_[i]]++] = uint32_t(i);
 
     const size_t perGuide = std::max<size_t>(1, in.verticesPerGuide);
-    const float kappa = std::clamp(in.relax, 0.f, 1.f);
     move_.resize(n);
     std::atomic<size_t> touching{0};
     for (int sweep = 0; sweep < std::max(1, in.iterations); ++sweep) {
@@ -103,7 +102,7 @@ size_t WispContact::apply(const ContactInput& in, const ParallelFor& parallel) {
                                     } else {
                                         continue;  // coincident now and at the start: no direction
                                     }
-                                    const float bound = std::min(d, d0 + kappa * (d - d0));
+                                    const float bound = std::min(d, d0);
                                     if (dist >= bound) continue;
                                     const float wj = in.mass[j] > 0.f ? 1.f / in.mass[j] : 0.f;
                                     const float depth = bound - dist;
