@@ -363,9 +363,11 @@ struct CurtainRun {
 /// through, or it drapes over. A vertex of that part ends on the wrong side
 /// when it is nearer the wisp's root than the curtain strand beside it at
 /// its height (x below the curtain's x there, less 2 mm).
-CurtainRun swingThroughCurtain(bool grid, bool push = true) {
+CurtainRun swingThroughCurtain(bool grid, bool push = true, float contactScale = -1.f, int substeps = 1) {
     GuideSettings s = chainSettings(grid);
     if (!push) s.volume.relaxTime = 0.f;
+    if (contactScale >= 0.f) s.volume.contactScale = contactScale;  // < 0: the default
+    s.substeps = substeps;
     s.segments = 15;
     s.length = kSegment * 15;
     s.hairsPerGuide = 100.f;
@@ -392,13 +394,6 @@ CurtainRun swingThroughCurtain(bool grid, bool push = true) {
     StrandFrame f;
     solver.write(f);
     run.energy0 = mechanicalEnergy(f, s, solver.measure(nullptr).kineticEnergy);
-    for (int k = 1; k <= 216; ++k) {
-        pose.time = solver.nextTime();
-        const StepStats st = solver.step(roots, pose);
-        run.nan += st.nanCount;
-        solver.write(f);
-        run.maxEnergyRise = std::max(run.maxEnergyRise, mechanicalEnergy(f, s, st.kineticEnergy) - run.energy0);
-    }
     // The curtain's x at height y beside z: its strand nearest in z, between
     // the two vertices that bracket y.
     auto curtainX = [&](float y, float z) {
@@ -415,24 +410,48 @@ CurtainRun swingThroughCurtain(bool grid, bool push = true) {
             }
         return p[n - 1].x();
     };
-    size_t wrong = 0, counted = 0;
-    for (size_t w = curtain; w < f.strandCount(); ++w)
-        for (uint32_t i = 6; i < f.vertexCount(w); ++i) {  // the vertices that started beyond x = 5 cm
-            const Vec3f& p = f.positions[f.first(w) + i];
-            ++counted;
-            if (p.x() < curtainX(p.y(), p.z()) - 0.002f) ++wrong;
-        }
-    run.wrongSide = double(wrong) / double(counted);
+    // Each outer vertex's side: behind the curtain (nearer the wisp's root
+    // than the curtain strand beside it at its height, by 2 mm) or not. Going
+    // over the curtain's top is a fair way round (the wisp's root is 3 cm
+    // above it): a vertex's allowed side is the one it had when last above
+    // the top (or within kOver below it). It ends on the wrong side when it
+    // reached its side through the curtain instead.
+    constexpr float kOver = 0.005f;
+    std::vector<char> allowed;
+    auto update = [&](bool final) {
+        size_t wrong = 0, counted = 0, k = 0;
+        allowed.resize(5 * 10, 0);  // all start in front of the curtain
+        for (size_t w = curtain; w < f.strandCount(); ++w)
+            for (uint32_t i = 6; i < f.vertexCount(w); ++i, ++k) {  // the vertices that started beyond x = 5 cm
+                const Vec3f& p = f.positions[f.first(w) + i];
+                const char behind = p.x() < curtainX(p.y(), p.z()) - 0.002f;
+                if (p.y() > f.positions[f.first(0)].y() - kOver && !final) allowed[k] = behind;
+                ++counted;
+                if (behind != allowed[k]) ++wrong;
+            }
+        return double(wrong) / double(counted);
+    };
+    for (int k = 1; k <= 216; ++k) {
+        pose.time = solver.nextTime();
+        const StepStats st = solver.step(roots, pose);
+        run.nan += st.nanCount;
+        solver.write(f);
+        run.maxEnergyRise = std::max(run.maxEnergyRise, mechanicalEnergy(f, s, st.kineticEnergy) - run.energy0);
+        update(false);
+    }
+    run.wrongSide = update(true);
     return run;
 }
 
 }  // namespace
 
-// Not met (issue 30 asks for under 1% with the grid on): the wisp swings
-// through the curtain with the grid on as with it off, 100% of its outer
-// vertices behind it after 3 s. Friction (the PIC blend) damps the relative
-// motion but holds no static load, and one volume push a substep (at most
-// c·Δ, millimetres) cannot stop a wisp moving centimetres a substep.
+// Not met (issue 30 asks for under 1% with the grid on, by default): the
+// grid alone (friction and the density push) lets the wisp through the
+// curtain, 100% of its outer vertices behind it after 3 s, as without it.
+// Friction (the PIC blend) damps the relative motion but holds no static
+// load, and one volume push a substep (at most c·Δ, millimetres) cannot
+// stop a wisp moving centimetres a substep. The wisp contact stops it
+// (Volume.WispContactKeepsCrossingWispsApart) but is off by default.
 // Disabled; run it with
 //   build/tests/test_hair_grid --gtest_also_run_disabled_tests --gtest_filter='*Crossing*'
 TEST(Volume, DISABLED_CrossingWispsDoNotPassThroughEachOther) {
@@ -442,6 +461,28 @@ TEST(Volume, DISABLED_CrossingWispsDoNotPassThroughEachOther) {
     EXPECT_EQ(on.nan, 0u);
     EXPECT_GT(off.wrongSide, 0.5) << "without the grid the wisp swings through";
     EXPECT_LT(on.wrongSide, 0.01);
+}
+
+TEST(Volume, WispContactKeepsCrossingWispsApart) {
+    // The wisp contact (sim/volume/wisp_contact.h) at 1.5 wisp diameters,
+    // the grid's density push off (relax_time 0): under 1% of the outer
+    // vertices through the curtain at 1, 2 and 4 substeps (measured 0%;
+    // without the grid 100/80/60%), and the energy rises no more than the
+    // volume step is allowed (5% of the energy released; measured 0%).
+    for (int sub : {1, 2, 4}) {
+        const CurtainRun off = swingThroughCurtain(false, true, -1.f, sub),
+                         on = swingThroughCurtain(true, false, 1.5f, sub);
+        GuideSettings s = chainSettings(true);
+        s.hairsPerGuide = 100.f;
+        const double released = 5 * 0.15 * s.guideMassPerLength() * 9.81 * 0.075;
+        std::printf("%d substeps: wisp's outer vertices through the curtain after 3 s: grid off %.1f%%, "
+                    "wisp contact %.1f%%; its largest energy rise %.0f%% of the %.3g J released\n",
+                    sub, 100 * off.wrongSide, 100 * on.wrongSide, 100 * on.maxEnergyRise / released, released);
+        EXPECT_EQ(on.nan, 0u);
+        EXPECT_GT(off.wrongSide, 0.5) << sub << " substeps: without the grid the wisp swings through";
+        EXPECT_LT(on.wrongSide, 0.01) << sub << " substeps";
+        EXPECT_LE(on.maxEnergyRise, off.maxEnergyRise + 0.05 * released) << sub << " substeps";
+    }
 }
 
 TEST(Volume, EnergyDoesNotGrowWithTheGridOn) {

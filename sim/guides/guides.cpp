@@ -10,6 +10,7 @@
 #include "sim/guides/guide_group.h"
 #include "sim/solver/skeleton.h"
 #include "sim/volume/hair_grid.h"
+#include "sim/volume/wisp_contact.h"
 
 #include <algorithm>
 #include <cmath>
@@ -125,6 +126,8 @@ struct GuideSolver::Impl final : solver::StrandModel {
     std::vector<std::unique_ptr<guides::GuideGroup>> groups;
     std::unique_ptr<guides::StrandContacts> contacts;
     std::unique_ptr<volume::HairGrid> grid;  ///< hair against hair (null: off)
+    std::unique_ptr<volume::WispContact> wisps;  ///< wisps against wisps (null: off)
+    std::vector<Vec3f> substepStart, beforeWisps;  ///< the wisp contact's scratch
     solver::Skeleton skeleton;
     size_t strandContacts = 0;  ///< of the current step
     volume::GridStats gridStats;  ///< of the current step: densest node, vertex pushes (summed over substeps)
@@ -172,6 +175,45 @@ struct GuideSolver::Impl final : solver::StrandModel {
         gridStats.maxDensity = std::max(gridStats.maxDensity, st.maxDensity);
         gridStats.pushed += st.pushed;
         ++set.version;  // the rope's Bullet nodes reload x and v
+    }
+
+    /// Wisps against wisps (sim/volume/wisp_contact.h) after the substep:
+    /// vertices of different guides kept a wisp diameter apart, the moves
+    /// turned into velocity (position-based dynamics), then each moved
+    /// guide's lengths and clearance restored.
+    void separateWisps(const guides::SubstepContext& ctx) {
+        const VolumeSettings& vs = set.settings.volume;
+        beforeWisps = set.x;
+        volume::ContactInput in;
+        in.x = set.x.data();
+        in.x0 = substepStart.data();
+        in.mass = set.mass.data();
+        in.count = set.x.size();
+        in.verticesPerGuide = size_t(set.vertices);
+        in.distance = 2.f * vs.contactScale * volume::wispRadius(set.settings.hairsPerGuide, vs.targetDensity);
+        in.iterations = vs.contactIterations;
+        in.friction = set.settings.friction;
+        const auto parallel = [&](size_t count, const std::function<void(size_t, size_t)>& f) {
+            skeleton.parallel(count, std::max<size_t>(1, count / 64), f);
+        };
+        if (wisps->apply(in, parallel) == 0) return;
+        const strand::HeadQuery* hq = ctx.collidingHead();
+        const float invH = 1.f / ctx.h;
+        skeleton.parallel(set.count, 1, [&](size_t b, size_t e) {
+            for (size_t g = b; g < e; ++g) {
+                const size_t first = set.vertex(g, 0), end = first + size_t(set.vertices);
+                bool moved = false;
+                for (size_t k = first; k < end && !moved; ++k) moved = set.x[k] != beforeWisps[k];
+                if (!moved) continue;
+                // The contact's own moves become velocity; restoring lengths
+                // then moves vertices without adding any (turning the
+                // follow-the-leader moves into velocity too added 13% of the
+                // crossing wisps' released energy at the impact).
+                for (size_t k = first + 1; k < end; ++k) set.v[k] += (set.x[k] - beforeWisps[k]) * invH;
+                relax(g, hq);
+            }
+        });
+        ++set.version;
     }
 
     // solver::StrandModel: the guides' own step.
@@ -284,6 +326,9 @@ void GuideSolver::initialize(const std::vector<SurfaceFrame>& roots, const HeadP
     m.grid.reset();
     if (s.volume.enabled && s.formulation != GuideFormulation::Rigid)
         m.grid = std::make_unique<volume::HairGrid>(s.volume);
+    m.wisps.reset();
+    if (s.volume.enabled && s.volume.contactScale > 0.f && s.formulation != GuideFormulation::Rigid)
+        m.wisps = std::make_unique<volume::WispContact>();
 
     ++set.version;
     if (s.preload) {
@@ -323,8 +368,10 @@ void GuideSolver::Impl::substep(const solver::Substep& sub) {
     guides::SubstepContext ctx;
     static_cast<solver::Substep&>(ctx) = sub;
     ctx.headCollision = set.settings.headCollision;
+    if (wisps) substepStart = set.x;  // before the grid's push: a push through another wisp is a crossing too
     if (grid) couple(sub);
     forGroups([&](guides::GuideGroup& grp) { grp.substep(ctx); });
+    if (wisps) separateWisps(ctx);
     if (contacts) {
         const strand::HeadQuery* hq = ctx.collidingHead();
         strandContacts += contacts->solve(set, ctx.h, [&](size_t g) { relax(g, hq); });

@@ -17,6 +17,8 @@ void VolumeSettings::validate() const {
     check(targetDensity > 0.f, "target density must be positive");
     check(friction >= 0.f, "friction must be ≥ 0");
     check(relaxTime >= 0.f, "relax time must be ≥ 0");
+    check(contactScale >= 0.f, "contact scale must be ≥ 0");
+    check(contactIterations >= 1, "contact iterations must be ≥ 1");
 }
 
 }  // namespace hp

@@ -1,0 +1,135 @@
+// Wisps against wisps (equations and determinism: sim/volume/wisp_contact.h).
+#include "sim/volume/wisp_contact.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+namespace hp::volume {
+namespace {
+
+/// Jacobi relaxation ω: a vertex between two neighbours gets both pairs'
+/// full moves in one sweep, so a sweep takes half of each (ω = 1
+/// overshoots a vertex squeezed from two sides, ω = 1/2 cannot).
+constexpr float kOmega = 0.5f;
+
+/// Vertices below which the sweeps run on the calling thread.
+constexpr size_t kParallelVertices = 8192;
+
+/// Hash of a cell (Teschner, Heidelberger, Müller, Pomeranets and Gross,
+/// "Optimized Spatial Hashing for Collision Detection of Deformable
+/// Objects", 2003): three large primes, xor, masked to the table size.
+inline uint32_t cellKey(const Eigen::Vector3i& c, uint32_t mask) {
+    return (uint32_t(c.x()) * 73856093u ^ uint32_t(c.y()) * 19349663u ^ uint32_t(c.z()) * 83492791u) & mask;
+}
+
+}  // namespace
+
+float wispRadius(float hairsPerGuide, float targetDensityPerCm2) {
+    return std::sqrt(hairsPerGuide / (float(M_PI) * targetDensityPerCm2 * 1e4f));
+}
+
+size_t WispContact::apply(const ContactInput& in, const ParallelFor& parallel) {
+    const size_t n = in.count;
+    const float d = in.distance;
+    if (n == 0 || !(d > 0.f)) return 0;
+    const bool serial = n < kParallelVertices;
+    auto run = [&](size_t count, const std::function<void(size_t, size_t)>& f) {
+        if (serial) f(0, count);
+        else parallel(count, f);
+    };
+
+    // Cells of side d on the positions after the substep: every pair closer
+    // than d lies in neighbouring cells. Found once a substep (the sweeps
+    // move vertices by less than d).
+    uint32_t table = 1;
+    while (table < 2 * n) table <<= 1;
+    const uint32_t mask = table - 1;
+    cell_.resize(n);
+    key_.resize(n);
+    const float invD = 1.f / d;
+    run(n, [&](size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i) {
+            const Eigen::Vector3f f = (in.x[i] * invD).array().floor();
+            // Non-finite or absurdly far vertices get no neighbours (key past the table).
+            const bool ok = f.allFinite() && f.cwiseAbs().maxCoeff() < 1e8f;
+            cell_[i] = ok ? Eigen::Vector3i(f.cast<int>()) : Eigen::Vector3i::Zero();
+            key_[i] = ok ? cellKey(cell_[i], mask) : table;
+        }
+    });
+    // Stable counting sort of the vertices by key (vertex order within a bucket).
+    bucketStart_.assign(size_t(table) + 2, 0u);
+    for (size_t i = 0; i < n; ++i) ++bucketStart_[size_t(key_[i]) + 1];
+    for (size_t k = 0; k <= table; ++k) bucketStart_[k + 1] += bucketStart_[k];
+    order_.resize(n);
+    fill_.assign(bucketStart_.begin(), bucketStart_.end() - 1);
+    for (size_t i = 0; i < n; ++i) order_[fill_[key_[i]]++] = uint32_t(i);
+
+    const size_t perGuide = std::max<size_t>(1, in.verticesPerGuide);
+    move_.resize(n);
+    std::atomic<size_t> touching{0};
+    for (int sweep = 0; sweep < std::max(1, in.iterations); ++sweep) {
+        run(n, [&](size_t b, size_t e) {
+            size_t count = 0;
+            for (size_t i = b; i < e; ++i) {
+                Eigen::Vector3f dx = Eigen::Vector3f::Zero();
+                const float mi = in.mass[i];
+                if (mi > 0.f && key_[i] != table) {
+                    const float wi = 1.f / mi;
+                    const size_t gi = i / perGuide;
+                    for (int oz = -1; oz <= 1; ++oz)
+                        for (int oy = -1; oy <= 1; ++oy)
+                            for (int ox = -1; ox <= 1; ++ox) {
+                                const Eigen::Vector3i c = cell_[i] + Eigen::Vector3i(ox, oy, oz);
+                                const uint32_t k = cellKey(c, mask);
+                                for (uint32_t o = bucketStart_[k]; o < bucketStart_[k + 1]; ++o) {
+                                    const size_t j = order_[o];
+                                    if (j / perGuide == gi || cell_[j] != c) continue;  // own guide; hash collision
+                                    const Eigen::Vector3f cur = in.x[i] - in.x[j];
+                                    const float dist2 = cur.squaredNorm();
+                                    if (dist2 >= d * d) continue;
+                                    const Eigen::Vector3f start = in.x0[i] - in.x0[j];
+                                    const float d0 = start.norm();
+                                    // Crossed since the start: back to the side it came from.
+                                    Eigen::Vector3f nrm;
+                                    float dist;
+                                    if (cur.dot(start) < 0.f && d0 > 0.f) {
+                                        nrm = start / d0;
+                                        dist = cur.dot(nrm);
+                                    } else if (dist2 > 0.f) {
+                                        dist = std::sqrt(dist2);
+                                        nrm = cur / dist;
+                                    } else {
+                                        continue;  // coincident now and at the start: no direction
+                                    }
+                                    const float bound = std::min(d, d0);
+                                    if (dist >= bound) continue;
+                                    const float wj = in.mass[j] > 0.f ? 1.f / in.mass[j] : 0.f;
+                                    const float depth = bound - dist;
+                                    // Friction at position level (Macklin, Müller, Chentanez and Kim,
+                                    // "Unified Particle Physics for Real-Time Applications", 2014):
+                                    // the pair's relative slide over the substep, taken back whole
+                                    // below μ·depth (static), by μ·depth above it (kinetic).
+                                    Eigen::Vector3f slide = (in.x[i] - in.x0[i]) - (in.x[j] - in.x0[j]);
+                                    slide -= slide.dot(nrm) * nrm;
+                                    const float slideLen = slide.norm(), grip = in.friction * depth;
+                                    const Eigen::Vector3f back =
+                                        slideLen <= grip ? slide : (slideLen > 0.f ? (grip / slideLen) * slide : slide);
+                                    dx += (kOmega * wi / (wi + wj)) * (depth * nrm - back);
+                                    ++count;
+                                }
+                            }
+                }
+                move_[i] = dx;
+            }
+            if (sweep == 0) touching += count;
+        });
+        if (touching.load() == 0) break;  // nothing closer than its bound
+        run(n, [&](size_t b, size_t e) {
+            for (size_t i = b; i < e; ++i) in.x[i] += move_[i];
+        });
+    }
+    return touching.load();
+}
+
+}  // namespace hp::volume
