@@ -142,6 +142,11 @@ inline Vec3f bdf2Extrapolate(const Vec3f& now, const Vec3f& back) { return (4.f 
 /// v_{n-1} = v; at rest, x_{n-1} = x): then x̄ = x + h·v/3 and v̄ = v, so
 /// x̄ + h'·v̄ = x + h·v, the displacement of the step h, and a start or a
 /// restart (scene cut, reset) needs no separate first-order step.
+/// rodSteps restarts so each vertex that the head placed or pinned: the
+/// contact removed its velocity into the head, v_{n+1} ≈ v_n - (v_n·n)n,
+/// and the history would extrapolate that change, v̄ = v_{n+1} +
+/// (v_{n+1} - v_n)/3, into a velocity away from the surface of a third of
+/// the impact speed: a bounce the contact does not have.
 inline void bdf2Start(const Vec3f* x, const Vec3f* v, int n, float h, Vec3f* xBack, Vec3f* vBack) {
     for (int i = 0; i < n; ++i) {
         xBack[i] = x[i] - h * v[i];

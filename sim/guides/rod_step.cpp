@@ -185,8 +185,9 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
 /// the solves, placed here; t.x[i] still holds the step's start and receives
 /// y. h: the step's length (the head's motion over it); start, hv: where the
 /// integrator's step starts and its length (x[i] and h, or BDF2's x̄ and h').
+/// touched: the head placed the vertex (a contact) or it was pinned.
 bool placeVertex(const RodStepTarget& t, int i, const Vec3f& parent, Vec3f& y, const Vec3f& start, float h, float hv,
-                 float damp, float friction, const strand::HeadQuery* head, float radius) {
+                 float damp, float friction, const strand::HeadQuery* head, float radius, bool& touched) {
     const Vec3f old = t.x[i];
     strand::Contact contact;
     bool pinned = false;
@@ -213,6 +214,7 @@ bool placeVertex(const RodStepTarget& t, int i, const Vec3f& parent, Vec3f& y, c
             pinned = true;
         }
     }
+    touched = pinned || contact.active;
     Vec3f vel = (y - start) / hv;
     if (contact.active) vel = strand::contactFriction(vel, head->surfaceVelocity(y, h), contact, friction, hv);
     vel *= damp;
@@ -303,7 +305,7 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
                 oldX[k] = targets[k].x[i];
                 oldV[k] = targets[k].v[i];
             }
-        bool scalar[kLanes] = {};
+        bool scalar[kLanes] = {}, touched[kLanes] = {};
         if (i > 0) {
             // followTheLeader: parent + e·(l/|e|), or straight up from a collapsed segment.
             const V3& parent = y[i - 1];
@@ -318,7 +320,7 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
                 if (!scalar[k]) continue;
                 Vec3f child = lane(y[i], k);
                 pinned += placeVertex(targets[k], i, lane(parent, k), child, lane(sc.start[size_t(i)], k), h, hv,
-                                      damp, friction, heads[k], radius);
+                                      damp, friction, heads[k], radius, touched[k]);
                 setLane(placed, k, child);
             }
             y[i] = placed;
@@ -326,13 +328,20 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
         V3 vel = (y[i] - sc.start[size_t(i)]) / hv;
         if (i > 0) vel = damp * vel;
         for (int k = 0; k < count; ++k) {
-            if (bdf2) {
-                targets[k].xBack[i] = oldX[k];
-                targets[k].vBack[i] = oldV[k];
-            }
             if (!scalar[k]) {
                 targets[k].x[i] = lane(y[i], k);
                 targets[k].v[i] = lane(vel, k);
+            }
+            if (bdf2 && touched[k]) {
+                // A vertex the head placed or pinned starts its history
+                // afresh (rod_kernels.h bdf2Start): the contact took its
+                // velocity into the head away, and BDF2's extrapolation
+                // would carry that change on, v̄ = v + (v - v_{n-1})/3,
+                // as a bounce off the surface.
+                bdf2Start(&targets[k].x[i], &targets[k].v[i], 1, h, &targets[k].xBack[i], &targets[k].vBack[i]);
+            } else if (bdf2) {
+                targets[k].xBack[i] = oldX[k];
+                targets[k].vBack[i] = oldV[k];
             }
         }
     }

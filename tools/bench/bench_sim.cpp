@@ -159,7 +159,8 @@ RunResult runOnce(const GuideSettings& settings, size_t guides, float rate, int 
 
 int main(int argc, char** argv) {
     std::vector<std::string> guideList{"94", "845"}, formList{"rod", "rope", "rigid"}, collList{"off", "on"},
-        threadList{"1", "2"}, colliderList{"sphere"}, volList{"off"}, integratorList{"euler"};
+        threadList{"1", "2"}, colliderList{"sphere"}, volList{"off"},
+        integratorList{rodIntegratorName(GuideSettings{}.rodIntegrator)};  // the default (bdf2)
     int runs = 3, warmup = 20, steps = 250, substeps = 1, iterations = 20, perWorld = 16, rodSubsteps = 2;
     float rate = 90.f;
     bool preload = true, digest = false;
