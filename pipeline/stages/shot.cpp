@@ -8,6 +8,9 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
 
 namespace fs = std::filesystem;
 
@@ -42,6 +45,26 @@ double peakResidentMb() {
     getrusage(RUSAGE_SELF, &u);
     return double(u.ru_maxrss) / 1024.0;
 }
+
+/// Process CPU time, all threads (llvmpipe's, TBB's): with the wall time it
+/// says how many cores a stage kept busy (-v logs both per stage and frame).
+double processCpuSeconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+/// Wall and CPU seconds of a stretch of work, for -v.
+struct StageClock {
+    std::chrono::steady_clock::time_point wall = std::chrono::steady_clock::now();
+    double cpu = processCpuSeconds();
+    std::string text() const {
+        const double w = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall).count();
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%.2f s (%.2f CPU-s)", w, processCpuSeconds() - cpu);
+        return buf;
+    }
+};
 
 /// A failure is logged when it happens and listed again at the end of the run.
 void recordFailure(RunReport& report, const std::string& what) {
@@ -79,9 +102,11 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
         bool sourceFailed = false;
         if (needsData) {
             try {
+                const StageClock clock;
                 data = source.get(frame);
                 for (const std::string& failure : data.failures) recordFailure(report, cat("frame ", frame, ": ", failure));
-                logVerbose("frame ", frame, " data (simulation or cache): peak RSS ", int(peakResidentMb()), " MB");
+                logVerbose("frame ", frame, " data (simulation or cache): ", clock.text(), ", peak RSS ",
+                           int(peakResidentMb()), " MB");
             } catch (const FrameError& e) {
                 // Without the frame's data no data stage can run; later frames may still work.
                 recordFailure(report, cat("frame ", frame, ": ", e.what()));
@@ -94,8 +119,10 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
         for (FrameStage* stage : todo) {
             if (sourceFailed && stage->needsFrameData()) continue;
             try {
+                const StageClock clock;
                 stage->run(data);
-                logVerbose("frame ", frame, " ", stage->name(), ": peak RSS ", int(peakResidentMb()), " MB");
+                logVerbose("frame ", frame, " ", stage->name(), ": ", clock.text(), ", peak RSS ",
+                           int(peakResidentMb()), " MB");
             } catch (const Error& e) {
                 recordFailure(report, cat("frame ", frame, " ", stage->name(), ": ", e.what()));
             }
