@@ -3,6 +3,7 @@
 #include "core/log.h"
 #include "pipeline/batch/progress.h"
 #include "pipeline/batch/output.h"
+#include "pipeline/stages/overlap_lane.h"
 #include "pipeline/stages/stages.h"
 
 #include <sys/resource.h>
@@ -11,6 +12,9 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <memory>
+#include <mutex>
+#include <optional>
 
 namespace fs = std::filesystem;
 
@@ -24,6 +28,7 @@ ShotSettings resolveShot(const Scene& scene, const RunOptions& options) {
     shot.frames = options.frames ? *options.frames : scene.frames("frames");
     shot.requireCache = options.cacheOnly;
     shot.wholeRunOutputs = !options.noReport;
+    shot.overlap = !options.noOverlap;
     fs::path out = options.outputDir;
     if (out.empty()) {
         const std::string& configured = scene.text("output.directory");
@@ -80,6 +85,26 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
         logWarning("nothing to do: the scene enables no output stage");
         return report;
     }
+    std::mutex reportMutex;  // the overlap lane records its failures too
+    auto fail = [&](const std::string& what) {
+        const std::lock_guard<std::mutex> lock(reportMutex);
+        recordFailure(report, what);
+    };
+    auto runStage = [&](FrameStage& stage, const FrameData& data) {
+        try {
+            const StageClock clock;
+            stage.run(data);
+            logVerbose("frame ", data.frame, " ", stage.name(), ": ", clock.text(), ", peak RSS ",
+                       int(peakResidentMb()), " MB");
+        } catch (const Error& e) {
+            fail(cat("frame ", data.frame, " ", stage.name(), ": ", e.what()));
+        }
+    };
+    const bool overlap = shot.overlap && std::any_of(stages.begin(), stages.end(), [](const StagePtr& s) {
+        return s->overlaps();
+    });
+    std::optional<OverlapLane> lane;  // destroyed (joined) before the locals its jobs use
+    if (overlap) lane.emplace();
     Progress progress("frames", shot.frames.size());
     for (int frame : shot.frames) {
         // Decide first which stages still have work, so a fully written frame
@@ -104,32 +129,41 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
             try {
                 const StageClock clock;
                 data = source.get(frame);
-                for (const std::string& failure : data.failures) recordFailure(report, cat("frame ", frame, ": ", failure));
+                for (const std::string& failure : data.failures) fail(cat("frame ", frame, ": ", failure));
                 logVerbose("frame ", frame, " data (simulation or cache): ", clock.text(), ", peak RSS ",
                            int(peakResidentMb()), " MB");
             } catch (const FrameError& e) {
                 // Without the frame's data no data stage can run; later frames may still work.
-                recordFailure(report, cat("frame ", frame, ": ", e.what()));
+                fail(cat("frame ", frame, ": ", e.what()));
                 sourceFailed = true;
             }
             // Any other error (a scene key, an unreadable head, a scalp that
             // grows no hair) would fail every frame the same way: it ends the
             // run with exit code 1, as a scene error found at load would.
         }
+        // The main lane runs the frame's stages in order; those that overlap
+        // run after them on the lane, beside the next frame's source and preview.
+        std::vector<FrameStage*> later;
         for (FrameStage* stage : todo) {
             if (sourceFailed && stage->needsFrameData()) continue;
-            try {
-                const StageClock clock;
-                stage->run(data);
-                logVerbose("frame ", frame, " ", stage->name(), ": ", clock.text(), ", peak RSS ",
-                           int(peakResidentMb()), " MB");
-            } catch (const Error& e) {
-                recordFailure(report, cat("frame ", frame, " ", stage->name(), ": ", e.what()));
+            if (lane && stage->overlaps()) {
+                later.push_back(stage);
+                continue;
             }
+            if (lane && stage->exclusive()) lane->drain();
+            runStage(*stage, data);
+        }
+        if (!later.empty()) {
+            // A copy: the source reuses its buffers for the next frame.
+            auto copy = std::make_shared<const LaneFrame>(data);
+            lane->post([copy, later, &runStage] {
+                for (FrameStage* stage : later) runStage(*stage, copy->data);
+            });
         }
         ++report.framesDone;
         progress.advance(cat("frame ", frame));
     }
+    if (lane) lane->drain();
     // Whole-run outputs (reports) once every frame is done.
     if (shot.wholeRunOutputs) finishStages(stages, shot, report);
     return report;

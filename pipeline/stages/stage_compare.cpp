@@ -113,6 +113,8 @@ class CompareStage final : public FrameStage {
         return out;
     }
     bool needsFrameData() const override { return false; }
+    /// Reads the frame's preview and reference files, written before it on the main lane.
+    bool overlaps() const override { return true; }
 
     void run(const FrameData& data) override {
         const FrameRecord r = compareFrame(job_, data.frame);

@@ -127,6 +127,8 @@ class ReferenceStage final : public FrameStage {
     }
 
     std::string name() const override { return "reference"; }
+    /// Samples on every core, to a time limit counted in wall time.
+    bool exclusive() const override { return true; }
 
     std::vector<fs::path> outputs(int frame) const override {
         std::vector<fs::path> out;
