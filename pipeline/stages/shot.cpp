@@ -7,6 +7,7 @@
 #include "pipeline/stages/stages.h"
 
 #include <sys/resource.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <chrono>
@@ -100,9 +101,10 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
             fail(cat("frame ", data.frame, " ", stage.name(), ": ", e.what()));
         }
     };
-    const bool overlap = shot.overlap && std::any_of(stages.begin(), stages.end(), [](const StagePtr& s) {
-        return s->overlaps();
-    });
+    // One core (--threads 1, or a --jobs child given one) gets no second lane.
+    const bool overlap = shot.overlap &&
+                         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) > 1 &&
+                         std::any_of(stages.begin(), stages.end(), [](const StagePtr& s) { return s->overlaps(); });
     std::optional<OverlapLane> lane;  // destroyed (joined) before the locals its jobs use
     if (overlap) lane.emplace();
     Progress progress("frames", shot.frames.size());
