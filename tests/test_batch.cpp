@@ -371,6 +371,19 @@ TEST(Batch, JobsOutputsEqualOneProcessAndTheReportCoversEveryFrame) {
     for (int f : {1, 5}) EXPECT_NE(csv.find(frameFile("\n%d,", f)), std::string::npos) << csv;
 }
 
+TEST(Batch, OverlappedStagesWriteWhatTheSerialRunWrites) {
+    // The VDB and compare of frame N run on the overlap lane beside frame
+    // N+1's source and preview (pipeline/stages/overlap_lane.h): scheduling
+    // only, so every file is the one the serial run writes.
+    TempDir dir;
+    const fs::path scene = writeSmallScene(dir.path());
+    ASSERT_TRUE(hairpipeSucceeds("run -q --no-overlap " + q(scene) + " --out " + q(dir / "serial")));
+    const ProcessResult r = runHairpipe("run -v " + q(scene) + " --out " + q(dir / "overlap"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    expectSameOutputs(dir / "serial", dir / "overlap");
+    for (int f = 1; f <= 6; ++f) EXPECT_NE(r.output.find(frameFile("frame %d vdb: ", f)), std::string::npos) << r.output;
+}
+
 TEST(Batch, ChunkWithoutReportLeavesTheReportToTheLastStep) {
     TempDir dir;
     const fs::path scene = writeSmallScene(dir.path(), "1-6");

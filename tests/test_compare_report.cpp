@@ -33,12 +33,12 @@ TEST(CompareFiles, ThresholdsAndTables) {
 }
 
 TEST(CompareReport, SidesAreLabelledFromTheScene) {
-    const Scene scene = Scene::parse("reference: {mode: physical, samples: 8, kajiya_kay: {enabled: true}}\n"
+    const Scene scene = Scene::parse("reference: {mode: physical, samples: 8, kajiya_kay: {enabled: true, samples: 4}}\n"
                                      "compare: {b: reference/kajiya-kay.####.exr, beside: reference/reference.####.exr}\n",
                                      "labels.yaml", ".");
     const CompareJob job = compareJobFromScene(scene, "/tmp/shot");
     EXPECT_EQ(job.aLabel, "preview (OpenGL)");
-    EXPECT_EQ(job.bLabel, "reference (Embree, kajiya-kay, 8 spp)");
+    EXPECT_EQ(job.bLabel, "reference (Embree, kajiya-kay, 4 spp)");  // its own budget
     EXPECT_EQ(job.beside, "/tmp/shot/reference/reference.####.exr");
     EXPECT_EQ(job.besideLabel, "reference (Embree, physical, 8 spp)");
     const std::string html = compareReportHtml(job, {});
@@ -64,7 +64,7 @@ TEST(CompareReport, SidesAreLabelledFromTheScene) {
 // report and metrics.json; the diagnostic writes beside the gate, never
 // over it, and has no thresholds.
 TEST(CompareReport, GateAndDiagnosticPairsAreNamed) {
-    const Scene scene = Scene::parse("reference: {mode: physical, samples: 8, kajiya_kay: {enabled: true}}\n"
+    const Scene scene = Scene::parse("reference: {mode: physical, samples: 8, kajiya_kay: {enabled: true, samples: 4}}\n"
                                      "compare: {diagnostic: reference/kajiya-kay.####.exr, max_flip: 0.5}\n",
                                      "pairs.yaml", ".");
     const CompareJob gate = compareJobFromScene(scene, "/tmp/shot");
@@ -73,7 +73,7 @@ TEST(CompareReport, GateAndDiagnosticPairsAreNamed) {
     const std::optional<CompareJob> diag = diagnosticJobFromScene(scene, "/tmp/shot");
     ASSERT_TRUE(diag);
     EXPECT_EQ(diag->b, "/tmp/shot/reference/kajiya-kay.####.exr");
-    EXPECT_EQ(diag->bLabel, "reference (Embree, kajiya-kay, 8 spp)");
+    EXPECT_EQ(diag->bLabel, "reference (Embree, kajiya-kay, 4 spp)");
     EXPECT_NE(diag->pair.find("same model, other visibility"), std::string::npos) << diag->pair;
     EXPECT_EQ(diag->outputDir, gate.outputDir / "diagnostic");
     EXPECT_NE(diag->report, gate.report);

@@ -417,7 +417,8 @@ TEST(ReferenceStage, KajiyaKayCompanionBesidePhysical) {
     ShotSettings shot;
     shot.outputDir = dir.path();
     const StagePtr stage =
-        makeReferenceStage(referenceScene("  mode: physical\n  png: \"\"\n  kajiya_kay: {enabled: true, png: \"\"}\n"), shot);
+        makeReferenceStage(
+        referenceScene("  mode: physical\n  png: \"\"\n  kajiya_kay: {enabled: true, png: \"\", samples: 2}\n"), shot);
     ASSERT_EQ(stage->outputs(1), (std::vector<std::filesystem::path>{dir.path() / "reference/reference.0001.exr",
                                                                      dir.path() / "reference/kajiya-kay.0001.exr"}));
     const HeadPose pose = sphereHead();
@@ -426,7 +427,7 @@ TEST(ReferenceStage, KajiyaKayCompanionBesidePhysical) {
     const Image physical = readImage(stage->outputs(1)[0].string());
     const Image kk = readImage(stage->outputs(1)[1].string());
     ASSERT_EQ(physical.width, kk.width);
-    // Same camera, samples and seed: the same coverage, pixel for pixel. The
+    // Same camera, samples (2, given to both) and seed: the same coverage, pixel for pixel. The
     // skin is one model with one albedo in both modes (no ambient by
     // default), so the two differ only by what the physical mode adds: the
     // light its bounces bring and its sampling noise (summed |ΔR| measured
@@ -447,4 +448,56 @@ TEST(ReferenceStage, KajiyaKayCompanionBesidePhysical) {
     } catch (const SceneError& e) {
         EXPECT_NE(std::string(e.what()).find("reference.kajiya_kay.enabled"), std::string::npos) << e.what();
     }
+}
+
+TEST(ReferenceStage, KajiyaKayCompanionHasItsOwnBudget) {
+    // reference.kajiya_kay.samples: the companion takes exactly that many
+    // samples in every pixel, while the physical reference beside it keeps
+    // its adaptive settings, bit for bit what it is without the companion.
+    const HeadPose pose = sphereHead();
+    const FrameData data = headOnlyFrame(pose);
+    auto render = [&](const std::string& companion) {
+        TempDir dir;
+        ShotSettings shot;
+        shot.outputDir = dir.path();
+        const StagePtr stage = makeReferenceStage(
+            Scene::parse("frames: 1\nrender:\n  camera: {width: 48, height: 40}\n"
+                         "reference:\n  enabled: true\n  mode: physical\n  png: \"\"\n"
+                         "  noise_threshold: 0.05\n  min_samples: 2\n  max_samples: 32\n" + companion,
+                         "test.yaml", std::filesystem::current_path()),
+            shot);
+        stage->run(data);
+        std::vector<Image> images;
+        for (const std::filesystem::path& p : stage->outputs(1)) images.push_back(readImage(p.string()));
+        return images;
+    };
+    auto samples = [](const Image& image, int x, int y) { return image.at(x, y, image.channelIndex("samples")); };
+
+    const std::vector<Image> alone = render("");
+    const std::vector<Image> budget = render("  kajiya_kay: {enabled: true, png: \"\", samples: 4}\n");
+    const std::vector<Image> same = render("  kajiya_kay: {enabled: true, png: \"\", samples: 0}\n");
+    ASSERT_EQ(alone.size(), 1u);
+    ASSERT_EQ(budget.size(), 2u);
+    ASSERT_EQ(same.size(), 2u);
+    const Image& physical = alone[0];
+    ASSERT_EQ(budget[0].channels, physical.channels);
+    EXPECT_TRUE(budget[0].pixels == physical.pixels) << "the companion's budget changed the physical reference";
+    int adaptive = 0, fixedFour = 0;
+    float fewest = 1e9f, most = 0.f;
+    for (int y = 0; y < physical.height; ++y)
+        for (int x = 0; x < physical.width; ++x) {
+            fixedFour += samples(budget[1], x, y) == 4.f;
+            adaptive += samples(physical, x, y) != 4.f;
+            // samples: 0 samples the companion as the physical reference is
+            // sampled: adaptively, from min_samples up to max_samples.
+            fewest = std::min(fewest, samples(same[1], x, y));
+            most = std::max(most, samples(same[1], x, y));
+        }
+    EXPECT_EQ(fixedFour, physical.width * physical.height);
+    // The physical reference's own counts (2 to 32, adaptive) are not the
+    // companion's, or the test could not tell the budgets apart.
+    EXPECT_GT(adaptive, 0);
+    EXPECT_EQ(fewest, 2.f);
+    EXPECT_GT(most, 4.f);
+    EXPECT_LE(most, 32.f);
 }

@@ -126,6 +126,7 @@ RunReport runShotInJobs(const Scene& scene, const RunOptions& options, const std
                 t.argv.push_back(a);
             if (hair) t.argv.push_back("--cache-only");
             if (shot.force) t.argv.push_back("--force");
+            if (options.noOverlap) t.argv.push_back("--no-overlap");
             t.argv.push_back(logLevel() == LogLevel::Verbose ? "-v" : "-q");
             tasks.push_back(std::move(t));
         }

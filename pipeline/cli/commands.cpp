@@ -53,12 +53,13 @@ std::string sceneArgument(const CommandLine& cl) {
 }
 
 /// --jobs, --chunk (run, render, vdb) and --stages, --cache-only,
-/// --no-report (run); a command that does not list one never sees it.
+/// --no-report, --no-overlap (run); a command that does not list one never sees it.
 void parseBatchOptions(const CommandLine& cl, RunOptions& options) {
     if (cl.has("--jobs")) options.jobs = int(integerOption(cl, "--jobs", 1, 256));
     if (cl.has("--chunk")) options.chunk = int(integerOption(cl, "--chunk", 1, 1000000));
     options.cacheOnly = cl.has("--cache-only");
     options.noReport = cl.has("--no-report");
+    options.noOverlap = cl.has("--no-overlap");
     if (cl.has("--stages")) {
         const std::string list = cl.value("--stages");
         size_t start = 0;
@@ -176,6 +177,8 @@ CommandSpec runCommandSpec() {
         {"--stages", "LIST", "run only these stages, e.g. preview,vdb (sim, preview, reference, vdb, compare)"},
         {"--cache-only", "", "read strands only from the strand cache; a frame without one fails"},
         {"--no-report", "", "skip whole-run outputs (the compare report): for one chunk of a larger run"},
+        {"--no-overlap", "", "run each frame's stages one after another (the VDB and compare of a frame otherwise "
+                             "run beside the next frame's preview); same outputs, stage timings in -v of their own"},
     });
     c.run = runStages([](const CommandContext& ctx, const CommandLine&) { return ctx.options.only; });
     return c;

@@ -23,6 +23,7 @@ struct RunOptions {
     int chunk = 0;               ///< --chunk: frames per child process; 0 = automatic
     bool cacheOnly = false;      ///< --cache-only: ShotSettings::requireCache
     bool noReport = false;       ///< --no-report: not ShotSettings::wholeRunOutputs
+    bool noOverlap = false;      ///< --no-overlap: not ShotSettings::overlap
     /// The command line's scene overrides (--set, --seed as seed=N) and
     /// --threads, so child processes can be given the same scene.
     std::vector<std::string> sets;

@@ -58,6 +58,10 @@ struct ShotSettings {
     /// compare report); false for one chunk of a larger run, whose last step
     /// writes them once over all frames.
     bool wholeRunOutputs = true;
+    /// Run the stages that allow it (FrameStage::overlaps) on a second lane,
+    /// beside the next frame's work (pipeline/stages/overlap_lane.h); false
+    /// runs every stage in turn (`run --no-overlap`). The outputs are the same.
+    bool overlap = true;
 };
 
 class FrameSource {
@@ -77,6 +81,15 @@ class FrameStage {
     /// Whether the stage reads FrameData (false for stages that only read
     /// other stages' files, such as compare), so the source can be skipped.
     virtual bool needsFrameData() const { return true; }
+    /// Whether the stage may run on the overlap lane after its frame's other
+    /// stages, beside the next frame's: it reads of FrameData only the strands
+    /// and head (LaneFrame), holds no thread-bound state (a GL context), and
+    /// no later stage of its frame reads its files.
+    virtual bool overlaps() const { return false; }
+    /// Whether the stage needs the machine to itself: the lane is drained
+    /// before it starts (a reference whose time limit counts wall time would
+    /// otherwise lose samples to the lane's work).
+    virtual bool exclusive() const { return false; }
     /// Produces the outputs of one frame, each through writeAtomically.
     /// Throws hp::Error on failure; the scheduler records it and goes on.
     virtual void run(const FrameData& data) = 0;

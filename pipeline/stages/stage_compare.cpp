@@ -38,7 +38,11 @@ std::string sequenceLabel(const Scene& scene, const fs::path& outputDir, const s
     if (is("reference.exr") || is("reference.png"))
         return cat("reference (Embree, ", scene.text("reference.mode"), ", ", spp, ")");
     if (scene.flag("reference.kajiya_kay.enabled") && (is("reference.kajiya_kay.exr") || is("reference.kajiya_kay.png")))
-        return cat("reference (Embree, kajiya-kay, ", spp, ")");
+        return cat("reference (Embree, kajiya-kay, ",
+                   scene.integer("reference.kajiya_kay.samples") > 0
+                       ? cat(scene.integer("reference.kajiya_kay.samples"), " spp")
+                       : spp,
+                   ")");
     return scene.text(key);
 }
 
@@ -109,6 +113,8 @@ class CompareStage final : public FrameStage {
         return out;
     }
     bool needsFrameData() const override { return false; }
+    /// Reads the frame's preview and reference files, written before it on the main lane.
+    bool overlaps() const override { return true; }
 
     void run(const FrameData& data) override {
         const FrameRecord r = compareFrame(job_, data.frame);

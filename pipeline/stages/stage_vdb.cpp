@@ -40,6 +40,8 @@ class VdbStage final : public FrameStage {
     }
 
     std::string name() const override { return "vdb"; }
+    /// Reads only the strands; voxelizing and writing run beside the next frame's preview.
+    bool overlaps() const override { return true; }
 
     std::vector<fs::path> outputs(int frame) const override {
         return {shot_.outputDir / expandFrame(output_, frame)};

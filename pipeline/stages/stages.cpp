@@ -36,6 +36,8 @@ class FrameSubset final : public FrameStage {
         return selected(frame) ? stage_->outputs(frame) : std::vector<std::filesystem::path>{};
     }
     bool needsFrameData() const override { return stage_->needsFrameData(); }
+    bool overlaps() const override { return stage_->overlaps(); }
+    bool exclusive() const override { return stage_->exclusive(); }
     void run(const FrameData& data) override {
         if (selected(data.frame)) stage_->run(data);
     }
