@@ -151,6 +151,23 @@ size_t lightPieceVertexBound(const StrandBuffers& b, const StrandFrame& s, const
     return vertices;
 }
 
+// In front of the camera and at most `lineWidth` pixels wide everywhere: strand.tesc's THICK_PASS culls every patch (its `widest`
+/// is the same 2 r f / w over the same vertices; the 1e-3 margin covers
+/// float rounding). Skipping the pass saves the vertex and tessellation
+/// control shaders of every patch, a few percent of a frame on llvmpipe.
+bool mayHaveThickStrands(const StrandFrame& s, const Mat4f& viewProj, float focalPixels, float lineWidth) {
+    if (lineWidth <= 0.f) return true;  // no line path: the ribbon pass draws every strand
+    const bool radii = s.radii.size() == s.positions.size();
+    const Eigen::RowVector4f wRow = viewProj.row(3);
+    for (size_t i = 0; i < s.positions.size(); ++i) {
+        const float w = wRow * s.positions[i].homogeneous();
+        if (w <= 1e-5f) return true;  // at or behind the eye: the shader's clamp makes it wide
+        const float radius = radii ? s.radii[i] : 0.00004f;  // StrandBuffers::upload's default
+        if (2.f * radius * focalPixels / w > lineWidth * (1.f - 1e-3f)) return true;
+    }
+    return false;
+}
+
 // ---- head ------------------------------------------------------------------
 
 void HeadBuffers::create() {
