@@ -4,41 +4,37 @@
 // (SHADED_POINTS). llvmpipe runs the tessellation stages on its calling
 // thread alone and fills their SIMD lanes with one patch's few points; a
 // compute dispatch runs on all its threads with full lanes, and shades each
-// vertex once instead of at every tessellated point (render/preview/preview_gpu.h
-// ShadedPoints). Same patch list as the draw: invocation (patch, k) shades
-// slot k + 1's vertex, the start of the patch's segment k, and the tip at
-// k = segments when the patch ends the strand, so each vertex is written by
-// exactly one invocation (a chunk's last vertex is the next chunk's first).
+// vertex once (render/preview/preview_gpu.h ShadedPoints). Invocation i
+// shades vertex i with the neighbours the tessellation gives it: the start of
+// segment (i, i + 1) at u = 0, or at a strand's tip the end of its last
+// segment at u = 1; at a root or tip the missing neighbour repeats the end
+// vertex, which strandCurve mirrors, as the patches do
+// (render/preview/preview_buffers.cpp StrandBuffers::upload).
 #include "common.glsl"
 #include "strand_curve.glsl"
 #include "hair_shading.glsl"
 
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Points { vec4 point[]; };    // xyz position, w radius
-layout(std430, binding = 1) readonly buffer Patches { uint patchIndex[]; };  // PATCH_SIZE vertex indices a patch
-layout(std430, binding = 2) writeonly buffer Colors { vec4 color[]; };    // rgb radiance per vertex
-uniform uint uPatches;
+layout(std430, binding = 0) readonly buffer Points { vec4 point[]; };  // xyz position, w radius
+// Four vertices a word, a byte each (StrandBuffers::vertexFlags): bit 0 the
+// vertex is a strand's root, bit 1 its tip.
+layout(std430, binding = 1) readonly buffer Flags { uint vertexFlags[]; };
+layout(std430, binding = 2) writeonly buffer Colors { vec4 color[]; };  // rgb radiance per vertex
+uniform uint uVertices;
 
-const uint kSlots = uint(PATCH_SIZE - 2);  // vertex slots 1 .. PATCH_SIZE - 2 can start a segment or end the strand
+uint flagsOf(uint i) { return (vertexFlags[i >> 2] >> (8u * (i & 3u))) & 3u; }
 
 void main() {
-    uint id = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
-    uint patch_ = id / kSlots;
-    int k = int(id % kSlots);
-    if (patch_ >= uPatches) return;
-    uint base = patch_ * uint(PATCH_SIZE);
-    // Segments in the patch as strand.tesc's patchSegments counts them.
-    int segments = 0;
-    for (int j = 2; j < PATCH_SIZE && patchIndex[base + j] == patchIndex[base + j - 1] + 1u; ++j) ++segments;
-    segments = min(segments, PATCH_SIZE - 3);
-    if (segments < 1 || k > segments) return;
-    // The strand's tip belongs to its last patch; a chunk's end vertex to the next chunk.
-    if (k == segments && patchIndex[base + segments + 2] != patchIndex[base + segments + 1]) return;
-    int i = min(k, segments - 1);
-    float u = float(k - i);
-    vec4 c0 = point[patchIndex[base + i]], c1 = point[patchIndex[base + i + 1]];
-    vec4 c2 = point[patchIndex[base + i + 2]], c3 = point[patchIndex[base + i + 3]];
+    uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
+    if (i >= uVertices) return;
+    uint f = flagsOf(i);
+    if (f == 3u) return;  // a strand of one vertex draws nothing
+    bool tip = (f & 2u) != 0u;
+    uint a = tip ? i - 1u : i;  // the segment (a, a + 1) the point lies on
+    uint before = (flagsOf(a) & 1u) != 0u ? a : a - 1u;
+    uint after = (flagsOf(a + 1u) & 2u) != 0u ? a + 1u : a + 2u;
     vec3 position, derivative;
-    strandCurve(c0.xyz, c1.xyz, c2.xyz, c3.xyz, u, position, derivative);
-    color[patchIndex[base + k + 1]] = vec4(shadeHair(position, derivative, uHairColor.rgb), 1.0);
+    strandCurve(point[before].xyz, point[a].xyz, point[a + 1u].xyz, point[after].xyz, tip ? 1.0 : 0.0, position,
+                derivative);
+    color[i] = vec4(shadeHair(position, derivative, uHairColor.rgb), 1.0);
 }

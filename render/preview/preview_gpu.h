@@ -112,6 +112,7 @@ class PersistentBuffer {
 struct StrandBuffers {
     PersistentBuffer vertices;
     unsigned indices = 0;
+    unsigned vertexFlags = 0;  ///< SSBO: a byte a vertex, bit 0 root, bit 1 tip (shaders/strand_shade.comp)
     unsigned vao = 0;
     int maxPatchVertices = 32;
     int patchSize = 4;
@@ -229,8 +230,8 @@ struct ShadedPoints {
     unsigned buffer = 0, texture = 0;
     size_t capacity = 0;  ///< vertices
 
-    /// Shades the vertices of `strands`' patches with `program` (the camera
-    /// pass's uniforms and shadow textures bound) and binds the result.
+    /// Shades the `vertexCount` vertices of `strands` with `program` (the
+    /// camera pass's uniforms and shadow textures bound) and binds the result.
     void shade(const StrandBuffers& strands, size_t vertexCount, const GlProgram& program);
     void destroy();
 };

@@ -23,14 +23,13 @@ void ShadedPoints::shade(const StrandBuffers& strands, size_t vertexCount, const
         glCreateTextures(GL_TEXTURE_BUFFER, 1, &texture);
         glTextureBuffer(texture, GL_RGBA32F, buffer);
     }
-    const size_t patches = strands.patchSize > 0 ? strands.indexCount / size_t(strands.patchSize) : 0;
-    if (patches > 0) {
+    if (vertexCount > 0) {
         program.use();
-        glProgramUniform1ui(program.id(), program.uniform("uPatches"), GLuint(patches));
+        glProgramUniform1ui(program.id(), program.uniform("uVertices"), GLuint(vertexCount));
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, strands.vertices.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, strands.indices);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, strands.vertexFlags);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, buffer);
-        const size_t invocations = patches * size_t(strands.patchSize - 2);  // kSlots in the shader
+        const size_t invocations = vertexCount;
         // Rows of at most 65535 groups (GL's least guaranteed count per dimension).
         const size_t groups = (invocations + 63) / 64, row = std::min<size_t>(groups, 65535);
         glDispatchCompute(GLuint(row), GLuint((groups + row - 1) / row), 1);
