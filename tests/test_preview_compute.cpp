@@ -132,11 +132,12 @@ TEST(PreviewCompute, DefaultTessellationStaysWithinPerVertexError) {
     PreviewSettings s;
     s.shadow.resolution = 64;
     View v = lightSetups(h.view)[2];  // the rig, fitted hair: the sharpest lobes
-    PreviewSettings stage = s, fragment = s;
+    PreviewSettings stage = s, compute = s, fragment = s;
     stage.shadeInCompute = false;
+    compute.shadeInCompute = true;
     fragment.shadePerFragment = true;
     const Image a = test::renderOnce(stage, v, h.strands, &h.head);
-    const Image b = test::renderOnce(s, v, h.strands, &h.head);
+    const Image b = test::renderOnce(compute, v, h.strands, &h.head);
     const Image f = test::renderOnce(fragment, v, h.strands, &h.head);
     auto rms = [](const Image& x, const Image& y) {
         double sum = 0.0;

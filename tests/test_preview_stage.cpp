@@ -47,10 +47,10 @@ preview:
     EXPECT_EQ(s.msaa, 2);
     EXPECT_TRUE(s.shadePerFragment);
     EXPECT_FALSE(s.shadeInCompute);
-    const Scene tessellated = Scene::parse("preview: {shading: tessellated}\n", "keys.yaml", ".");
-    EXPECT_FALSE(makePreviewSettings(tessellated).shadePerFragment);
-    EXPECT_FALSE(makePreviewSettings(tessellated).shadeInCompute);
-    EXPECT_TRUE(makePreviewSettings(Scene::parse("preview: {}\n", "keys.yaml", ".")).shadeInCompute);
+    const Scene compute = Scene::parse("preview: {shading: compute}\n", "keys.yaml", ".");
+    EXPECT_FALSE(makePreviewSettings(compute).shadePerFragment);
+    EXPECT_TRUE(makePreviewSettings(compute).shadeInCompute);
+    EXPECT_FALSE(makePreviewSettings(Scene::parse("preview: {}\n", "keys.yaml", ".")).shadeInCompute);
     EXPECT_EQ(s.curve, CurveType::BSpline);
     EXPECT_EQ(s.tessellationLevel, 5);
     EXPECT_EQ(s.shadow.mode, VoxelMode::Binary);

@@ -22,8 +22,9 @@
 // For experiments: --max-lights N (PreviewShadowSettings::maxLights: 1 shadows
 // the key alone), --share 0 (each light tessellates the strands itself),
 // --voxels 0, --shadow-map 0, --msaa N, --pieces P (tessellationPixels),
-// --compute 0 (shade every tessellated point in the tessellation stage, as
-// before PreviewSettings::shadeInCompute).
+// --compute 1 (shade the strand vertices in a compute pass,
+// PreviewSettings::shadeInCompute; the default 0 shades every tessellated
+// point in the tessellation stage).
 // Per strand count: median, min and max of the timed frames (draw + glFinish,
 // wall and process CPU time, llvmpipe's threads included), readback time,
 // peak resident memory; --profile adds a per-pass breakdown of one extra frame
