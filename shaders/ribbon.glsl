@@ -4,8 +4,9 @@
 // tangent, so consecutive pieces share edges exactly). A strand narrower than
 // the minimum width (uTess.w pixels) is drawn that wide with alpha = true
 // width / drawn width: its expected coverage stays its projected area.
-// gColor carries the shaded radiance (per-vertex shading) or the albedo.
-#ifndef SHADE_PER_FRAGMENT
+// gColor carries the shaded radiance (per-vertex shading) or the albedo;
+// with SHADED_POINTS `color` comes shaded already (strand_shade.comp).
+#if !defined(SHADE_PER_FRAGMENT) && !defined(SHADED_POINTS)
 #include "hair_shading.glsl"
 #endif
 
@@ -23,7 +24,7 @@ void emitRibbonEdges(vec3 world, vec3 tangent, float radius, vec3 color) {
     float widthPx = 2.0 * radius * uEye.w / clip.w;
     float drawnPx = max(widthPx, uTess.w);
     vec2 offset = side * drawnPx * uViewport.zw * clip.w;  // half width, pixels -> clip
-#ifndef SHADE_PER_FRAGMENT
+#if !defined(SHADE_PER_FRAGMENT) && !defined(SHADED_POINTS)
     color = shadeHair(world, tangent, color);
 #endif
     gWorld = world;

@@ -16,6 +16,7 @@ in vec4 vPoint[];
 in float vIndex[];
 out vec4 cPoint[];
 patch out float pSegments;
+patch out float pFirst;  // vertex index of control point 1 (strand.tese reads the shaded vertices by it)
 
 // Segments in this patch, read off its vertex indices: slots 1, 2, ... are
 // consecutive vertices of the strand up to its last segment's end; after it
@@ -59,6 +60,7 @@ void main() {
     cull = cull || (uBlend.z > 0.5 && widest <= uTess.w);  // uBlend.z: the thin pass runs
 #endif
     pSegments = float(segments);
+    pFirst = vIndex[1];
     gl_TessLevelOuter[0] = cull ? 0.0 : lines;
     gl_TessLevelOuter[1] = ceil(pieces / lines);
 }

@@ -46,6 +46,11 @@ preview:
     const PreviewSettings s = makePreviewSettings(scene);
     EXPECT_EQ(s.msaa, 2);
     EXPECT_TRUE(s.shadePerFragment);
+    EXPECT_FALSE(s.shadeInCompute);
+    const Scene compute = Scene::parse("preview: {shading: compute}\n", "keys.yaml", ".");
+    EXPECT_FALSE(makePreviewSettings(compute).shadePerFragment);
+    EXPECT_TRUE(makePreviewSettings(compute).shadeInCompute);
+    EXPECT_FALSE(makePreviewSettings(Scene::parse("preview: {}\n", "keys.yaml", ".")).shadeInCompute);
     EXPECT_EQ(s.curve, CurveType::BSpline);
     EXPECT_EQ(s.tessellationLevel, 5);
     EXPECT_EQ(s.shadow.mode, VoxelMode::Binary);

@@ -15,6 +15,7 @@ PreviewSettings makePreviewSettings(const Scene& s) {
         {"preview.tessellation.pixels", &PreviewSettings::tessellationPixels},
     });
     p.shadePerFragment = s.text("preview.shading") == "fragment";
+    p.shadeInCompute = s.text("preview.shading") == "compute";
     p.blend = s.text("preview.transparency") == "weighted" ? HairBlend::Weighted : HairBlend::Sorted;
     p.curve = s.text("preview.tessellation.curve") == "b-spline" ? CurveType::BSpline : CurveType::CatmullRom;
 

@@ -43,37 +43,20 @@ double wallMilliseconds() {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-/// Whether the ribbon pass can draw anything: true unless every strand vertex
-/// lies in front of the camera and is at most `lineWidth` pixels wide there,
-/// in which case strand.tesc's THICK_PASS culls every patch (its `widest`
-/// is the same 2 r f / w over the same vertices; the 1e-3 margin covers
-/// float rounding). Skipping the pass saves the vertex and tessellation
-/// control shaders of every patch, a few percent of a frame on llvmpipe.
-bool mayHaveThickStrands(const StrandFrame& s, const Mat4f& viewProj, float focalPixels, float lineWidth) {
-    if (lineWidth <= 0.f) return true;  // no line path: the ribbon pass draws every strand
-    const bool radii = s.radii.size() == s.positions.size();
-    const Eigen::RowVector4f wRow = viewProj.row(3);
-    for (size_t i = 0; i < s.positions.size(); ++i) {
-        const float w = wRow * s.positions[i].homogeneous();
-        if (w <= 1e-5f) return true;  // at or behind the eye: the shader's clamp makes it wide
-        const float radius = radii ? s.radii[i] : 0.00004f;  // StrandBuffers::upload's default
-        if (2.f * radius * focalPixels / w > lineWidth * (1.f - 1e-3f)) return true;
-    }
-    return false;
-}
-
 }  // namespace
 
 struct PreviewRenderer::Impl {
     PreviewSettings settings;
     PreviewStats stats;
-    GlProgram strand, strandLines, strandVoxel, voxelLines, fur, furVoxel, head, headDepth, prefix, resolveMs, resolveSs,
+    GlProgram strand, strandLines, strandVoxel, strandShade, voxelLines, fur, furVoxel, head, headDepth, prefix, resolveMs, resolveSs,
         present;
     StrandBuffers strands;
     HeadBuffers headBuffers;
     RenderTargets targets;
     ShadowTargets shadows;
     CapturedPieces captured;
+    ShadedPoints shadedPoints;
+    size_t strandVertices = 0;  ///< this frame's
     GLuint cameraUbo = 0, emptyVao = 0, query = 0;
     GLuint lightUbo[kMaxShadowedLights] = {};  ///< one per shadowed light: its passes' grid
     GLsync fence = nullptr;
@@ -84,7 +67,7 @@ struct PreviewRenderer::Impl {
     int strandPatchSize = 0;
     bool thickStrands = true;  ///< some strand may be wider than the line path's width (the ribbon pass runs)
     bool strandsVisible = false, headVisible = false, furVisible = false;  // what this frame draws
-    bool shadedPerFragment = false;
+    bool shadedPerFragment = false, shadedInCompute = false;
     std::vector<std::string> hairDefines, compiledHairDefines;  ///< this frame's lights and flags (hairShadingDefines)
     std::vector<ShadowSlot> slots;   ///< this frame's shadowed lights
     int slotResolution[kMaxShadowedLights] = {};
@@ -139,6 +122,7 @@ struct PreviewRenderer::Impl {
         targets.destroy();
         shadows.destroy();
         captured.destroy();
+        shadedPoints.destroy();
         glDeleteBuffers(1, &cameraUbo);
         glDeleteBuffers(kMaxShadowedLights, lightUbo);
         glDeleteVertexArrays(1, &emptyVao);
@@ -150,8 +134,9 @@ struct PreviewRenderer::Impl {
     /// recompiled when any changes.
     void compileHairPrograms(int patchSize) {
         const bool perFragment = settings.shadePerFragment;
-        if (patchSize == strandPatchSize && perFragment == shadedPerFragment && hairDefines == compiledHairDefines &&
-            strand.id())
+        const bool inCompute = settings.shadeInCompute && !perFragment;
+        if (patchSize == strandPatchSize && perFragment == shadedPerFragment && inCompute == shadedInCompute &&
+            hairDefines == compiledHairDefines && strand.id())
             return;
         std::vector<std::string> shading = perFragment ? std::vector<std::string>{"SHADE_PER_FRAGMENT"}
                                                        : std::vector<std::string>{};
@@ -170,6 +155,11 @@ struct PreviewRenderer::Impl {
         thick.push_back("THICK_PASS");
         thin.push_back("THIN_PASS");
         thin.push_back("LINE_OUTPUT");
+        if (inCompute) {
+            thick.push_back("SHADED_POINTS");
+            thin.push_back("SHADED_POINTS");
+            strandShade = GlProgram("strand point shading", {{ShaderStage::Compute, "strand_shade.comp"}}, defines);
+        }
         strand = GlProgram("strand ribbons", camera, thick);
         strandLines = GlProgram("strand lines", lines, thin);
         strandVoxel = GlProgram("strand voxelization", voxel, {cat("PATCH_SIZE ", patchSize), "CAPTURE"});
@@ -182,6 +172,7 @@ struct PreviewRenderer::Impl {
                         shading);
         strandPatchSize = patchSize;
         shadedPerFragment = perFragment;
+        shadedInCompute = inCompute;
         compiledHairDefines = hairDefines;
     }
 
@@ -325,6 +316,10 @@ struct PreviewRenderer::Impl {
         for (int k = 0; k < kMaxShadowedLights; ++k)
             glBindTextureUnit(GLuint(4 + k), voxelsOn && k < int(slots.size()) ? shadows.density[k] : shadows.dummyDensity);
         glBindTextureUnit(1, mapOn ? shadows.map : shadows.dummyMap);
+        if (shadedInCompute && strandsVisible && strands.indexCount) {
+            shadedPoints.shade(strands, strandVertices, strandShade);
+            mark("strand point shading");
+        }
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_LESS);
         glEnable(GL_MULTISAMPLE);
@@ -437,6 +432,7 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
             strands.sortBackToFront(*frame.strands, cam.position, (cam.target - cam.position).normalized());
         compileHairPrograms(strands.patchSize);
         stats.strandSegments = strands.segments;
+        strandVertices = frame.strands->vertexCount();
         for (const Vec3f& p : frame.strands->positions) bounds.extend(p);
     }
     strandsVisible = drawStrandsNow;

@@ -131,6 +131,14 @@ struct PreviewSettings {
     /// piece end). Per vertex is several times faster on llvmpipe; per
     /// fragment resolves sharp highlights and shadow edges along a strand.
     bool shadePerFragment = false;
+    /// Per-vertex shading in a compute pass, once per strand vertex, which
+    /// the tessellation interpolates along each segment (llvmpipe runs
+    /// compute on all its threads, the tessellation stages on one); false:
+    /// shade every tessellated point in the tessellation stage. Off by
+    /// default: on 2 cores it saves 2 % of a 1080p frame's CPU and costs 10 %
+    /// of a 560 x 720 one, whose pieces span several vertices
+    /// (docs/benchmarks.md).
+    bool shadeInCompute = false;
     /// Compile the hair programs for each frame's lights, flags and hair
     /// model (llvmpipe pays both sides of a branch on a uniform); false: one
     /// program that reads them from uniforms (the same pixels; tests).

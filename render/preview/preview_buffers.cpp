@@ -37,6 +37,7 @@ void StrandBuffers::create() {
     glVertexArrayAttribFormat(vao, 0, 4, GL_FLOAT, GL_FALSE, 0);
     glVertexArrayAttribBinding(vao, 0, 0);
     glCreateBuffers(1, &indices);
+    glCreateBuffers(1, &vertexFlags);
     GLint limit = 32;
     glGetIntegerv(GL_MAX_PATCH_VERTICES, &limit);
     maxPatchVertices = std::clamp(limit, 4, 32);  // 32: the TCS's array size
@@ -45,7 +46,8 @@ void StrandBuffers::create() {
 void StrandBuffers::destroy() {
     if (vao) glDeleteVertexArrays(1, &vao);
     if (indices) glDeleteBuffers(1, &indices);
-    vao = indices = 0;
+    if (vertexFlags) glDeleteBuffers(1, &vertexFlags);
+    vao = indices = vertexFlags = 0;
 }
 
 void StrandBuffers::upload(const StrandFrame& s, int maxSegments) {
@@ -94,6 +96,15 @@ void StrandBuffers::upload(const StrandFrame& s, int maxSegments) {
                       list.empty() ? nullptr : list.data(), GL_DYNAMIC_DRAW);
     glVertexArrayElementBuffer(vao, indices);
     indexCount = list.size();
+    // Roots and tips for the compute pass that shades the vertices, a byte a vertex.
+    std::vector<uint32_t> flags((s.vertexCount() + 3) / 4 + 1, 0u);
+    for (size_t k = 0; k < s.strandCount(); ++k) {
+        const uint32_t first = s.offsets[k], count = s.vertexCount(k);
+        if (count == 0) continue;
+        flags[first / 4] |= 1u << (8 * (first % 4));
+        flags[(first + count - 1) / 4] |= 2u << (8 * ((first + count - 1) % 4));
+    }
+    glNamedBufferData(vertexFlags, GLsizeiptr(flags.size() * sizeof(uint32_t)), flags.data(), GL_DYNAMIC_DRAW);
     offsets = s.offsets;
     chunkSegments = maxSegments;
 }
@@ -149,6 +160,23 @@ size_t lightPieceVertexBound(const StrandBuffers& b, const StrandFrame& s, const
         vertices += size_t(2.0 * (pieces + std::ceil(pieces / 64.0)));
     }
     return vertices;
+}
+
+// In front of the camera and at most `lineWidth` pixels wide everywhere: strand.tesc's THICK_PASS culls every patch (its `widest`
+/// is the same 2 r f / w over the same vertices; the 1e-3 margin covers
+/// float rounding). Skipping the pass saves the vertex and tessellation
+/// control shaders of every patch, a few percent of a frame on llvmpipe.
+bool mayHaveThickStrands(const StrandFrame& s, const Mat4f& viewProj, float focalPixels, float lineWidth) {
+    if (lineWidth <= 0.f) return true;  // no line path: the ribbon pass draws every strand
+    const bool radii = s.radii.size() == s.positions.size();
+    const Eigen::RowVector4f wRow = viewProj.row(3);
+    for (size_t i = 0; i < s.positions.size(); ++i) {
+        const float w = wRow * s.positions[i].homogeneous();
+        if (w <= 1e-5f) return true;  // at or behind the eye: the shader's clamp makes it wide
+        const float radius = radii ? s.radii[i] : 0.00004f;  // StrandBuffers::upload's default
+        if (2.f * radius * focalPixels / w > lineWidth * (1.f - 1e-3f)) return true;
+    }
+    return false;
 }
 
 // ---- head ------------------------------------------------------------------

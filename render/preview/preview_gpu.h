@@ -112,6 +112,7 @@ class PersistentBuffer {
 struct StrandBuffers {
     PersistentBuffer vertices;
     unsigned indices = 0;
+    unsigned vertexFlags = 0;  ///< SSBO: a byte a vertex, bit 0 root, bit 1 tip (shaders/strand_shade.comp)
     unsigned vao = 0;
     int maxPatchVertices = 32;
     int patchSize = 4;
@@ -212,5 +213,27 @@ struct CapturedPieces {
 /// never overflows.
 size_t lightPieceVertexBound(const StrandBuffers& buffers, const StrandFrame& strands, const LightGrid& grid,
                              int resolution, int level, float pixels);
+
+/// Whether the ribbon pass can draw anything: true unless every strand vertex
+/// lies in front of the camera and is at most `lineWidth` pixels wide there
+/// (strand.tesc's THICK_PASS then culls every patch; exact, see the .cpp).
+bool mayHaveThickStrands(const StrandFrame& strands, const Mat4f& viewProj, float focalPixels, float lineWidth);
+
+class GlProgram;
+
+/// The strand vertices' radiance, shaded once a frame by a compute pass
+/// (shaders/strand_shade.comp) before the camera pass, which interpolates
+/// it along each segment (strand.tese with SHADED_POINTS). One RGBA32F
+/// texel a vertex, in a buffer texture on unit kUnit.
+struct ShadedPoints {
+    static constexpr unsigned kUnit = 8;  ///< uPointColor in shaders/strand.tese
+    unsigned buffer = 0, texture = 0;
+    size_t capacity = 0;  ///< vertices
+
+    /// Shades the `vertexCount` vertices of `strands` with `program` (the
+    /// camera pass's uniforms and shadow textures bound) and binds the result.
+    void shade(const StrandBuffers& strands, size_t vertexCount, const GlProgram& program);
+    void destroy();
+};
 
 }  // namespace hp

@@ -10,6 +10,7 @@
 //                 [--profile] [--png out.png] [--shading kajiya-kay|fitted]
 //                 [--lights one|rig] [--other-resolution N] [--max-lights N]
 //                 [--share 0|1] [--voxels 0|1] [--shadow-map 0|1] [--msaa N] [--pieces P]
+//                 [--compute 0|1]
 // --shading fitted shades with the hair material fitted to the physical
 // fibre (render/reference/hair_fit.h, melanin 1.3) and dual scattering; the
 // default keeps the plain Kajiya-Kay material the benchmark always had.
@@ -20,7 +21,10 @@
 // the shadowed lights after the first (PreviewShadowSettings::otherResolution).
 // For experiments: --max-lights N (PreviewShadowSettings::maxLights: 1 shadows
 // the key alone), --share 0 (each light tessellates the strands itself),
-// --voxels 0, --shadow-map 0, --msaa N, --pieces P (tessellationPixels).
+// --voxels 0, --shadow-map 0, --msaa N, --pieces P (tessellationPixels),
+// --compute 1 (shade the strand vertices in a compute pass,
+// PreviewSettings::shadeInCompute; the default 0 shades every tessellated
+// point in the tessellation stage).
 // Per strand count: median, min and max of the timed frames (draw + glFinish,
 // wall and process CPU time, llvmpipe's threads included), readback time,
 // peak resident memory; --profile adds a per-pass breakdown of one extra frame
@@ -69,7 +73,7 @@ int main(int argc, char** argv) {
     bool profile = false;
     bool fitted = false, rig = false;
     int otherResolution = -1;
-    int voxels = -1, shadowMap = -1, msaa = -1, maxLights = -1, share = -1;
+    int voxels = -1, shadowMap = -1, msaa = -1, maxLights = -1, share = -1, compute = -1;
     float pieces = -1.f;
     std::string png;
     for (int i = 1; i < argc; ++i) {
@@ -97,6 +101,8 @@ int main(int argc, char** argv) {
             shadowMap = std::atoi(argv[++i]);
         } else if (a == "--max-lights" && more) {
             maxLights = std::atoi(argv[++i]);
+        } else if (a == "--compute" && more) {
+            compute = std::atoi(argv[++i]);
         } else if (a == "--share" && more) {
             share = std::atoi(argv[++i]);
         } else if (a == "--msaa" && more) {
@@ -106,7 +112,7 @@ int main(int argc, char** argv) {
         } else if (a == "--png" && more) {
             png = argv[++i];
         } else {
-            std::cerr << "usage: bench_preview [--strands N,M] [--frames N] [--warmup N] [--profile] [--png FILE] [--shading kajiya-kay|fitted] [--lights one|rig] [--other-resolution N] [--max-lights N] [--share 0|1] [--voxels 0|1] [--shadow-map 0|1] [--msaa N] [--pieces P]\n";
+            std::cerr << "usage: bench_preview [--strands N,M] [--frames N] [--warmup N] [--profile] [--png FILE] [--shading kajiya-kay|fitted] [--lights one|rig] [--other-resolution N] [--max-lights N] [--share 0|1] [--voxels 0|1] [--shadow-map 0|1] [--msaa N] [--pieces P] [--compute 0|1]\n";
             return 1;
         }
     }
@@ -122,6 +128,7 @@ int main(int argc, char** argv) {
         if (msaa >= 0) settings.msaa = msaa;
         if (maxLights >= 0) settings.shadow.maxLights = maxLights;
         if (share >= 0) settings.shadow.shareTessellation = share != 0;
+        if (compute >= 0) settings.shadeInCompute = compute != 0;
         if (pieces >= 0.f) settings.tessellationPixels = pieces;
         const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 32, 64);
         std::printf("bench_preview: %s\n", context->description().c_str());
