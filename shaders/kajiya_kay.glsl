@@ -38,9 +38,17 @@ float lobeAzimuth(int k, int a, int b) {
 }
 
 // Fitted lobe k (render/view/view.cpp hairLobe): strength(|thetaO|) * cos(thetaI + thetaO - shift)^n'
-// * sqrt(n'/n) / sqrt(cos thetaI cos thetaO) * N(|phi|), strength and N tabulated (linear between
-// nodes), with 1/n' = 1/n + spread (rad^2): light spread by the fibres it crossed.
-vec3 hairLobe(int k, vec3 t, vec3 l, vec3 v, float spread) {
+// * sqrt(n'/n) / sqrt(cos thetaI cos thetaO) * N(|phi|; |thetaO|), strength and N tabulated
+// (linear between nodes), with 1/n' = 1/n + spread (rad^2): light spread by the fibres it crossed.
+// `turn` (rad^2) is the variance of the azimuth by which those fibres turned the light (n
+// crossings: n s_phi^2, uLobeShape's z). N is then N convolved with that spread around the
+// fibre; on the circle a convolution with a wrapped normal of variance V multiplies N's
+// Fourier coefficient k by exp(-k^2 V / 2); keeping the first, k = 1, for all (the others
+// fade faster, so this keeps a little too much of the peak):
+//   N_V(phi) = 1/(2 pi) + (N(phi) - 1/(2 pi)) exp(-V / 2).
+// Zinke 2008 takes the limit instead, N averaged over the forward half circle (their N^G),
+// which on the default shot lit the key's shaded side 4 times as bright as the physical render.
+vec3 hairLobeTurned(int k, vec3 t, vec3 l, vec3 v, float spread, float turn) {
     vec4 shape = uLobeShape[k];
     float si = clamp(dot(t, l), -1.0, 1.0), so = clamp(dot(t, v), -1.0, 1.0);
     float ci = sqrt(1.0 - si * si), co = sqrt(1.0 - so * so);
@@ -60,13 +68,23 @@ vec3 hairLobe(int k, vec3 t, vec3 l, vec3 v, float spread) {
         float g = y - float(j);
         azimuthal = mix(mix(lobeAzimuth(k, i, j), lobeAzimuth(k, i, j + 1), g),
                         mix(lobeAzimuth(k, i + 1, j), lobeAzimuth(k, i + 1, j + 1), g), x - float(i));
+        azimuthal = 0.15915494 + (azimuthal - 0.15915494) * exp(-0.5 * max(turn, 0.0));
     }
     return strength * (longitudinal * azimuthal);
 }
+
+vec3 hairLobe(int k, vec3 t, vec3 l, vec3 v, float spread) { return hairLobeTurned(k, t, l, v, spread, 0.0); }
 
 // The fitted single-fibre response (kajiyaKay() in HairShading::Fitted):
 // diffuse kd * albedo * cos(thetaI) plus R, TRT and TT, each spread by `spread`.
 vec3 fittedHair(vec3 albedo, vec3 t, vec3 l, vec3 v, float spread) {
     return uHairColor.w * sinBetween(t, l) * albedo + hairLobe(0, t, l, v, spread) + hairLobe(1, t, l, v, spread) +
            hairLobe(2, t, l, v, spread);
+}
+
+// ... for light that reached the fibre through n other fibres (Zinke 2008's f_s^scatter):
+// every lobe spread longitudinally by `spread` = n beta_f^2 and turned in azimuth by `turn` = n s_phi^2.
+vec3 fittedHairScattered(vec3 albedo, vec3 t, vec3 l, vec3 v, float spread, float turn) {
+    return uHairColor.w * sinBetween(t, l) * albedo + hairLobeTurned(0, t, l, v, spread, turn) +
+           hairLobeTurned(1, t, l, v, spread, turn) + hairLobeTurned(2, t, l, v, spread, turn);
 }

@@ -175,6 +175,9 @@ struct HairLobe {
 struct HairDualScattering {
     Vec3f forward = Vec3f::Ones();  ///< a_f: fraction of light one fibre scatters forward
     float forwardVariance = 0.f;    ///< β_f² (rad²): longitudinal spread per fibre crossed
+    /// s_φ² (rad²): variance of the azimuthal turn π − |φ| of light one fibre
+    /// scatters forward; n crossings turn it by variance n s_φ²
+    float forwardAzimuthVariance = 0.f;
     HairLobe back;                  ///< d_b f_back: local multiple back-scattering, a lobe of the same family
 };
 
