@@ -2,14 +2,16 @@
 // Kajiya-Kay: the model times the light's visibility (its slot's voxel grid
 // and shadow map; 1 for a light without a slot).
 // Fitted (render/reference/hair_fit.h): the dual-scattering approximation of
-// Zinke, Yuksel, Weber and Keyser 2008. Behind C expected fibre crossings
-// toward each shadowed light (its slot's voxel grid) the light arriving is the forward-
-// scattered T_f = exp(-(1 - a_f) C) (coloured: each fibre keeps what it
-// scatters forward, a_f per channel), spread along the fibre by
-// sigma_f^2 = C beta_f^2, which widens every lobe; the fibres around the point
-// add the local back-scatter d_b f_back (lobe 3), scaled by how much hair lies
+// Zinke, Yuksel, Weber and Keyser 2008. Behind n fibre crossings toward each
+// shadowed light (Poisson with mean C, its slot's voxel grid) the light
+// arrives straight with probability exp(-C) and forward-scattered as the rest
+// of T_f = exp(-(1 - a_f) C) (coloured: each fibre keeps what it scatters
+// forward, a_f per channel), the latter times d_f, spread along the fibre by
+// n beta_f^2 and turned about it by n s_phi^2; the fibres around the point add
+// the local back-scatter d_b f_back (lobe 3), scaled by how much hair lies
 // behind the point (C_b, the rest of the voxel column):
-//   L = sum over lights of E T_f shadowMap (f_fitted(sigma_f^2) + (1 - exp(-(1 - a_f^2) C_b)) d_b f_back(sigma_f^2)).
+//   L = sum over lights of E shadowMap [exp(-C) (f + B(0)) + (T_f - exp(-C)) d_f (f_turned(n) + B(n))],
+//   B(n) = (1 - exp(-(1 - a_f^2) C_b)) d_b f_back(n beta_f^2), n = C / (1 - exp(-C)).
 // Evaluated per ribbon vertex (default; Gouraud along the strand, which
 // software rasterizers need for speed) or per fragment (SHADE_PER_FRAGMENT).
 #include "kajiya_kay.glsl"
