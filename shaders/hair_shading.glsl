@@ -71,9 +71,10 @@ vec3 shadeLight(int i, int s, bool point, vec3 world, vec3 t, vec3 n, vec3 v, ve
     float crossed = c.x / max(1.0 - direct, 1e-4);
     float spread = uShadowColor.w * crossed;
     vec3 depthFactor = vec3(1.0) - exp(-(vec3(1.0) - af * af) * (c.y - c.x));
-    vec3 f = direct * (fittedHair(albedo, t, l, v, 0.0) + hairLobe(3, t, l, v, 0.0) * depthFactor) +
-             scattered * (fittedHairScattered(albedo, t, l, v, spread, uLobeShape[0].z * crossed) +
-                          hairLobe(3, t, l, v, spread) * depthFactor);
+    vec3 fScattered, backScattered;
+    vec3 fStraight = fittedHairBoth(albedo, t, l, v, spread, uLobeShape[0].z * crossed, fScattered);
+    vec3 backStraight = hairLobeBoth(3, t, l, v, spread, 0.0, backScattered);
+    vec3 f = direct * (fStraight + backStraight * depthFactor) + scattered * (fScattered + backScattered * depthFactor);
     return f * radiance * headVisibility(s, world);
 }
 
