@@ -2,14 +2,16 @@
 // Kajiya-Kay: the model times the light's visibility (its slot's voxel grid
 // and shadow map; 1 for a light without a slot).
 // Fitted (render/reference/hair_fit.h): the dual-scattering approximation of
-// Zinke, Yuksel, Weber and Keyser 2008. Behind C expected fibre crossings
-// toward each shadowed light (its slot's voxel grid) the light arriving is the forward-
-// scattered T_f = exp(-(1 - a_f) C) (coloured: each fibre keeps what it
-// scatters forward, a_f per channel), spread along the fibre by
-// sigma_f^2 = C beta_f^2, which widens every lobe; the fibres around the point
-// add the local back-scatter d_b f_back (lobe 3), scaled by how much hair lies
+// Zinke, Yuksel, Weber and Keyser 2008. Behind n fibre crossings toward each
+// shadowed light (Poisson with mean C, its slot's voxel grid) the light
+// arrives straight with probability exp(-C) and forward-scattered as the rest
+// of T_f = exp(-(1 - a_f) C) (coloured: each fibre keeps what it scatters
+// forward, a_f per channel), the latter times d_f, spread along the fibre by
+// n beta_f^2 and turned about it by n s_phi^2; the fibres around the point add
+// the local back-scatter d_b f_back (lobe 3), scaled by how much hair lies
 // behind the point (C_b, the rest of the voxel column):
-//   L = sum over lights of E T_f shadowMap (f_fitted(sigma_f^2) + (1 - exp(-(1 - a_f^2) C_b)) d_b f_back(sigma_f^2)).
+//   L = sum over lights of E shadowMap [exp(-C) (f + B(0)) + (T_f - exp(-C)) d_f (f_turned(n) + B(n))],
+//   B(n) = (1 - exp(-(1 - a_f^2) C_b)) d_b f_back(n beta_f^2), n = C / (1 - exp(-C)).
 // Evaluated per ribbon vertex (default; Gouraud along the strand, which
 // software rasterizers need for speed) or per fragment (SHADE_PER_FRAGMENT).
 #include "kajiya_kay.glsl"
@@ -46,20 +48,34 @@ vec3 shadeLight(int i, int s, bool point, vec3 world, vec3 t, vec3 n, vec3 v, ve
             reach = min(meanDepth, max(half_, 1.0));
         }
         float spreadU = uShadowColor.w * reach;
-        vec3 f = fittedHair(albedo, t, l, v, 0.0) + chain * fittedHair(albedo, t, l, v, spreadU) +
+        vec3 f = fittedHair(albedo, t, l, v, 0.0) + chain * fittedHairScattered(albedo, t, l, v, spreadU, uLobeShape[0].z * reach) +
                  hairLobe(3, t, l, v, spreadU) * (column >= 0.0 ? vec3(1.0) - exp(-(vec3(1.0) - af * af) * 0.5 * column) : vec3(1.0));
         return f * radiance * headVisibility(s, world);
     }
-    // A shadowed light: forward transmittance and spread through the
-    // C fibres in front, back-scatter from the C_b = column - C behind.
-    // Zinke's A_b sums paths into a half-space of hair; through C_b
-    // fibres the round trips a_f^2k stop after about C_b, the factor
+    // A shadowed light (Zinke 2008 §4, their F(T_f, sigma_f^2, directFraction)):
+    // n fibres lie toward the light, Poisson with mean C (the column in front).
+    // With none (directFraction = P(n = 0) = exp(-C)) the light arrives straight:
+    //   F_direct = exp(-C) (f_s + d_b f_back);
+    // through n >= 1 it arrives forward-scattered, T_f = E[a_f^n] = exp(-(1 - a_f) C)
+    // less that direct share, times their forward density factor d_f, spread along the
+    // fibre by sigma_f^2 = n beta_f^2 and turned about it by n s_phi^2 (hairLobeTurned),
+    // n's mean given n >= 1 being C / (1 - exp(-C)):
+    //   F_scatter = (T_f - exp(-C)) d_f (f_s^G(sigma_f^2) + d_b f_back(sigma_f^2)).
+    // d_b f_back is lobe 3 (A_b, Zinke eq. 13-14, render/reference/hair_fit.cpp). A_b
+    // sums paths into a half-space of hair; through the C_b = column - C fibres behind
+    // the point the round trips a_f^2k stop after about C_b, the factor
     // 1 - exp(-(1 - a_f^2) C_b) (Poisson mean of 1 - a_f^(2n)).
     vec2 c = hairColumn(s, world);
-    float spread = uShadowColor.w * c.x;
+    float direct = exp(-c.x);
+    vec3 scattered = max(exp(-uShadowColor.rgb * c.x) - vec3(direct), vec3(0.0)) * kForwardDensity;
+    float crossed = c.x / max(1.0 - direct, 1e-4);
+    float spread = uShadowColor.w * crossed;
     vec3 depthFactor = vec3(1.0) - exp(-(vec3(1.0) - af * af) * (c.y - c.x));
-    vec3 f = fittedHair(albedo, t, l, v, spread) + hairLobe(3, t, l, v, spread) * depthFactor;
-    return f * radiance * exp(-uShadowColor.rgb * c.x) * headVisibility(s, world);
+    vec3 fScattered, backScattered;
+    vec3 fStraight = fittedHairBoth(albedo, t, l, v, spread, uLobeShape[0].z * crossed, fScattered);
+    vec3 backStraight = hairLobeBoth(3, t, l, v, spread, 0.0, backScattered);
+    vec3 f = direct * (fStraight + backStraight * depthFactor) + scattered * (fScattered + backScattered * depthFactor);
+    return f * radiance * headVisibility(s, world);
 }
 
 vec3 shadeHair(vec3 world, vec3 tangent, vec3 albedo) {

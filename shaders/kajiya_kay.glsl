@@ -38,9 +38,17 @@ float lobeAzimuth(int k, int a, int b) {
 }
 
 // Fitted lobe k (render/view/view.cpp hairLobe): strength(|thetaO|) * cos(thetaI + thetaO - shift)^n'
-// * sqrt(n'/n) / sqrt(cos thetaI cos thetaO) * N(|phi|), strength and N tabulated (linear between
-// nodes), with 1/n' = 1/n + spread (rad^2): light spread by the fibres it crossed.
-vec3 hairLobe(int k, vec3 t, vec3 l, vec3 v, float spread) {
+// * sqrt(n'/n) / sqrt(cos thetaI cos thetaO) * N(|phi|; |thetaO|), strength and N tabulated
+// (linear between nodes), with 1/n' = 1/n + spread (rad^2): light spread by the fibres it crossed.
+// `turn` (rad^2) is the variance of the azimuth by which those fibres turned the light (n
+// crossings: n s_phi^2, uLobeShape's z). N is then N convolved with that spread around the
+// fibre; on the circle a convolution with a wrapped normal of variance V multiplies N's
+// Fourier coefficient k by exp(-k^2 V / 2); keeping the first, k = 1, for all (the others
+// fade faster, so this keeps a little too much of the peak):
+//   N_V(phi) = 1/(2 pi) + (N(phi) - 1/(2 pi)) exp(-V / 2).
+// Zinke 2008 takes the limit instead, N averaged over the forward half circle (their N^G),
+// which on the default shot lit the key's shaded side 4 times as bright as the physical render.
+vec3 hairLobeTurned(int k, vec3 t, vec3 l, vec3 v, float spread, float turn) {
     vec4 shape = uLobeShape[k];
     float si = clamp(dot(t, l), -1.0, 1.0), so = clamp(dot(t, v), -1.0, 1.0);
     float ci = sqrt(1.0 - si * si), co = sqrt(1.0 - so * so);
@@ -60,13 +68,66 @@ vec3 hairLobe(int k, vec3 t, vec3 l, vec3 v, float spread) {
         float g = y - float(j);
         azimuthal = mix(mix(lobeAzimuth(k, i, j), lobeAzimuth(k, i, j + 1), g),
                         mix(lobeAzimuth(k, i + 1, j), lobeAzimuth(k, i + 1, j + 1), g), x - float(i));
+        azimuthal = 0.15915494 + (azimuthal - 0.15915494) * exp(-0.5 * max(turn, 0.0));
     }
     return strength * (longitudinal * azimuthal);
 }
+
+vec3 hairLobe(int k, vec3 t, vec3 l, vec3 v, float spread) { return hairLobeTurned(k, t, l, v, spread, 0.0); }
 
 // The fitted single-fibre response (kajiyaKay() in HairShading::Fitted):
 // diffuse kd * albedo * cos(thetaI) plus R, TRT and TT, each spread by `spread`.
 vec3 fittedHair(vec3 albedo, vec3 t, vec3 l, vec3 v, float spread) {
     return uHairColor.w * sinBetween(t, l) * albedo + hairLobe(0, t, l, v, spread) + hairLobe(1, t, l, v, spread) +
            hairLobe(2, t, l, v, spread);
+}
+
+// Lobe k for straight light (no spread, N as tabulated), and in `scattered` for
+// light spread by `spread` and turned by `turn` (hairLobeTurned): the two share
+// their angles and table lookups, which are most of a lobe's cost.
+vec3 hairLobeBoth(int k, vec3 t, vec3 l, vec3 v, float spread, float turn, out vec3 scattered) {
+    scattered = vec3(0.0);
+    vec4 shape = uLobeShape[k];
+    float si = clamp(dot(t, l), -1.0, 1.0), so = clamp(dot(t, v), -1.0, 1.0);
+    float ci = sqrt(1.0 - si * si), co = sqrt(1.0 - so * so);
+    float c = (ci * co - si * so) * cos(shape.y) + (si * co + ci * so) * sin(shape.y);
+    if (c <= 0.0) return vec3(0.0);
+    float n = shape.x / (1.0 + shape.x * max(spread, 0.0));
+    float projected = inversesqrt(max(ci * co, 0.01));
+    vec3 lp = l - si * t, vp = v - so * t;
+    float norms = sqrt(dot(lp, lp) * dot(vp, vp));
+    float x = clamp(asin(abs(so)) * (16.0 / 3.14159265), 0.0, 8.0);  // |thetaO| in node units (11.25 deg)
+    int i = min(int(x), 7);
+    vec3 strength = mix(uLobeStrength[9 * k + i].rgb, uLobeStrength[9 * k + i + 1].rgb, x - float(i));
+    float azimuthal = 0.15915494, turned = 0.15915494;  // along the fibre phi is undefined: N's mean, 1 / (2 pi)
+    if (norms > 1e-12) {
+        float y = acos(clamp(dot(lp, vp) / norms, -1.0, 1.0)) * (8.0 / 3.14159265);  // |phi| in node units (22.5 deg)
+        int j = min(int(y), 7);
+        float g = y - float(j);
+        azimuthal = mix(mix(lobeAzimuth(k, i, j), lobeAzimuth(k, i, j + 1), g),
+                        mix(lobeAzimuth(k, i + 1, j), lobeAzimuth(k, i + 1, j + 1), g), x - float(i));
+        turned = 0.15915494 + (azimuthal - 0.15915494) * exp(-0.5 * max(turn, 0.0));
+    }
+    scattered = strength * (sqrt(n / shape.x) * pow(c, n) * projected * turned);
+    return strength * (pow(c, shape.x) * projected * azimuthal);
+}
+
+// The fitted single-fibre response to straight light (fittedHair(.., 0)), and in
+// `scattered` to light that reached the fibre through n other fibres (Zinke 2008's
+// f_s^scatter): every lobe spread along the fibre by `spread` = n beta_f^2 and
+// turned about it by `turn` = n s_phi^2.
+vec3 fittedHairBoth(vec3 albedo, vec3 t, vec3 l, vec3 v, float spread, float turn, out vec3 scattered) {
+    vec3 diffuse = uHairColor.w * sinBetween(t, l) * albedo;
+    vec3 r, trt, tt;
+    vec3 straight = diffuse + hairLobeBoth(0, t, l, v, spread, turn, r) + hairLobeBoth(1, t, l, v, spread, turn, trt) +
+                    hairLobeBoth(2, t, l, v, spread, turn, tt);
+    scattered = diffuse + r + trt + tt;
+    return straight;
+}
+
+// ... for light that reached the fibre through n other fibres (Zinke 2008's f_s^scatter):
+// every lobe spread longitudinally by `spread` = n beta_f^2 and turned in azimuth by `turn` = n s_phi^2.
+vec3 fittedHairScattered(vec3 albedo, vec3 t, vec3 l, vec3 v, float spread, float turn) {
+    return uHairColor.w * sinBetween(t, l) * albedo + hairLobeTurned(0, t, l, v, spread, turn) +
+           hairLobeTurned(1, t, l, v, spread, turn) + hairLobeTurned(2, t, l, v, spread, turn);
 }

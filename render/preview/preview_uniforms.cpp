@@ -81,7 +81,8 @@ void fillFrameUniforms(FrameUniforms& u, const UniformInputs& in) {
     const HairLobe* lobes[4] = {&h.r, &h.trt, &h.tt, &h.dual.back};
     for (int k = 0; k < 4; ++k) {
         const HairLobe& lobe = *lobes[k];
-        set4(u.lobeShape[k], lobe.exponent, lobe.shift, 0.f, 0.f);
+        // z: the azimuthal variance per fibre crossed, s_φ² (the same for every lobe).
+        set4(u.lobeShape[k], lobe.exponent, lobe.shift, fittedHair ? h.dual.forwardAzimuthVariance : 0.f, 0.f);
         for (int node = 0; node < kHairLobeNodes; ++node)
             set3(u.lobeStrength[k * kHairLobeNodes + node], lobe.strength[size_t(node)], 0.f);
         for (int a = 0; a < kHairLobeNodes; ++a)

@@ -242,6 +242,20 @@ HairMaterial fitted(const HairFiberParams& fiber) {
     back.shift = 0.f;
     back.setStrength((kDualBackDensity * Ab * std::sqrt(1.0 / (sigmaB2 * 2.0 * kPi))).cast<float>());
     back.setAzimuthPower(1.f, 1.f);
+    // The azimuthal turn of forward-scattered light, δ = π − |φ| (0: straight
+    // on through the fibre), its variance over the forward half of every lobe
+    // (luminance, weights cos θi cos θo): s_φ² = Σ w δ² / Σ w.
+    double turn = 0.0, turnW = 0.0;
+    for (int p = 0; p < kLobes; ++p)
+        for (int i = 0; i < kTheta; ++i)
+            for (int o = 0; o < kTheta; ++o)
+                for (int j = 0; j < kPhi; ++j) {
+                    const double delta = kPi - std::abs(phiAt(j));
+                    if (delta >= 0.5 * kPi) continue;
+                    turn += t->phiCell[p][i][o][j] * delta * delta;
+                    turnW += t->phiCell[p][i][o][j];
+                }
+    m.dual.forwardAzimuthVariance = float(turnW > 0.0 ? turn / turnW : 0.0);
     m.dual.forward = af.cast<float>().cwiseMin(Vec3f::Ones());
     m.dual.forwardVariance = float(betaF2);
     m.shading = HairShading::Fitted;

@@ -5,7 +5,8 @@
 // light) with every strength, exponent, shift and azimuthal width derived from
 // Chiang et al. 2016's BSDF (hair_bsdf.h), plus the dual-scattering constants
 // of Zinke, Yuksel, Weber and Keyser 2008, "Dual Scattering Approximation for
-// Fast Multiple Scattering in Hair".
+// Fast Multiple Scattering in Hair" (a_f, β_f², A_b) and the azimuthal variance
+// s_φ² of the light one fibre scatters forward.
 //
 // Method: per material, at scene load (~0.1 s, memoised per fibre). The
 // physical kernel S is averaged over the fibre's width h (a preview ribbon is

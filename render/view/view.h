@@ -167,14 +167,17 @@ struct HairLobe {
 
 /// Zinke, Yuksel, Weber and Keyser 2008's dual-scattering constants of a
 /// fibre (render/reference/hair_fit.h derives them from the physical BSDF),
-/// averaged over the longitudinal angle. A point behind C expected fibre
-/// crossings toward a light receives the forward-scattered light
-/// T_f = exp(−(1 − a_f) C) (a_f^n averaged over Poisson crossing counts n),
-/// spread by the longitudinal variance σ_f² = C β_f², plus the light that the
-/// fibres around it scatter back (the `back` lobe).
+/// averaged over the longitudinal angle. Behind n fibre crossings toward a
+/// light (Poisson with mean C) a point receives the light straight with
+/// probability exp(−C), and forward-scattered, T_f = E[a_f^n] = exp(−(1 − a_f) C)
+/// less that, spread along the fibre by n β_f² and turned about it by n s_φ²;
+/// the fibres around it add the light they scatter back (the `back` lobe).
 struct HairDualScattering {
     Vec3f forward = Vec3f::Ones();  ///< a_f: fraction of light one fibre scatters forward
     float forwardVariance = 0.f;    ///< β_f² (rad²): longitudinal spread per fibre crossed
+    /// s_φ² (rad²): variance of the azimuthal turn π − |φ| of light one fibre
+    /// scatters forward; n crossings turn it by variance n s_φ²
+    float forwardAzimuthVariance = 0.f;
     HairLobe back;                  ///< d_b f_back: local multiple back-scattering, a lobe of the same family
 };
 
