@@ -7,6 +7,8 @@
 #include "sim/strands/head.h"
 #include "sim/volume/hair_grid.h"
 
+#include "volume_support.h"
+
 #include <gtest/gtest.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -20,6 +22,7 @@
 #include <random>
 
 using namespace hp;
+using namespace hp::test;
 using volume::GridInput;
 using volume::HairGrid;
 
@@ -63,23 +66,6 @@ struct Cloud {
         return e;
     }
 };
-
-/// Runs f over [0, count) in `threads` threads, chunks of `grain`.
-volume::ParallelFor arenaFor(int threads, size_t grain) {
-    return [threads, grain](size_t count, const std::function<void(size_t, size_t)>& f) {
-        tbb::task_arena arena(threads);
-        arena.execute([&] {
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, count, grain),
-                              [&](const tbb::blocked_range<size_t>& r) { f(r.begin(), r.end()); },
-                              tbb::simple_partitioner());
-        });
-    };
-}
-
-/// Runs the chunks one at a time, last first: any order-dependent sum shows.
-void reversedFor(size_t count, const std::function<void(size_t, size_t)>& f) {
-    for (size_t e = count; e > 0; --e) f(e - 1, e);
-}
 
 VolumeSettings frictionOnly(float rate) {
     VolumeSettings s;

@@ -6,6 +6,8 @@
 // Volume.WispContactKeepsCrossingWispsApart in test_hair_grid.cpp.
 #include "sim/volume/wisp_contact.h"
 
+#include "volume_support.h"
+
 #include <gtest/gtest.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -17,27 +19,7 @@
 
 using Vec3f = Eigen::Vector3f;
 using namespace hp;
-
-namespace {
-
-/// Runs f over [0, count) in `threads` threads, chunks of `grain`.
-volume::ParallelFor arenaFor(int threads, size_t grain) {
-    return [threads, grain](size_t count, const std::function<void(size_t, size_t)>& f) {
-        tbb::task_arena arena(threads);
-        arena.execute([&] {
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, count, grain),
-                              [&](const tbb::blocked_range<size_t>& r) { f(r.begin(), r.end()); },
-                              tbb::simple_partitioner());
-        });
-    };
-}
-
-/// Runs the chunks one at a time, last first: any order-dependent sum shows.
-void reversedFor(size_t count, const std::function<void(size_t, size_t)>& f) {
-    for (size_t e = count; e > 0; --e) f(e - 1, e);
-}
-
-}  // namespace
+using namespace hp::test;
 
 namespace {
 
