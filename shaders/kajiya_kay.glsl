@@ -37,6 +37,39 @@ float lobeAzimuth(int k, int a, int b) {
     return uLobeAzimuth[index >> 2][index & 3];
 }
 
+// What lobe k's straight and scattered responses share, most of a lobe's cost: the
+// cone term c = cos(thetaI + thetaO - shift), 1 / sqrt(cos thetaI cos thetaO), the
+// strength at |thetaO| and the tabulated N(|phi|; |thetaO|). False where c <= 0 (no light).
+bool lobeTerms(int k, vec3 t, vec3 l, vec3 v, out float c, out float projected, out vec3 strength, out float azimuthal) {
+    vec4 shape = uLobeShape[k];
+    float si = clamp(dot(t, l), -1.0, 1.0), so = clamp(dot(t, v), -1.0, 1.0);
+    float ci = sqrt(1.0 - si * si), co = sqrt(1.0 - so * so);
+    c = (ci * co - si * so) * cos(shape.y) + (si * co + ci * so) * sin(shape.y);
+    projected = 0.0;
+    strength = vec3(0.0);
+    azimuthal = 0.15915494;  // along the fibre phi is undefined: N's mean, 1 / (2 pi)
+    if (c <= 0.0) return false;
+    projected = inversesqrt(max(ci * co, 0.01));
+    vec3 lp = l - si * t, vp = v - so * t;
+    float norms = sqrt(dot(lp, lp) * dot(vp, vp));
+    float x = clamp(asin(abs(so)) * (16.0 / 3.14159265), 0.0, 8.0);  // |thetaO| in node units (11.25 deg)
+    int i = min(int(x), 7);
+    strength = mix(uLobeStrength[9 * k + i].rgb, uLobeStrength[9 * k + i + 1].rgb, x - float(i));
+    if (norms > 1e-12) {
+        float y = acos(clamp(dot(lp, vp) / norms, -1.0, 1.0)) * (8.0 / 3.14159265);  // |phi| in node units (22.5 deg)
+        int j = min(int(y), 7);
+        float g = y - float(j);
+        azimuthal = mix(mix(lobeAzimuth(k, i, j), lobeAzimuth(k, i, j + 1), g),
+                        mix(lobeAzimuth(k, i + 1, j), lobeAzimuth(k, i + 1, j + 1), g), x - float(i));
+    }
+    return true;
+}
+
+// N turned by the azimuthal variance `turn` (hairLobeTurned's N_V).
+float turnedAzimuth(float azimuthal, float turn) {
+    return 0.15915494 + (azimuthal - 0.15915494) * exp(-0.5 * max(turn, 0.0));
+}
+
 // Fitted lobe k (render/view/view.cpp hairLobe): strength(|thetaO|) * cos(thetaI + thetaO - shift)^n'
 // * sqrt(n'/n) / sqrt(cos thetaI cos thetaO) * N(|phi|; |thetaO|), strength and N tabulated
 // (linear between nodes), with 1/n' = 1/n + spread (rad^2): light spread by the fibres it crossed.
@@ -49,28 +82,12 @@ float lobeAzimuth(int k, int a, int b) {
 // Zinke 2008 takes the limit instead, N averaged over the forward half circle (their N^G),
 // which on the default shot lit the key's shaded side 4 times as bright as the physical render.
 vec3 hairLobeTurned(int k, vec3 t, vec3 l, vec3 v, float spread, float turn) {
-    vec4 shape = uLobeShape[k];
-    float si = clamp(dot(t, l), -1.0, 1.0), so = clamp(dot(t, v), -1.0, 1.0);
-    float ci = sqrt(1.0 - si * si), co = sqrt(1.0 - so * so);
-    float c = (ci * co - si * so) * cos(shape.y) + (si * co + ci * so) * sin(shape.y);
-    if (c <= 0.0) return vec3(0.0);
-    float n = shape.x / (1.0 + shape.x * max(spread, 0.0));
-    float longitudinal = sqrt(n / shape.x) * pow(c, n) * inversesqrt(max(ci * co, 0.01));
-    vec3 lp = l - si * t, vp = v - so * t;
-    float norms = sqrt(dot(lp, lp) * dot(vp, vp));
-    float x = clamp(asin(abs(so)) * (16.0 / 3.14159265), 0.0, 8.0);  // |thetaO| in node units (11.25 deg)
-    int i = min(int(x), 7);
-    vec3 strength = mix(uLobeStrength[9 * k + i].rgb, uLobeStrength[9 * k + i + 1].rgb, x - float(i));
-    float azimuthal = 0.15915494;  // along the fibre phi is undefined: N's mean, 1 / (2 pi)
-    if (norms > 1e-12) {
-        float y = acos(clamp(dot(lp, vp) / norms, -1.0, 1.0)) * (8.0 / 3.14159265);  // |phi| in node units (22.5 deg)
-        int j = min(int(y), 7);
-        float g = y - float(j);
-        azimuthal = mix(mix(lobeAzimuth(k, i, j), lobeAzimuth(k, i, j + 1), g),
-                        mix(lobeAzimuth(k, i + 1, j), lobeAzimuth(k, i + 1, j + 1), g), x - float(i));
-        azimuthal = 0.15915494 + (azimuthal - 0.15915494) * exp(-0.5 * max(turn, 0.0));
-    }
-    return strength * (longitudinal * azimuthal);
+    float c, projected, azimuthal;
+    vec3 strength;
+    if (!lobeTerms(k, t, l, v, c, projected, strength, azimuthal)) return vec3(0.0);
+    float n = uLobeShape[k].x / (1.0 + uLobeShape[k].x * max(spread, 0.0));
+    float longitudinal = sqrt(n / uLobeShape[k].x) * pow(c, n) * projected;
+    return strength * (longitudinal * turnedAzimuth(azimuthal, turn));
 }
 
 vec3 hairLobe(int k, vec3 t, vec3 l, vec3 v, float spread) { return hairLobeTurned(k, t, l, v, spread, 0.0); }
@@ -87,29 +104,12 @@ vec3 fittedHair(vec3 albedo, vec3 t, vec3 l, vec3 v, float spread) {
 // their angles and table lookups, which are most of a lobe's cost.
 vec3 hairLobeBoth(int k, vec3 t, vec3 l, vec3 v, float spread, float turn, out vec3 scattered) {
     scattered = vec3(0.0);
-    vec4 shape = uLobeShape[k];
-    float si = clamp(dot(t, l), -1.0, 1.0), so = clamp(dot(t, v), -1.0, 1.0);
-    float ci = sqrt(1.0 - si * si), co = sqrt(1.0 - so * so);
-    float c = (ci * co - si * so) * cos(shape.y) + (si * co + ci * so) * sin(shape.y);
-    if (c <= 0.0) return vec3(0.0);
-    float n = shape.x / (1.0 + shape.x * max(spread, 0.0));
-    float projected = inversesqrt(max(ci * co, 0.01));
-    vec3 lp = l - si * t, vp = v - so * t;
-    float norms = sqrt(dot(lp, lp) * dot(vp, vp));
-    float x = clamp(asin(abs(so)) * (16.0 / 3.14159265), 0.0, 8.0);  // |thetaO| in node units (11.25 deg)
-    int i = min(int(x), 7);
-    vec3 strength = mix(uLobeStrength[9 * k + i].rgb, uLobeStrength[9 * k + i + 1].rgb, x - float(i));
-    float azimuthal = 0.15915494, turned = 0.15915494;  // along the fibre phi is undefined: N's mean, 1 / (2 pi)
-    if (norms > 1e-12) {
-        float y = acos(clamp(dot(lp, vp) / norms, -1.0, 1.0)) * (8.0 / 3.14159265);  // |phi| in node units (22.5 deg)
-        int j = min(int(y), 7);
-        float g = y - float(j);
-        azimuthal = mix(mix(lobeAzimuth(k, i, j), lobeAzimuth(k, i, j + 1), g),
-                        mix(lobeAzimuth(k, i + 1, j), lobeAzimuth(k, i + 1, j + 1), g), x - float(i));
-        turned = 0.15915494 + (azimuthal - 0.15915494) * exp(-0.5 * max(turn, 0.0));
-    }
-    scattered = strength * (sqrt(n / shape.x) * pow(c, n) * projected * turned);
-    return strength * (pow(c, shape.x) * projected * azimuthal);
+    float c, projected, azimuthal;
+    vec3 strength;
+    if (!lobeTerms(k, t, l, v, c, projected, strength, azimuthal)) return vec3(0.0);
+    float n = uLobeShape[k].x / (1.0 + uLobeShape[k].x * max(spread, 0.0));
+    scattered = strength * (sqrt(n / uLobeShape[k].x) * pow(c, n) * projected * turnedAzimuth(azimuthal, turn));
+    return strength * (pow(c, uLobeShape[k].x) * projected * azimuthal);
 }
 
 // The fitted single-fibre response to straight light (fittedHair(.., 0)), and in
