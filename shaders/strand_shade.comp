@@ -16,7 +16,7 @@
 
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Points { vec4 point[]; };  // xyz position, w radius
-// Four vertices a word, a byte each (StrandBuffers::vertexFlags): bit 0 the
+// Four vertices a word, a byte each (render/preview/preview_gpu.h ShadedPoints::flags): bit 0 the
 // vertex is a strand's root, bit 1 its tip.
 layout(std430, binding = 1) readonly buffer Flags { uint vertexFlags[]; };
 layout(std430, binding = 2) writeonly buffer Colors { vec4 color[]; };  // rgb radiance per vertex

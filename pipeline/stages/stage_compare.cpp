@@ -37,12 +37,10 @@ std::string sequenceLabel(const Scene& scene, const fs::path& outputDir, const s
     if (is("preview.exr") || is("preview.png")) return "preview (OpenGL)";
     if (is("reference.exr") || is("reference.png"))
         return cat("reference (Embree, ", scene.text("reference.mode"), ", ", spp, ")");
-    if (scene.flag("reference.kajiya_kay.enabled") && (is("reference.kajiya_kay.exr") || is("reference.kajiya_kay.png")))
-        return cat("reference (Embree, kajiya-kay, ",
-                   scene.integer("reference.kajiya_kay.samples") > 0
-                       ? cat(scene.integer("reference.kajiya_kay.samples"), " spp")
-                       : spp,
-                   ")");
+    if (scene.flag("reference.kajiya_kay.enabled") && (is("reference.kajiya_kay.exr") || is("reference.kajiya_kay.png"))) {
+        const long own = scene.integer("reference.kajiya_kay.samples");  // 0: sampled as the physical reference
+        return cat("reference (Embree, kajiya-kay, ", own > 0 ? cat(own, " spp") : spp, ")");
+    }
     return scene.text(key);
 }
 

@@ -56,7 +56,6 @@ struct PreviewRenderer::Impl {
     ShadowTargets shadows;
     CapturedPieces captured;
     ShadedPoints shadedPoints;
-    size_t strandVertices = 0;  ///< this frame's
     GLuint cameraUbo = 0, emptyVao = 0, query = 0;
     GLuint lightUbo[kMaxShadowedLights] = {};  ///< one per shadowed light: its passes' grid
     GLsync fence = nullptr;
@@ -317,7 +316,7 @@ struct PreviewRenderer::Impl {
             glBindTextureUnit(GLuint(4 + k), voxelsOn && k < int(slots.size()) ? shadows.density[k] : shadows.dummyDensity);
         glBindTextureUnit(1, mapOn ? shadows.map : shadows.dummyMap);
         if (shadedInCompute && strandsVisible && strands.indexCount) {
-            shadedPoints.shade(strands, strandVertices, strandShade);
+            shadedPoints.shade(strands, strandShade);
             mark("strand point shading");
         }
         glEnable(GL_DEPTH_TEST);
@@ -432,7 +431,6 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
             strands.sortBackToFront(*frame.strands, cam.position, (cam.target - cam.position).normalized());
         compileHairPrograms(strands.patchSize);
         stats.strandSegments = strands.segments;
-        strandVertices = frame.strands->vertexCount();
         for (const Vec3f& p : frame.strands->positions) bounds.extend(p);
     }
     strandsVisible = drawStrandsNow;

@@ -37,7 +37,6 @@ void StrandBuffers::create() {
     glVertexArrayAttribFormat(vao, 0, 4, GL_FLOAT, GL_FALSE, 0);
     glVertexArrayAttribBinding(vao, 0, 0);
     glCreateBuffers(1, &indices);
-    glCreateBuffers(1, &vertexFlags);
     GLint limit = 32;
     glGetIntegerv(GL_MAX_PATCH_VERTICES, &limit);
     maxPatchVertices = std::clamp(limit, 4, 32);  // 32: the TCS's array size
@@ -46,8 +45,7 @@ void StrandBuffers::create() {
 void StrandBuffers::destroy() {
     if (vao) glDeleteVertexArrays(1, &vao);
     if (indices) glDeleteBuffers(1, &indices);
-    if (vertexFlags) glDeleteBuffers(1, &vertexFlags);
-    vao = indices = vertexFlags = 0;
+    vao = indices = 0;
 }
 
 void StrandBuffers::upload(const StrandFrame& s, int maxSegments) {
@@ -96,15 +94,6 @@ void StrandBuffers::upload(const StrandFrame& s, int maxSegments) {
                       list.empty() ? nullptr : list.data(), GL_DYNAMIC_DRAW);
     glVertexArrayElementBuffer(vao, indices);
     indexCount = list.size();
-    // Roots and tips for the compute pass that shades the vertices, a byte a vertex.
-    std::vector<uint32_t> flags((s.vertexCount() + 3) / 4 + 1, 0u);
-    for (size_t k = 0; k < s.strandCount(); ++k) {
-        const uint32_t first = s.offsets[k], count = s.vertexCount(k);
-        if (count == 0) continue;
-        flags[first / 4] |= 1u << (8 * (first % 4));
-        flags[(first + count - 1) / 4] |= 2u << (8 * ((first + count - 1) % 4));
-    }
-    glNamedBufferData(vertexFlags, GLsizeiptr(flags.size() * sizeof(uint32_t)), flags.data(), GL_DYNAMIC_DRAW);
     offsets = s.offsets;
     chunkSegments = maxSegments;
 }

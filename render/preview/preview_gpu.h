@@ -112,7 +112,6 @@ class PersistentBuffer {
 struct StrandBuffers {
     PersistentBuffer vertices;
     unsigned indices = 0;
-    unsigned vertexFlags = 0;  ///< SSBO: a byte a vertex, bit 0 root, bit 1 tip (shaders/strand_shade.comp)
     unsigned vao = 0;
     int maxPatchVertices = 32;
     int patchSize = 4;
@@ -228,11 +227,13 @@ class GlProgram;
 struct ShadedPoints {
     static constexpr unsigned kUnit = 8;  ///< uPointColor in shaders/strand.tese
     unsigned buffer = 0, texture = 0;
+    unsigned flags = 0;   ///< SSBO: a byte a vertex, bit 0 root, bit 1 tip (shaders/strand_shade.comp)
     size_t capacity = 0;  ///< vertices
 
-    /// Shades the `vertexCount` vertices of `strands` with `program` (the
-    /// camera pass's uniforms and shadow textures bound) and binds the result.
-    void shade(const StrandBuffers& strands, size_t vertexCount, const GlProgram& program);
+    /// Shades the vertices of `strands` (as last uploaded) with `program`
+    /// (the camera pass's uniforms and shadow textures bound) and binds the
+    /// result.
+    void shade(const StrandBuffers& strands, const GlProgram& program);
     void destroy();
 };
 

@@ -11,10 +11,31 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <vector>
 
 namespace hp {
 
-void ShadedPoints::shade(const StrandBuffers& strands, size_t vertexCount, const GlProgram& program) {
+namespace {
+
+/// Roots and tips of the strands `offsets` delimits, a byte a vertex, four a
+/// word (the compute pass's Flags buffer): bit 0 a root, bit 1 a tip.
+std::vector<uint32_t> rootAndTipFlags(const std::vector<uint32_t>& offsets) {
+    const size_t vertices = offsets.empty() ? 0 : offsets.back();
+    std::vector<uint32_t> flags((vertices + 3) / 4 + 1, 0u);
+    for (size_t k = 0; k + 1 < offsets.size(); ++k) {
+        const uint32_t first = offsets[k], last = offsets[k + 1];
+        if (last == first) continue;
+        flags[first / 4] |= 1u << (8 * (first % 4));
+        flags[(last - 1) / 4] |= 2u << (8 * ((last - 1) % 4));
+    }
+    return flags;
+}
+
+}  // namespace
+
+void ShadedPoints::shade(const StrandBuffers& strands, const GlProgram& program) {
+    const size_t vertexCount = strands.offsets.empty() ? 0 : strands.offsets.back();
     if (vertexCount > capacity || !buffer) {
         destroy();
         capacity = std::max<size_t>(vertexCount + vertexCount / 2, 64);  // room to grow, as PersistentBuffer
@@ -22,12 +43,16 @@ void ShadedPoints::shade(const StrandBuffers& strands, size_t vertexCount, const
         glNamedBufferStorage(buffer, GLsizeiptr(capacity * 4 * sizeof(float)), nullptr, 0);
         glCreateTextures(GL_TEXTURE_BUFFER, 1, &texture);
         glTextureBuffer(texture, GL_RGBA32F, buffer);
+        glCreateBuffers(1, &flags);
     }
     if (vertexCount > 0) {
+        // Only this pass reads them, so they are built here, not in every frame's upload.
+        const std::vector<uint32_t> words = rootAndTipFlags(strands.offsets);
+        glNamedBufferData(flags, GLsizeiptr(words.size() * sizeof(uint32_t)), words.data(), GL_DYNAMIC_DRAW);
         program.use();
         glProgramUniform1ui(program.id(), program.uniform("uVertices"), GLuint(vertexCount));
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, strands.vertices.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, strands.vertexFlags);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, flags);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, buffer);
         const size_t invocations = vertexCount;
         // Rows of at most 65535 groups (GL's least guaranteed count per dimension).
@@ -41,7 +66,8 @@ void ShadedPoints::shade(const StrandBuffers& strands, size_t vertexCount, const
 void ShadedPoints::destroy() {
     if (texture) glDeleteTextures(1, &texture);
     if (buffer) glDeleteBuffers(1, &buffer);
-    texture = buffer = 0;
+    if (flags) glDeleteBuffers(1, &flags);
+    texture = buffer = flags = 0;
     capacity = 0;
 }
 
