@@ -23,6 +23,45 @@ inline uint32_t cellKey(const Eigen::Vector3i& c, uint32_t mask) {
     return (uint32_t(c.x()) * 73856093u ^ uint32_t(c.y()) * 19349663u ^ uint32_t(c.z()) * 83492791u) & mask;
 }
 
+/// The move of vertex i (inverse mass wi) against vertex j of another wisp,
+/// added to dx: apart along the pair's normal to the bound min(d, start
+/// distance), the side being where the pair started if it crossed since,
+/// and its slide taken back by friction. False when the pair is not closer
+/// than its bound (no move).
+bool pairMove(const ContactInput& in, size_t i, size_t j, float d, float wi, Eigen::Vector3f& dx) {
+    const Eigen::Vector3f cur = in.x[i] - in.x[j];
+    const float dist2 = cur.squaredNorm();
+    if (dist2 >= d * d) return false;
+    const Eigen::Vector3f start = in.x0[i] - in.x0[j];
+    const float d0 = start.norm();
+    // Crossed since the start: back to the side it came from.
+    Eigen::Vector3f nrm;
+    float dist;
+    if (cur.dot(start) < 0.f && d0 > 0.f) {
+        nrm = start / d0;
+        dist = cur.dot(nrm);
+    } else if (dist2 > 0.f) {
+        dist = std::sqrt(dist2);
+        nrm = cur / dist;
+    } else {
+        return false;  // coincident now and at the start: no direction
+    }
+    const float bound = std::min(d, d0);
+    if (dist >= bound) return false;
+    const float wj = in.mass[j] > 0.f ? 1.f / in.mass[j] : 0.f;
+    const float depth = bound - dist;
+    // Friction at position level (Macklin, Müller, Chentanez and Kim,
+    // "Unified Particle Physics for Real-Time Applications", 2014): the
+    // pair's relative slide over the substep, taken back whole below μ·depth
+    // (static), by μ·depth above it (kinetic; slideLen > grip ≥ 0 there).
+    Eigen::Vector3f slide = (in.x[i] - in.x0[i]) - (in.x[j] - in.x0[j]);
+    slide -= slide.dot(nrm) * nrm;
+    const float slideLen = slide.norm(), grip = in.friction * depth;
+    const Eigen::Vector3f back = slideLen <= grip ? slide : Eigen::Vector3f((grip / slideLen) * slide);
+    dx += (kOmega * wi / (wi + wj)) * (depth * nrm - back);
+    return true;
+}
+
 }  // namespace
 
 float wispRadius(float hairsPerGuide, float targetDensityPerCm2) {
@@ -85,38 +124,7 @@ size_t WispContact::apply(const ContactInput& in, const ParallelFor& parallel) {
                                 for (uint32_t o = bucketStart_[k]; o < bucketStart_[k + 1]; ++o) {
                                     const size_t j = order_[o];
                                     if (j / perGuide == gi || cell_[j] != c) continue;  // own guide; hash collision
-                                    const Eigen::Vector3f cur = in.x[i] - in.x[j];
-                                    const float dist2 = cur.squaredNorm();
-                                    if (dist2 >= d * d) continue;
-                                    const Eigen::Vector3f start = in.x0[i] - in.x0[j];
-                                    const float d0 = start.norm();
-                                    // Crossed since the start: back to the side it came from.
-                                    Eigen::Vector3f nrm;
-                                    float dist;
-                                    if (cur.dot(start) < 0.f && d0 > 0.f) {
-                                        nrm = start / d0;
-                                        dist = cur.dot(nrm);
-                                    } else if (dist2 > 0.f) {
-                                        dist = std::sqrt(dist2);
-                                        nrm = cur / dist;
-                                    } else {
-                                        continue;  // coincident now and at the start: no direction
-                                    }
-                                    const float bound = std::min(d, d0);
-                                    if (dist >= bound) continue;
-                                    const float wj = in.mass[j] > 0.f ? 1.f / in.mass[j] : 0.f;
-                                    const float depth = bound - dist;
-                                    // Friction at position level (Macklin, Müller, Chentanez and Kim,
-                                    // "Unified Particle Physics for Real-Time Applications", 2014):
-                                    // the pair's relative slide over the substep, taken back whole
-                                    // below μ·depth (static), by μ·depth above it (kinetic).
-                                    Eigen::Vector3f slide = (in.x[i] - in.x0[i]) - (in.x[j] - in.x0[j]);
-                                    slide -= slide.dot(nrm) * nrm;
-                                    const float slideLen = slide.norm(), grip = in.friction * depth;
-                                    const Eigen::Vector3f back =
-                                        slideLen <= grip ? slide : (slideLen > 0.f ? (grip / slideLen) * slide : slide);
-                                    dx += (kOmega * wi / (wi + wj)) * (depth * nrm - back);
-                                    ++count;
+                                    if (pairMove(in, i, j, d, wi, dx)) ++count;
                                 }
                             }
                 }
