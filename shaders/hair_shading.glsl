@@ -48,7 +48,8 @@ vec3 shadeLight(int i, int s, bool point, vec3 world, vec3 t, vec3 n, vec3 v, ve
             reach = min(meanDepth, max(half_, 1.0));
         }
         float spreadU = uShadowColor.w * reach;
-        vec3 f = fittedHair(albedo, t, l, v, 0.0) + chain * fittedHairScattered(albedo, t, l, v, spreadU, uLobeShape[0].z * reach) +
+        vec3 fScattered;
+        vec3 f = fittedHairBoth(albedo, t, l, v, spreadU, uLobeShape[0].z * reach, fScattered) + chain * fScattered +
                  hairLobe(3, t, l, v, spreadU) * (column >= 0.0 ? vec3(1.0) - exp(-(vec3(1.0) - af * af) * 0.5 * column) : vec3(1.0));
         return f * radiance * headVisibility(s, world);
     }

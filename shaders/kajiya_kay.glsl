@@ -92,13 +92,6 @@ vec3 hairLobeTurned(int k, vec3 t, vec3 l, vec3 v, float spread, float turn) {
 
 vec3 hairLobe(int k, vec3 t, vec3 l, vec3 v, float spread) { return hairLobeTurned(k, t, l, v, spread, 0.0); }
 
-// The fitted single-fibre response (kajiyaKay() in HairShading::Fitted):
-// diffuse kd * albedo * cos(thetaI) plus R, TRT and TT, each spread by `spread`.
-vec3 fittedHair(vec3 albedo, vec3 t, vec3 l, vec3 v, float spread) {
-    return uHairColor.w * sinBetween(t, l) * albedo + hairLobe(0, t, l, v, spread) + hairLobe(1, t, l, v, spread) +
-           hairLobe(2, t, l, v, spread);
-}
-
 // Lobe k for straight light (no spread, N as tabulated), and in `scattered` for
 // light spread by `spread` and turned by `turn` (hairLobeTurned): the two share
 // their angles and table lookups, which are most of a lobe's cost.
@@ -112,7 +105,8 @@ vec3 hairLobeBoth(int k, vec3 t, vec3 l, vec3 v, float spread, float turn, out v
     return strength * (pow(c, uLobeShape[k].x) * projected * azimuthal);
 }
 
-// The fitted single-fibre response to straight light (fittedHair(.., 0)), and in
+// The fitted single-fibre response (kajiyaKay() in HairShading::Fitted: diffuse
+// kd * albedo * cos(thetaI) plus R, TRT and TT) to straight light, and in
 // `scattered` to light that reached the fibre through n other fibres (Zinke 2008's
 // f_s^scatter): every lobe spread along the fibre by `spread` = n beta_f^2 and
 // turned about it by `turn` = n s_phi^2.
@@ -123,11 +117,4 @@ vec3 fittedHairBoth(vec3 albedo, vec3 t, vec3 l, vec3 v, float spread, float tur
                     hairLobeBoth(2, t, l, v, spread, turn, tt);
     scattered = diffuse + r + trt + tt;
     return straight;
-}
-
-// ... for light that reached the fibre through n other fibres (Zinke 2008's f_s^scatter):
-// every lobe spread longitudinally by `spread` = n beta_f^2 and turned in azimuth by `turn` = n s_phi^2.
-vec3 fittedHairScattered(vec3 albedo, vec3 t, vec3 l, vec3 v, float spread, float turn) {
-    return uHairColor.w * sinBetween(t, l) * albedo + hairLobeTurned(0, t, l, v, spread, turn) +
-           hairLobeTurned(1, t, l, v, spread, turn) + hairLobeTurned(2, t, l, v, spread, turn);
 }
