@@ -99,11 +99,14 @@ std::vector<uint32_t> partsAroundRoots(const MeshPartition& partition, const Tri
                                        const std::vector<SurfacePoint>& roots, float tolerance) {
     std::vector<uint32_t> masks(roots.size(), 0u);
     if (partition.count() < 2) return masks;
+    // Each part as posed, kept for the winding numbers of the roots' own
+    // parts, and its exact collider.
+    std::vector<TriangleMesh> posed;
     std::vector<std::unique_ptr<MeshCollider>> parts;
-    for (size_t k = 0; k < std::min<size_t>(partition.count(), kMaxIgnoredParts); ++k)
-        parts.push_back(std::make_unique<MeshCollider>(partition.part(mesh, k), partition.welds[k]));
-    std::vector<TriangleMesh> posed;  // for the winding numbers of the roots' own parts
-    for (size_t k = 0; k < parts.size(); ++k) posed.push_back(partition.part(mesh, k));
+    for (size_t k = 0; k < std::min<size_t>(partition.count(), kMaxIgnoredParts); ++k) {
+        posed.push_back(partition.part(mesh, k));
+        parts.push_back(std::make_unique<MeshCollider>(posed.back(), partition.welds[k]));
+    }
     for (size_t r = 0; r < roots.size(); ++r) {
         const uint32_t own = partition.triangleParts[roots[r].triangle];
         const Vec3f p = evaluate(mesh, roots[r]).position;
