@@ -2,6 +2,7 @@
 // draw their strands in.
 #pragma once
 
+#include "render/reference/hair_fit.h"
 #include "render/view/simple_view.h"
 #include "sim/strands/head.h"
 #include "sim/strands/synthetic.h"
@@ -40,6 +41,28 @@ inline HairOnHead hairOnHead(int width, int height) {
                  testView(width, height, Vec3f(-1.f, -1.f, -1.f))};
     h.view.camera.position = Vec3f(0.f, 0.05f, 0.9f);
     return h;
+}
+
+/// @brief Four light set-ups of `base` that exercise every shading path
+/// of the preview's hair programs (test_preview_shadows.cpp,
+/// test_preview_compute.cpp): 0 one light, shadowed, Kajiya-Kay; 1 the rig with
+/// the rim unshadowed; 2 the same with fitted hair and an unshadowed point
+/// light; 3 no light shadowed.
+inline std::vector<View> lightSetups(const View& base) {
+    std::vector<View> views(4, base);
+    views[1].lights = threePointRig();
+    views[1].lights[2].castsShadows = false;
+    views[2] = views[1];
+    fitHairMaterial(HairFiberParams{}, &views[2].hair);
+    Light point;
+    point.type = LightType::Point;
+    point.position = Vec3f(0.4f, 0.3f, 0.6f);
+    point.intensity = 0.2f;
+    point.castsShadows = false;
+    views[2].lights.push_back(point);
+    views[3] = views[2];
+    for (Light& l : views[3].lights) l.castsShadows = false;
+    return views;
 }
 
 }  // namespace hp::test

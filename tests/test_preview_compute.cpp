@@ -44,25 +44,6 @@ std::pair<double, double> largestDifference(const Image& a, const Image& b) {
     return {diff, peak};
 }
 
-/// The views of the test: 0 one light, shadowed, Kajiya-Kay; 1 the rig with
-/// the rim unshadowed; 2 the same with fitted hair and an unshadowed point
-/// light; 3 no light shadowed.
-std::vector<View> lightSetups(const View& base) {
-    std::vector<View> views(4, base);
-    views[1].lights = threePointRig();
-    views[1].lights[2].castsShadows = false;
-    views[2] = views[1];
-    fitHairMaterial(HairFiberParams{}, &views[2].hair);
-    Light point;
-    point.type = LightType::Point;
-    point.position = Vec3f(0.4f, 0.3f, 0.6f);
-    point.intensity = 0.2f;
-    point.castsShadows = false;
-    views[2].lights.push_back(point);
-    views[3] = views[2];
-    for (Light& l : views[3].lights) l.castsShadows = false;
-    return views;
-}
 
 // Tolerance, relative to the brightest pixel: 1e-4 for the two paths
 // evaluating the same expressions in different shader stages (the compiler
@@ -88,7 +69,7 @@ TEST(PreviewCompute, ComputeShadedVerticesMatchStageShadedOnes) {
     s.tessellationPixels = 0.f;
     s.shadow.resolution = 32;
     s.shadow.otherResolution = 16;
-    const std::vector<View> views = lightSetups(h.view);
+    const std::vector<View> views = test::lightSetups(h.view);
     struct Case {
         const char* name;
         HairBlend blend;
@@ -131,7 +112,7 @@ TEST(PreviewCompute, DefaultTessellationStaysWithinPerVertexError) {
     h.view.head.ambient = 0.f;
     PreviewSettings s;
     s.shadow.resolution = 64;
-    View v = lightSetups(h.view)[2];  // the rig, fitted hair: the sharpest lobes
+    View v = test::lightSetups(h.view)[2];  // the rig, fitted hair: the sharpest lobes
     PreviewSettings stage = s, compute = s, fragment = s;
     stage.shadeInCompute = false;
     compute.shadeInCompute = true;

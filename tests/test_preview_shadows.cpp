@@ -311,19 +311,7 @@ TEST(PreviewShadows, EachViewIsShadedWithItsOwnLights) {
     HP_REQUIRE_GL();
     test::HairOnHead h = test::hairOnHead(96, 72);
     h.view.head.ambient = 0.f;
-    std::vector<View> views(4, h.view);  // 0: the one light, shadowed, Kajiya-Kay
-    views[1].lights = threePointRig();   // 1: three lights, the rim unshadowed
-    views[1].lights[2].castsShadows = false;
-    views[2] = views[1];                 // 2: the same, fitted hair, and a point light
-    fitHairMaterial(HairFiberParams{}, &views[2].hair);
-    Light point;
-    point.type = LightType::Point;
-    point.position = Vec3f(0.4f, 0.3f, 0.6f);
-    point.intensity = 0.2f;
-    point.castsShadows = false;
-    views[2].lights.push_back(point);
-    views[3] = views[2];                 // 3: no light shadowed
-    for (Light& l : views[3].lights) l.castsShadows = false;
+    const std::vector<View> views = test::lightSetups(h.view);
     PreviewSettings s;
     s.shadow.resolution = 32;
     s.shadow.otherResolution = 16;
