@@ -1,8 +1,10 @@
 // The preview shadows every light that casts shadows (up to
 // PreviewShadowSettings::maxLights), each through its own light grid, voxel
 // density and head shadow map: a second light's shadow through a slab of hair
-// is Beer-Lambert's, computed here from the slab's strand density; shadowing
-// the rig's fill darkens the hair; the cap and the slot order hold.
+// is Beer-Lambert's, computed here from the slab's strand density; the skin
+// under a slab of hair lights it as a Lambertian plane's bounce does
+// (analytic); shadowing the rig's fill darkens the hair; the cap and the
+// slot order hold.
 //
 // Set HAIRPIPE_TEST_DUMP=<folder> to write the images as EXR there.
 #include "gl_support.h"
