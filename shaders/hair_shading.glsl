@@ -11,7 +11,9 @@
 // the local back-scatter d_b f_back (lobe 3), scaled by how much hair lies
 // behind the point (C_b, the rest of the voxel column):
 //   L = sum over lights of E shadowMap [exp(-C) (f + B(0)) + (T_f - exp(-C)) d_f (f_turned(n) + B(n))],
-//   B(n) = (1 - exp(-(1 - a_f^2) C_b)) d_b f_back(n beta_f^2), n = C / (1 - exp(-C)).
+//   B(n) = (1 - exp(-(1 - a_f^2) C_b)) d_b f_back(n beta_f^2), n = C / (1 - exp(-C)),
+// plus the scalp's bounce under the hair (scalpBounce below): the skin lit through
+// the hair's column lights the fibres above it.
 // Evaluated per ribbon vertex (default; Gouraud along the strand, which
 // software rasterizers need for speed) or per fragment (SHADE_PER_FRAGMENT).
 #include "kajiya_kay.glsl"
@@ -20,6 +22,38 @@
 // Zinke 2008's forward density factor d_f (their 0.7 for human hair): the
 // share of forward-scattered light that meets the next fibre of a chain.
 const float kForwardDensity = 0.7;
+// The scalp's bounce: light that crossed the hair to the skin, reflected
+// diffusely by it and scattered by the fibre above it. The hair lies on the
+// scalp as a layer over a Lambertian plane: along the light's ray through the
+// point the whole column C_all = c.y of hair lies between the light and the
+// skin (where the ray meets the head: the shadow map's head lies behind the
+// point, headBehind), so the skin receives E cos(theta_s) T_f(C_all), with
+// T_f(C) = exp(-(1 - a_f) C) the forward transmittance that lights the head's
+// own skin (shadow.glsl hairOnlyVisibility), and leaves with the radiance
+//   L_s = rho (1 - k_s) / pi * E cos(theta_s) T_f(C_all)
+// (render/view/view.cpp skinShade's diffuse part, its wrap left out). The
+// fibre meets it through the C_b = c.y - c.x crossings between it and the skin
+// (the light's column taken back), T_f(C_b), and by reciprocity a fibre lit
+// by radiance L over the half space it faces sends the viewer
+// L int S cos(theta_i) d(omega_i) = L a_f: the share of light arriving from the
+// viewer that it scatters forward, away from the viewer, into that half space
+// (Zinke et al. 2008's forward albedo, one of the fitted dual-scattering
+// terms). The skin's normal n_s is not known here; the hair lies on the scalp,
+// so n_s is perpendicular to the fibre and faces the viewer: taken uniform over
+// that half circle (angle psi from the ribbon normal n, gamma the light's angle
+// from n in the plane across the fibre, |l_p| = sin(t, l)),
+//   E[max(0, n_s . l)] = |l_p| / pi int_{-pi/2}^{pi/2} max(0, cos(psi - gamma)) dpsi
+//                      = |l_p| (1 + cos gamma) / pi.
+// Per unit light radiance:
+//   B = headBehind a_f T_f(C_b) rho (1 - k_s) / pi * |l_p| (1 + cos gamma) / pi * T_f(C_all).
+vec3 scalpBounce(int s, vec3 world, vec3 t, vec3 n, vec3 l, vec3 af, vec2 c) {
+    vec3 lp = l - dot(l, t) * t;
+    float lpLength = length(lp);
+    float cosGamma = lpLength > 1e-6 ? dot(n, lp) / lpLength : 0.0;
+    float skinCos = lpLength * (1.0 + cosGamma) * 0.31830989;
+    vec3 skin = uHeadColor.rgb * ((1.0 - clamp(uHeadSkin.y, 0.0, 1.0)) * skinCos * 0.31830989) * exp(-uShadowColor.rgb * c.y);
+    return headBehind(s, world) * af * exp(-uShadowColor.rgb * max(c.y - c.x, 0.0)) * skin;
+}
 
 // Light i's share, its shadow slot s (-1 none) and type given: constants
 // when the program is compiled for its lights (HAIR_LIGHTS below).
@@ -75,7 +109,8 @@ vec3 shadeLight(int i, int s, bool point, vec3 world, vec3 t, vec3 n, vec3 v, ve
     vec3 fScattered, backScattered;
     vec3 fStraight = fittedHairBoth(albedo, t, l, v, spread, uLobeShape[0].z * crossed, fScattered);
     vec3 backStraight = hairLobeBoth(3, t, l, v, spread, 0.0, backScattered);
-    vec3 f = direct * (fStraight + backStraight * depthFactor) + scattered * (fScattered + backScattered * depthFactor);
+    vec3 f = direct * (fStraight + backStraight * depthFactor) + scattered * (fScattered + backScattered * depthFactor) +
+             scalpBounce(s, world, t, n, l, af, c);
     return f * radiance * headVisibility(s, world);
 }
 

@@ -70,6 +70,17 @@ float headVisibility(int s, vec3 world) {
     return shadowMapVisibility(s, world);
 }
 
+// 1 where the light's ray through a point goes on to meet the head (the skin
+// lies behind the point, seen from the light of slot s), 0 where it leaves
+// past the head: one comparison with the shadow map at the grid's far end.
+float headBehind(int s, vec3 world) {
+    if (s < 0 || (SHADE_FLAGS & kFlagShadowMap) == 0) return 0.0;
+    vec4 c = uSlotClip[s] * vec4(world, 1.0);
+    vec3 p = c.xyz / c.w * 0.5 + 0.5;
+    if (any(lessThan(p.xy, vec2(0.0))) || any(greaterThan(p.xy, vec2(1.0)))) return 0.0;
+    return 1.0 - texture(uShadowMap, vec4(p.xy, float(s), 0.9999));
+}
+
 // The head's own visibility: hair shadows only, as in the reference
 // (render/reference/embree_scene.h RayStart::throughHead: a low-poly head shadowing
 // itself cuts its smooth shading into a staircase along the terminator).
