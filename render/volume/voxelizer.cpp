@@ -3,6 +3,7 @@
 #include "core/errors.h"
 #include "render/volume/cell_walk.h"
 
+#include <emmintrin.h>  // SSE2, the x86-64 baseline
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -58,34 +59,50 @@ struct SegmentVelocity {
     Vec3f v0, v1;
 };
 
+/// Voxels per axis of a tile's accumulator: the tile's own kTile voxels and
+/// one on each side, so a dual cell's 8 corners (cells −1 .. kTile−1 reach
+/// the tile) are always inside it and a deposit needs no bounds checks. The
+/// border voxels belong to neighbouring tiles (which compute the same pieces
+/// and keep them); they are discarded.
+constexpr int kPad = kTile + 2;
+/// Cell blocks: dual cells c grouped by (c + 1) >> 3 per axis (0 .. kBlocksPerTile),
+/// the unit in which the accumulator records where deposits went.
+constexpr int kCellBlocks = kBlocksPerTile + 1;
+
 /// A tile's dense accumulator: C channels per voxel (density, or density and
-/// momentum = density × velocity). Stored block by block in OpenVDB's leaf
-/// order, so a block is extracted and cleared as one contiguous run.
+/// momentum = density × velocity), x-major over the padded kPad³ voxels
+/// (tile-local −1 .. kTile), in double precision so that each voxel's sum
+/// keeps the mass error at the float grid's rounding.
 template <int C>
 struct TileBuffer {
     Vec3i origin;  // first voxel of the tile
-    std::vector<double> values = std::vector<double>(size_t(kTileVoxels) * C, 0.0);
-    static constexpr int kBlocks = kBlocksPerTile * kBlocksPerTile * kBlocksPerTile;
-    uint64_t touched[(kBlocks + 63) / 64] = {};  // bit b: block b received deposits (sparse hair touches few)
+    std::vector<double> values = std::vector<double>(size_t(kPad) * kPad * kPad * C, 0.0);
+    /// Bit per cell block that received deposits (sparse hair touches few).
+    uint64_t touched[(kCellBlocks * kCellBlocks * kCellBlocks + 63) / 64] = {};
 
-    static int block(int x, int y, int z) { return ((x >> 3) * kBlocksPerTile + (y >> 3)) * kBlocksPerTile + (z >> 3); }
-    /// Position of tile-local voxel (x, y, z) in `values`, in voxels.
-    static int index(int x, int y, int z) {
-        return block(x, y, z) * kBlockVoxels + DensityGrid::voxelOffset(x & 7, y & 7, z & 7);
+    /// Position of tile-local voxel (x, y, z), each in −1 .. kTile, in `values`, in voxels.
+    static int index(int x, int y, int z) { return ((x + 1) * kPad + (y + 1)) * kPad + (z + 1); }
+    static int cellBlock(int x, int y, int z) {
+        return (((x + 1) >> 3) * kCellBlocks + ((y + 1) >> 3)) * kCellBlocks + ((z + 1) >> 3);
     }
-    static int index(const Vec3i& v) { return index(v.x(), v.y(), v.z()); }
-    /// Voxel `local`'s C channels, marking its block touched.
-    double* at(const Vec3i& local) {
-        const int b = block(local.x(), local.y(), local.z());
+    /// Records a deposit from the dual cell (x, y, z) (or, for the box
+    /// filter, into voxel (x, y, z), whose cell block is one of the voxel's).
+    void mark(int x, int y, int z) {
+        const int b = cellBlock(x, y, z);
         touched[b >> 6] |= uint64_t(1) << (b & 63);
-        return &values[size_t(index(local)) * C];
+    }
+    bool isTouched(int bx, int by, int bz) const {
+        const int b = (bx * kCellBlocks + by) * kCellBlocks + bz;
+        return touched[b >> 6] >> (b & 63) & 1;
     }
     bool inside(const Vec3i& local) const {
         return unsigned(local.x()) < unsigned(kTile) && unsigned(local.y()) < unsigned(kTile) &&
                unsigned(local.z()) < unsigned(kTile);
     }
+    /// Adds q to voxel `local` (in the tile: 0 .. kTile−1).
     void add(const Vec3i& local, const double* q) {
-        double* v = at(local);
+        mark(local.x(), local.y(), local.z());
+        double* v = &values[size_t(index(local.x(), local.y(), local.z())) * C];
         for (int c = 0; c < C; ++c) v[c] += q[c];
     }
 };
@@ -114,6 +131,88 @@ void depositBox(TileBuffer<C>& tile, const Segment& s, const SegmentVelocity* sv
     });
 }
 
+/// The walk's state where a segment enters the dual cells that reach a tile
+/// (see depositTrilinear).
+struct WalkStart {
+    int cell[3], step[3];
+    double tMax[3], inv[3];
+    double tIn, tOut;
+};
+
+/// Starts the dual-cell walk of segment s at the part whose cells reach the
+/// tile at `origin`, cells [origin − 1, origin + kTile) per axis: t ∈ [tIn,
+/// tOut], its ends plane crossings computed as the walk computes them.
+/// False if the segment misses those cells.
+bool startWalk(const Segment& s, const Vec3i& origin, WalkStart* w) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    double tIn = 0, tOut = 1;
+    for (int e = 0; e < 3; ++e) {
+        const double a = s.a[e], d = s.b[e] - a;
+        w->inv[e] = d != 0 ? 1.0 / d : 0.0;
+        w->step[e] = d > 0 ? 1 : (d < 0 ? -1 : 0);
+        const int lo = origin[e] - 1, hi = origin[e] + kTile;  // the box's planes
+        if (w->step[e] == 0) {
+            if (!(a >= lo && a < hi)) return false;
+            continue;
+        }
+        const double tLo = (lo - a) * w->inv[e], tHi = (hi - a) * w->inv[e];
+        tIn = std::max(tIn, w->step[e] > 0 ? tLo : tHi);
+        tOut = std::min(tOut, w->step[e] > 0 ? tHi : tLo);
+    }
+    if (!(tIn < tOut)) return false;
+    // The walk's state at tIn: along each axis, every plane whose crossing
+    // time is ≤ tIn has been crossed (crossing times grow with the plane
+    // index, also in floating point, so this is the state the walk from
+    // t = 0 reaches; the pieces from tIn on are the same, bit for bit).
+    for (int e = 0; e < 3; ++e) {
+        const double a = s.a[e];
+        const int start = int(std::floor(a)), step = w->step[e];
+        if (step == 0) {
+            w->cell[e] = start;
+            w->tMax[e] = kInf;
+            continue;
+        }
+        // Plane crossed when leaving cell c forwards: c + 1 (step > 0) or c (step < 0).
+        auto exitTime = [&](int c) { return (c + (step > 0 ? 1 : 0) - a) * w->inv[e]; };
+        int c = tIn > 0 ? int(std::floor(a + (s.b[e] - a) * tIn)) : start;
+        if (step > 0 ? c < start : c > start) c = start;
+        while (exitTime(c) <= tIn) c += step;
+        while (c != start && exitTime(c - step) > tIn) c -= step;
+        w->cell[e] = c;
+        w->tMax[e] = exitTime(c);
+    }
+    w->tIn = tIn;
+    w->tOut = tOut;
+    return true;
+}
+
+/// Calls piece(lx, ly, lz, t0, t1) for each piece [t0, t1] of the segment in
+/// a dual cell that reaches the tile, (lx, ly, lz) the cell's corner (0,0,0)
+/// in tile coordinates (−1 .. kTile−1). The cell walk of cell_walk.h (same
+/// planes, same intervals), written out so the deposit is inlined into it.
+template <typename Piece>
+void walkTile(const Segment& s, const Vec3i& origin, Piece&& piece) {
+    WalkStart w;
+    if (!startWalk(s, origin, &w)) return;
+    const int ox = origin.x(), oy = origin.y(), oz = origin.z();
+    double t = w.tIn;
+    for (;;) {
+        int e = w.tMax[1] < w.tMax[0] ? 1 : 0;
+        e = w.tMax[2] < w.tMax[e] ? 2 : e;
+        const double t1 = std::min(w.tMax[e], 1.0);
+        // The tile owns voxels 0..kTile-1, so cells -1..kTile-1 reach it.
+        const int lx = w.cell[0] - ox, ly = w.cell[1] - oy, lz = w.cell[2] - oz;
+        if (t1 > t && unsigned(lx + 1) <= unsigned(kTile) && unsigned(ly + 1) <= unsigned(kTile) &&
+            unsigned(lz + 1) <= unsigned(kTile))
+            piece(lx, ly, lz, t, t1);
+        if (w.tMax[e] >= w.tOut) return;  // tOut ≤ 1: the segment's end or the box's
+        t = std::max(t, t1);
+        // Recomputed from the plane rather than accumulated (as in cell_walk.h).
+        w.cell[e] += w.step[e];
+        w.tMax[e] = (w.cell[e] + (w.step[e] > 0 ? 1 : 0) - s.a[e]) * w.inv[e];
+    }
+}
+
 /// Trilinear filter: the centre line cut at the planes through voxel centres
 /// (dual cells); within a dual cell every point spreads its volume over the
 /// cell's 8 corner voxels with trilinear weights, which sum to 1. The tile
@@ -123,146 +222,94 @@ void depositBox(TileBuffer<C>& tile, const Segment& s, const SegmentVelocity* sv
 /// For a piece t ∈ [t0, t1] of dual cell c, corner (i, j, l) receives
 ///     k · ∫ r(t)² · X_i(t) · Y_j(t) · Z_l(t) dt,
 /// X_1 = f_x(t) = a_x + d_x t − c_x, X_0 = 1 − X_1 (likewise Y, Z), r linear:
-/// a degree-5 polynomial, integrated exactly by 3-point Gauss-Legendre.
+/// a polynomial of degree 5 (2 from the tapering radius, 3 from the
+/// weights), integrated exactly by 3-point Gauss-Legendre (2 points are
+/// exact to degree 3 only: enough for an untapered segment, not for hair).
 ///
-/// This is the hot loop of the VDB export: the cell walk of cell_walk.h
-/// (same planes, same intervals) is written out here so the deposit is
-/// inlined into it, cells outside the tile cost one compare, and the 8
-/// weights are formed as (w · X_i) · (Y_j · Z_l): 2 + 4 + 8 products per
-/// Gauss point instead of 24.
+/// Density only (C = 1, the hot loop of the VDB export): with w_g = k·h·W_g·r(t_g)²
+/// the rule accumulates the 8 moments Σ_g w_g·{1, f_x}·{1, f_y}·{1, f_z}
+/// as four SSE2 pairs (24 operations a Gauss point), and the corners follow
+/// by inclusion-exclusion, e.g. Σ w·(1 − f_x)·f_y·f_z = M_yz − M_xyz: the same
+/// sums as the products of the weights, in another order (so values differ
+/// in the last bits; the absolute rounding stays ~1e-16 of the piece's
+/// volume). Each corner pair (Z_0, Z_1) is one unaligned add into the padded
+/// buffer.
 template <int C>
 void depositTrilinear(TileBuffer<C>& tile, const Segment& s, const SegmentVelocity* sv) {
-    // Locals, not loads through `s`: the tile's stores are doubles too, so the
-    // compiler could not otherwise keep these in registers.
+    double* const values = tile.values.data();
     const double ax = s.a.x(), ay = s.a.y(), az = s.a.z();
     const double dx = s.b.x() - ax, dy = s.b.y() - ay, dz = s.b.z() - az;
     const double r0 = s.r0, dr = s.r1 - s.r0, k = s.k;
-    int cell[3], step[3];
-    double tMax[3], inv[3];
-    constexpr double kInf = std::numeric_limits<double>::infinity();
-    const int origin[3] = {tile.origin.x(), tile.origin.y(), tile.origin.z()};
-    // The part of the segment inside the dual cells that reach the tile,
-    // [origin − 1, origin + kTile) per axis: t ∈ [tIn, tOut], its ends plane
-    // crossings computed as the walk computes them.
-    double tIn = 0, tOut = 1;
-    for (int e = 0; e < 3; ++e) {
-        const double a = s.a[e], d = s.b[e] - a;
-        inv[e] = d != 0 ? 1.0 / d : 0.0;
-        step[e] = d > 0 ? 1 : (d < 0 ? -1 : 0);
-        const int lo = origin[e] - 1, hi = origin[e] + kTile;  // the box's planes
-        if (step[e] == 0) {
-            if (!(a >= lo && a < hi)) return;
-            continue;
-        }
-        const double tLo = (lo - a) * inv[e], tHi = (hi - a) * inv[e];
-        tIn = std::max(tIn, step[e] > 0 ? tLo : tHi);
-        tOut = std::min(tOut, step[e] > 0 ? tHi : tLo);
-    }
-    if (!(tIn < tOut)) return;
-    // The walk's state at tIn: along each axis, every plane whose crossing
-    // time is ≤ tIn has been crossed (crossing times grow with the plane
-    // index, also in floating point, so this is the state the walk from
-    // t = 0 reaches; the pieces from tIn on are the same, bit for bit).
-    for (int e = 0; e < 3; ++e) {
-        const double a = s.a[e];
-        const int start = int(std::floor(a));
-        if (step[e] == 0) {
-            cell[e] = start;
-            tMax[e] = kInf;
-            continue;
-        }
-        // Plane crossed when leaving cell c forwards: c + 1 (step > 0) or c (step < 0).
-        auto exitTime = [&](int c) { return (c + (step[e] > 0 ? 1 : 0) - a) * inv[e]; };
-        int c = tIn > 0 ? int(std::floor(a + (s.b[e] - a) * tIn)) : start;
-        if (step[e] > 0 ? c < start : c > start) c = start;
-        while (exitTime(c) <= tIn) c += step[e];
-        while (c != start && exitTime(c - step[e]) > tIn) c -= step[e];
-        cell[e] = c;
-        tMax[e] = exitTime(c);
-    }
-    const int ox = origin[0], oy = origin[1], oz = origin[2];
-    double* const values = tile.values.data();
-    double t = tIn;
-    for (;;) {
-        int e = tMax[1] < tMax[0] ? 1 : 0;
-        e = tMax[2] < tMax[e] ? 2 : e;
-        const double t1 = std::min(tMax[e], 1.0);
-        // Corner (0,0,0) of the dual cell in tile coordinates; the tile owns
-        // voxels 0..kTile-1, so cells -1..kTile-1 reach it.
-        const int lx = cell[0] - ox, ly = cell[1] - oy, lz = cell[2] - oz;
-        if (t1 > t && unsigned(lx + 1) <= unsigned(kTile) && unsigned(ly + 1) <= unsigned(kTile) &&
-            unsigned(lz + 1) <= unsigned(kTile)) {
-            const double mid = 0.5 * (t + t1), h = 0.5 * (t1 - t);
-            const double bx = ax - cell[0], by = ay - cell[1], bz = az - cell[2];
+    if constexpr (C == 1) {
+        constexpr double kInf = std::numeric_limits<double>::infinity();
+        const __m128d zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0);
+        const __m128d d1 = _mm_set_pd(dy, dx), d2 = _mm_set_pd(dr, dz);  // _mm_set_pd(high, low)
+        // Clamps of (f_z, r): f_z to [0, 1] (rounding at the cell's faces), r untouched.
+        const __m128d lo2 = _mm_set_pd(-kInf, 0.0), hi2 = _mm_set_pd(kInf, 1.0);
+        walkTile(s, tile.origin, [&](int lx, int ly, int lz, double t0, double t1) {
+            const double mid = 0.5 * (t0 + t1), h = 0.5 * (t1 - t0), kh = k * h;
+            const Vec3i& o = tile.origin;
+            const __m128d b1 = _mm_set_pd(ay - (o.y() + ly), ax - (o.x() + lx));  // f at t = 0
+            const __m128d b2 = _mm_set_pd(r0, az - (o.z() + lz));
+            // u: (Σ w, Σ w f_x), v: (Σ w f_y, Σ w f_x f_y); u1, v1 the same times f_z.
+            __m128d u = zero, v = zero, u1 = zero, v1 = zero;
+            for (int g = 0; g < 3; ++g) {
+                const __m128d tg = _mm_set1_pd(mid + h * kGaussX[g]);
+                const __m128d f1 = _mm_min_pd(_mm_max_pd(_mm_add_pd(b1, _mm_mul_pd(d1, tg)), zero), one);  // (fx, fy)
+                const __m128d f2 = _mm_min_pd(_mm_max_pd(_mm_add_pd(b2, _mm_mul_pd(d2, tg)), lo2), hi2);   // (fz, r)
+                const __m128d r = _mm_unpackhi_pd(f2, f2);
+                const __m128d w = _mm_mul_pd(_mm_mul_pd(r, r), _mm_set1_pd(kh * kGaussW[g]));
+                const __m128d wu = _mm_mul_pd(w, _mm_unpacklo_pd(one, f1));
+                const __m128d wv = _mm_mul_pd(wu, _mm_unpackhi_pd(f1, f1));
+                const __m128d fz = _mm_unpacklo_pd(f2, f2);
+                u = _mm_add_pd(u, wu);
+                v = _mm_add_pd(v, wv);
+                u1 = _mm_add_pd(u1, _mm_mul_pd(wu, fz));
+                v1 = _mm_add_pd(v1, _mm_mul_pd(wv, fz));
+            }
+            // (P_lo, P_hi) = (Σ w·g, Σ w·f_x·g) → (Σ w·X_0·g, Σ w·X_1·g).
+            auto splitX = [&](__m128d p) { return _mm_sub_pd(p, _mm_unpackhi_pd(p, zero)); };
+            const __m128d all0 = splitX(_mm_sub_pd(u, v)), all1 = splitX(v);     // Y_0, Y_1; any z
+            const __m128d top0 = splitX(_mm_sub_pd(u1, v1)), top1 = splitX(v1);  // Y_0, Y_1; Z_1
+            const __m128d bot0 = _mm_sub_pd(all0, top0), bot1 = _mm_sub_pd(all1, top1);  // Z_0
+            // Corner pairs (Z_0, Z_1) of (i, j), at x·kPad² + y·kPad from corner (0,0,0).
+            double* c = values + TileBuffer<C>::index(lx, ly, lz);
+            auto add = [](double* at, __m128d q) { _mm_storeu_pd(at, _mm_add_pd(_mm_loadu_pd(at), q)); };
+            add(c, _mm_unpacklo_pd(bot0, top0));
+            add(c + kPad, _mm_unpacklo_pd(bot1, top1));
+            add(c + kPad * kPad, _mm_unpackhi_pd(bot0, top0));
+            add(c + kPad * kPad + kPad, _mm_unpackhi_pd(bot1, top1));
+            tile.mark(lx, ly, lz);
+        });
+    } else {
+        walkTile(s, tile.origin, [&](int lx, int ly, int lz, double t0, double t1) {
+            const double mid = 0.5 * (t0 + t1), h = 0.5 * (t1 - t0);
+            const double bx = ax - (tile.origin.x() + lx), by = ay - (tile.origin.y() + ly),
+                         bz = az - (tile.origin.z() + lz);
             double q[8][C] = {};  // corner (x-major: ix·4 + iy·2 + iz) × channel
-            // Gauss point g of the piece: its parameter, weight k·h·w_g·r²
-            // and fractional position in the dual cell.
-            struct GaussPoint {
-                double t, w, fx, fy, fz;
-            };
-            auto at = [&](int g) {
+            for (int g = 0; g < 3; ++g) {
                 const double tg = mid + h * kGaussX[g];
                 const double r = r0 + dr * tg;
-                return GaussPoint{tg, k * h * kGaussW[g] * r * r, std::min(std::max(bx + dx * tg, 0.0), 1.0),
-                                  std::min(std::max(by + dy * tg, 0.0), 1.0),
-                                  std::min(std::max(bz + dz * tg, 0.0), 1.0)};
-            };
-            if constexpr (C == 1) {
-                // Density only: the z pair of each (x, y) corner as one SSE2
-                // packet, (w · X_i · Y_j) · (Z_0, Z_1).
-                Eigen::Array2d pair[4] = {Eigen::Array2d::Zero(), Eigen::Array2d::Zero(), Eigen::Array2d::Zero(),
-                                          Eigen::Array2d::Zero()};
-                for (int g = 0; g < 3; ++g) {
-                    const GaussPoint p = at(g);
-                    const double w = p.w, fx = p.fx, fy = p.fy, fz = p.fz;
-                    const double wx0 = w * (1 - fx), wx1 = w * fx;
-                    const Eigen::Array2d z(1 - fz, fz);
-                    pair[0] += (wx0 * (1 - fy)) * z;
-                    pair[1] += (wx0 * fy) * z;
-                    pair[2] += (wx1 * (1 - fy)) * z;
-                    pair[3] += (wx1 * fy) * z;
-                }
-                for (int i = 0; i < 4; ++i) {
-                    q[2 * i][0] = pair[i][0];
-                    q[2 * i + 1][0] = pair[i][1];
-                }
-            } else {
-                for (int g = 0; g < 3; ++g) {
-                    const GaussPoint p = at(g);
-                    const double tg = p.t, w = p.w, fx = p.fx, fy = p.fy, fz = p.fz;
-                    const double wx[2] = {w * (1 - fx), w * fx};
-                    const double y[2] = {1 - fy, fy}, z[2] = {1 - fz, fz};
-                    const Vec3d v = sv->v0.cast<double>() + (sv->v1 - sv->v0).cast<double>() * tg;
-                    for (int i = 0; i < 8; ++i) {
-                        const double c = (wx[i >> 2] * y[(i >> 1) & 1]) * z[i & 1];
-                        q[i][0] += c;
-                        for (int m = 0; m < 3; ++m) q[i][1 + m] += c * v[m];
-                    }
+                const double w = k * h * kGaussW[g] * r * r;
+                const double fx = std::min(std::max(bx + dx * tg, 0.0), 1.0);
+                const double fy = std::min(std::max(by + dy * tg, 0.0), 1.0);
+                const double fz = std::min(std::max(bz + dz * tg, 0.0), 1.0);
+                const double wx[2] = {w * (1 - fx), w * fx};
+                const double y[2] = {1 - fy, fy}, z[2] = {1 - fz, fz};
+                const Vec3d vel = sv->v0.cast<double>() + (sv->v1 - sv->v0).cast<double>() * tg;
+                for (int i = 0; i < 8; ++i) {
+                    const double cw = (wx[i >> 2] * y[(i >> 1) & 1]) * z[i & 1];
+                    q[i][0] += cw;
+                    for (int m = 0; m < 3; ++m) q[i][1 + m] += cw * vel[m];
                 }
             }
-            if (lx >= 0 && ly >= 0 && lz >= 0 && (lx & 7) != 7 && (ly & 7) != 7 && (lz & 7) != 7) {
-                // All 8 corners in one block (7 cells in 8 along each axis;
-                // lx < kTile - 1 follows from lx & 7 != 7).
-                const int b = TileBuffer<C>::block(lx, ly, lz);
-                tile.touched[b >> 6] |= uint64_t(1) << (b & 63);
-                double* v = values + size_t(TileBuffer<C>::index(lx, ly, lz)) * C;
-                for (int i = 0; i < 8; ++i) {
-                    double* corner = v + DensityGrid::voxelOffset(i >> 2, (i >> 1) & 1, i & 1) * C;
-                    for (int c = 0; c < C; ++c) corner[c] += q[i][c];
-                }
-            } else {
-                const Vec3i local(lx, ly, lz);
-                for (int i = 0; i < 8; ++i) {
-                    const Vec3i corner = local + Vec3i(i >> 2, (i >> 1) & 1, i & 1);
-                    if (tile.inside(corner)) tile.add(corner, q[i]);
-                }
+            double* c = values + size_t(TileBuffer<C>::index(lx, ly, lz)) * C;
+            for (int i = 0; i < 8; ++i) {
+                double* corner = c + size_t(((i >> 2) * kPad + ((i >> 1) & 1)) * kPad + (i & 1)) * C;
+                for (int m = 0; m < C; ++m) corner[m] += q[i][m];
             }
-        }
-        if (tMax[e] >= tOut) return;  // tOut ≤ 1: the segment's end or the box's
-        t = std::max(t, t1);
-        // Recomputed from the plane rather than accumulated (as in cell_walk.h).
-        cell[e] += step[e];
-        tMax[e] = (cell[e] + (step[e] > 0 ? 1 : 0) - s.a[e]) * inv[e];
+            tile.mark(lx, ly, lz);
+        });
     }
 }
 
@@ -273,35 +320,59 @@ struct TileBlocks {
     std::vector<DensityGrid::VelocityBlockPtr> velocity;
 };
 
-/// Moves the tile's non-empty blocks into `out` as floats and clears them,
-/// leaving the buffer zeroed for the next tile.
+/// Moves the tile's non-empty blocks into `out` as floats and clears the
+/// buffer (the border voxels too), leaving it zeroed for the next tile.
 template <int C>
 void extractBlocks(TileBuffer<C>& tile, TileBlocks* out) {
-    for (int b = 0; b < kBlocksPerTile * kBlocksPerTile * kBlocksPerTile; ++b) {
-        if (!(tile.touched[b >> 6] >> (b & 63) & 1)) continue;
-        double* v = &tile.values[size_t(b) * kBlockVoxels * C];
-        bool any = false;
-        for (int i = 0; i < kBlockVoxels; ++i) any |= v[i * C] > 0;
-        if (!any) {  // only zero deposits (e.g. exactly on a voxel plane): nothing active
-            std::fill(v, v + size_t(kBlockVoxels) * C, 0.0);
-            continue;
-        }
-        const Vec3i local(b / (kBlocksPerTile * kBlocksPerTile), (b / kBlocksPerTile) % kBlocksPerTile,
-                          b % kBlocksPerTile);
-        out->origins.push_back(tile.origin + local * kBlock);
-        out->density.emplace_back(new DensityGrid::DensityBlock);  // every voxel written below
-        DensityGrid::DensityBlock& density = *out->density.back();
-        for (int i = 0; i < kBlockVoxels; ++i) density[size_t(i)] = float(v[i * C]);
-        if constexpr (C == 4) {
-            out->velocity.emplace_back(new DensityGrid::VelocityBlock);
-            DensityGrid::VelocityBlock& velocity = *out->velocity.back();
-            for (int i = 0; i < kBlockVoxels; ++i) {
-                const double* m = v + i * C;
-                const double w = m[0] > 0 ? 1.0 / m[0] : 0.0;
-                velocity[size_t(i)] = Vec3f(float(m[1] * w), float(m[2] * w), float(m[3] * w));
+    double* const values = tile.values.data();
+    for (int bx = 0; bx < kBlocksPerTile; ++bx)
+        for (int by = 0; by < kBlocksPerTile; ++by)
+            for (int bz = 0; bz < kBlocksPerTile; ++bz) {
+                // Voxel block b receives deposits from the dual cells of cell blocks b and b + 1.
+                bool touched = false;
+                for (int i = 0; i < 8; ++i) touched |= tile.isTouched(bx + (i >> 2), by + ((i >> 1) & 1), bz + (i & 1));
+                if (!touched) continue;
+                const int x0 = bx * kBlock, y0 = by * kBlock, z0 = bz * kBlock;
+                bool any = false;
+                for (int x = 0; x < kBlock; ++x)
+                    for (int y = 0; y < kBlock; ++y) {
+                        const double* row = values + size_t(TileBuffer<C>::index(x0 + x, y0 + y, z0)) * C;
+                        for (int z = 0; z < kBlock; ++z) any |= row[z * C] > 0;
+                    }
+                if (!any) continue;  // only zero deposits (e.g. exactly on a voxel plane): nothing active
+                out->origins.push_back(tile.origin + Vec3i(x0, y0, z0));
+                out->density.emplace_back(new DensityGrid::DensityBlock);  // every voxel written below
+                DensityGrid::DensityBlock& density = *out->density.back();
+                DensityGrid::VelocityBlock* velocity = nullptr;
+                if constexpr (C == 4) {
+                    out->velocity.emplace_back(new DensityGrid::VelocityBlock);
+                    velocity = out->velocity.back().get();
+                }
+                for (int x = 0; x < kBlock; ++x)
+                    for (int y = 0; y < kBlock; ++y) {
+                        const double* row = values + size_t(TileBuffer<C>::index(x0 + x, y0 + y, z0)) * C;
+                        for (int z = 0; z < kBlock; ++z) {
+                            const int i = DensityGrid::voxelOffset(x, y, z);
+                            density[size_t(i)] = float(row[z * C]);
+                            if constexpr (C == 4) {
+                                const double* m = row + z * C;
+                                const double w = m[0] > 0 ? 1.0 / m[0] : 0.0;
+                                (*velocity)[size_t(i)] = Vec3f(float(m[1] * w), float(m[2] * w), float(m[3] * w));
+                            }
+                        }
+                    }
             }
-        }
-        std::fill(v, v + size_t(kBlockVoxels) * C, 0.0);
+    // Clear what the deposits reached: cell block b's cells b·8 − 1 .. b·8 + 6
+    // write voxels b·8 − 1 .. b·8 + 7, padded b·8 .. b·8 + 8.
+    for (int b = 0; b < kCellBlocks * kCellBlocks * kCellBlocks; ++b) {
+        if (!(tile.touched[b >> 6] >> (b & 63) & 1)) continue;
+        const int X = b / (kCellBlocks * kCellBlocks), Y = (b / kCellBlocks) % kCellBlocks, Z = b % kCellBlocks;
+        const int zLo = Z * kBlock, zHi = std::min(Z * kBlock + kBlock, kPad - 1);
+        for (int x = X * kBlock; x <= std::min(X * kBlock + kBlock, kPad - 1); ++x)
+            for (int y = Y * kBlock; y <= std::min(Y * kBlock + kBlock, kPad - 1); ++y) {
+                double* row = values + (size_t(x * kPad + y) * kPad + zLo) * C;
+                std::fill(row, row + size_t(zHi - zLo + 1) * C, 0.0);
+            }
     }
     std::fill(std::begin(tile.touched), std::end(tile.touched), 0);
 }
