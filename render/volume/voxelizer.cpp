@@ -28,7 +28,7 @@ constexpr int kBlockVoxels = DensityGrid::kBlockVoxels;
 
 /// Tiles of 32³ voxels (4³ blocks) are the unit of parallel work: one task
 /// owns a tile, accumulates every segment touching it into a dense buffer
-/// that stays in cache (256 KiB of doubles), in a fixed segment order. So
+/// that stays in cache (34³ doubles with its border, 314 KiB), in a fixed segment order. So
 /// each voxel's sum is formed in the same order whatever the thread count,
 /// and no per-thread copies of the grid need merging.
 constexpr int kTileLog2 = 5;
