@@ -5,6 +5,7 @@
 #include "render/volume/cell_walk.h"
 
 #include <emmintrin.h>  // SSE2, the x86-64 baseline
+#include <xmmintrin.h>  // _mm_prefetch
 
 #include <algorithm>
 #include <cmath>
@@ -19,8 +20,6 @@ namespace {
 /// i.e. r(t)² (degree 2) times the trilinear weights (degree 3) along a line.
 constexpr double kGaussX[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
 constexpr double kGaussW[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
-
-}  // namespace
 
 /// Box filter: the segment's centre line cut at voxel faces; each piece's
 /// exact volume goes to the voxel containing it (if that voxel is in the tile).
@@ -45,8 +44,6 @@ void depositBox(TileBuffer<C>& tile, const Segment& s, const SegmentVelocity* sv
         tile.add(local, q);
     });
 }
-
-namespace {
 
 /// The walk's state where a segment enters the dual cells that reach a tile
 /// (see depositTrilinear).
@@ -164,7 +161,6 @@ void walkTile(const Segment& s, const Vec3i& origin, Piece&& piece) {
     }
 }
 
-}  // namespace
 
 /// Trilinear filter: the centre line cut at the planes through voxel centres
 /// (dual cells); within a dual cell every point spreads its volume over the
@@ -315,19 +311,46 @@ void extractBlocks(TileBuffer<C>& tile, TileBlocks* out) {
         const int zLo = Z * kBlock, zHi = std::min(Z * kBlock + kBlock, kPad - 1);
         for (int x = X * kBlock; x <= std::min(X * kBlock + kBlock, kPad - 1); ++x)
             for (int y = Y * kBlock; y <= std::min(Y * kBlock + kBlock, kPad - 1); ++y) {
+                // In SSE2 pairs: a call to memset per row of 9 cost more than
+                // the clearing. An odd row's extra double is the next voxel of
+                // the same row (zHi < kPad − 1 then), cleared or zero anyway:
+                // extraction is done.
                 double* row = values + (size_t(x * kPad + y) * kPad + zLo) * C;
-                std::fill(row, row + size_t(zHi - zLo + 1) * C, 0.0);
+                for (int i = 0; i < (zHi - zLo + 1) * C; i += 2) _mm_storeu_pd(row + i, _mm_setzero_pd());
             }
     }
     std::fill(std::begin(tile.touched), std::end(tile.touched), 0);
 }
 
 
-template void depositBox<1>(TileBuffer<1>&, const Segment&, const SegmentVelocity*);
-template void depositBox<4>(TileBuffer<4>&, const Segment&, const SegmentVelocity*);
-template void depositTrilinear<1>(TileBuffer<1>&, const Segment&, const SegmentVelocity*);
-template void depositTrilinear<4>(TileBuffer<4>&, const Segment&, const SegmentVelocity*);
-template void extractBlocks<1>(TileBuffer<1>&, TileBlocks*);
-template void extractBlocks<4>(TileBuffer<4>&, TileBlocks*);
+}  // namespace
+
+/// How many segments ahead the tile loop prefetches.
+constexpr size_t kPrefetch = 4;
+
+template <int C>
+void fillTile(TileBuffer<C>& tile, bool box, const Segment* segments, const SegmentVelocity* velocities,
+              const uint32_t* ids, size_t count, TileBlocks* out) {
+    for (size_t i = 0; i < count; ++i) {
+        // A tile's segments are near in memory, not adjacent: fetch one a
+        // few walks ahead (its load was ~10% of the loop).
+        if (i + kPrefetch < count) {
+            const char* ahead = reinterpret_cast<const char*>(&segments[ids[i + kPrefetch]]);
+            _mm_prefetch(ahead, _MM_HINT_T0);
+            _mm_prefetch(ahead + sizeof(Segment) - 1, _MM_HINT_T0);
+        }
+        const SegmentVelocity* v = C == 4 ? &velocities[ids[i]] : nullptr;
+        if (box)
+            depositBox(tile, segments[ids[i]], v);
+        else
+            depositTrilinear(tile, segments[ids[i]], v);
+    }
+    extractBlocks(tile, out);
+}
+
+template void fillTile<1>(TileBuffer<1>&, bool, const Segment*, const SegmentVelocity*, const uint32_t*, size_t,
+                          TileBlocks*);
+template void fillTile<4>(TileBuffer<4>&, bool, const Segment*, const SegmentVelocity*, const uint32_t*, size_t,
+                          TileBlocks*);
 
 }  // namespace hp::voxel_tiles

@@ -94,16 +94,14 @@ struct TileBlocks {
 };
 
 
-/// Deposits segment s into the tile (the part of it whose voxels the tile
-/// owns), with the box or the trilinear filter; `sv` its end-point
-/// velocities when C = 4 (else null). Defined for C = 1 and C = 4.
+/// Deposits the `count` segments segments[ids[0 .. count)] into the tile
+/// (the part of each whose voxels the tile owns), in that order, with the
+/// box or the trilinear filter (`velocities`: their end-point velocities
+/// when C = 4, else null), then moves the tile's non-empty blocks into `out`
+/// as floats and clears the buffer (the border voxels too) for the next
+/// tile. Defined for C = 1 and C = 4.
 template <int C>
-void depositBox(TileBuffer<C>& tile, const Segment& s, const SegmentVelocity* sv);
-template <int C>
-void depositTrilinear(TileBuffer<C>& tile, const Segment& s, const SegmentVelocity* sv);
-/// Moves the tile's non-empty blocks into `out` as floats and clears the
-/// buffer (the border voxels too), leaving it zeroed for the next tile.
-template <int C>
-void extractBlocks(TileBuffer<C>& tile, TileBlocks* out);
+void fillTile(TileBuffer<C>& tile, bool box, const Segment* segments, const SegmentVelocity* velocities,
+              const uint32_t* ids, size_t count, TileBlocks* out);
 
 }  // namespace hp::voxel_tiles

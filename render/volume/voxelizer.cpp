@@ -3,7 +3,6 @@
 #include "core/errors.h"
 #include "render/volume/voxel_tiles.h"
 
-#include <xmmintrin.h>  // _mm_prefetch (SSE, the x86-64 baseline)
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -202,9 +201,6 @@ TileBins binSegments(const std::vector<Segment>& segments, VoxelFilter filter, d
     return bins;
 }
 
-/// How many segments ahead the tile loop prefetches.
-constexpr size_t kPrefetch = 4;
-
 template <int C>
 DensityGrid voxelizeTiles(const StrandFrame& strands, const GridTransform& transform,
                           const VoxelizeSettings& settings) {
@@ -230,23 +226,8 @@ DensityGrid voxelizeTiles(const StrandFrame& strands, const GridTransform& trans
         TileBuffer<C>& tile = buffers.local();
         for (size_t t = range.begin(); t != range.end(); ++t) {
             tile.origin = DensityGrid::blockCoordOfKey(bins.keys[t]) * kTile;
-            const size_t end = bins.start[t + 1];
-            for (size_t i = bins.start[t]; i < end; ++i) {
-                const uint32_t g = bins.segments[i];
-                // A tile's segments are near in memory, not adjacent: fetch
-                // one a few walks ahead (its load was ~10% of the loop).
-                if (i + kPrefetch < end) {
-                    const char* ahead = reinterpret_cast<const char*>(&segments[bins.segments[i + kPrefetch]]);
-                    _mm_prefetch(ahead, _MM_HINT_T0);
-                    _mm_prefetch(ahead + sizeof(Segment) - 1, _MM_HINT_T0);
-                }
-                const SegmentVelocity* v = C == 4 ? &velocities[g] : nullptr;
-                if (settings.filter == VoxelFilter::Box)
-                    depositBox(tile, segments[g], v);
-                else
-                    depositTrilinear(tile, segments[g], v);
-            }
-            extractBlocks(tile, &results[t]);
+            fillTile(tile, settings.filter == VoxelFilter::Box, segments.data(), C == 4 ? velocities.data() : nullptr,
+                     &bins.segments[bins.start[t]], bins.start[t + 1] - bins.start[t], &results[t]);
             if (bytes.fetch_add(results[t].origins.size() * blockBytes) > limit)
                 throw Error(cat("voxelize: the density grid needs more than ", settings.maxMemoryGiB,
                                 " GiB; use a larger voxel size"));
