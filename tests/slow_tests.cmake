@@ -21,6 +21,7 @@ set(_hp_slow_tests
   test_preview_stage:PreviewStage.ViewerRendersUnderXvfb       # Xvfb start-up
   test_guides:Guides.StableOverTenThousandStepsWithATeleport   # 10^4 solver steps
   test_vdb:VdbFile.BytesAreIdenticalForOneAndTwoThreadsAndRepeatedWrites
+  test_voxelizer:Voxelizer.ConservesHairVolumeOfAHeadOfHairToFloatRounding  # 20,000 strands at 1 mm
   test_shot_simulation:ShotSimulation.DefaultClipKeepsLengthsRootsAndClearance
   test_shot_simulation:ShotSimulation.CheckpointRestoreContinuesBitForBit
   test_hair_grid:Volume.BallOfStrandsDroppedOnSphereStaysLessDense   # two 3 s drops of 48 strands

@@ -3,7 +3,7 @@
 //
 // Shared by the voxelizer's box filter and DensityGrid's ray integrals, so
 // both cut segments at exactly the same planes. The trilinear voxelizer
-// (render/volume/voxelizer.cpp) writes the same walk out inline, started
+// (render/volume/voxel_tiles.cpp) writes the same walk out inline, started
 // where a segment enters a tile, with the same plane formula.
 #pragma once
 

@@ -24,6 +24,12 @@
 // usage: bench_vdb [--strands N] [--voxel m ...] [--threads n ...] [--runs k]
 //                  [--filter box|trilinear] [--velocity] [--float] [--compression blosc|none] [--limits]
 //                  [--keep DIR]   (keep the written files there)
+//                  [--compare FILE] (compare the first run's grid with the density of a
+//                                  float VDB written before, e.g. by another build with
+//                                  --float --keep: active voxels, max relative difference)
+//                  [--frames N]   (instead: frames 1..N, each turned 0.5° from the last,
+//                                  voxelized and written serially, then with frame k
+//                                  written while frame k+1 voxelizes: seconds per frame)
 //                  [--sequence F] (instead: write frames 1..F of the hair spinning with the
 //                                  B-sim head, 90°/s about +Y at 24 fps, as hair.####.vdb —
 //                                  the whole-sequence time, and files to check in a DCC)
@@ -47,7 +53,10 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 #include <unistd.h>
+#include <limits>
+#include <unordered_map>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -153,19 +162,109 @@ void reportLimits(const StrandFrame& frame, double h) {
                 double(values * 4) / best * 1e-6, best);
 }
 
+/// --compare: how `grid` differs from the density of a float VDB file written
+/// earlier (e.g. by another build with --float --keep): voxels active in one
+/// and not the other, and the largest relative difference of a voxel's value.
+void compareWith(const fs::path& file, const DensityGrid& grid) {
+    const DensityGrid other = readDensityVdb(file).density;
+    std::unordered_map<uint64_t, size_t> blocks;
+    for (size_t b = 0; b < other.blockCount(); ++b)
+        blocks.emplace(DensityGrid::blockKey(other.blockOrigin(b) / DensityGrid::kBlockSize), b);
+    size_t onlyHere = 0, onlyThere = 0, differ = 0, same = 0;
+    double maxRelative = 0;
+    for (size_t b = 0; b < grid.blockCount(); ++b) {
+        const auto it = blocks.find(DensityGrid::blockKey(grid.blockOrigin(b) / DensityGrid::kBlockSize));
+        const float* there = it == blocks.end() ? nullptr : other.blockDensity(it->second);
+        for (int i = 0; i < DensityGrid::kBlockVoxels; ++i) {
+            const float a = grid.blockDensity(b)[i], o = there ? there[i] : 0.f;
+            if ((a > 0) != (o > 0)) ++(a > 0 ? onlyHere : onlyThere);
+            if (a > 0 && o > 0) {
+                a == o ? ++same : ++differ;
+                maxRelative = std::max(maxRelative, std::abs(double(a) - double(o)) / double(o));
+            }
+        }
+        if (there) blocks.erase(it);
+    }
+    for (const auto& kv : blocks)
+        for (int i = 0; i < DensityGrid::kBlockVoxels; ++i) onlyThere += other.blockDensity(kv.second)[i] > 0;
+    std::printf("compared with %s: %zu voxels active only here, %zu only there; of the common ones %zu equal, "
+                "%zu differ, max relative difference %.3g (float ulp %.3g)\n",
+                file.c_str(), onlyHere, onlyThere, same, differ, maxRelative, double(std::numeric_limits<float>::epsilon()));
+}
+
+/// Frame f of a short shot: the strands turned by 0.5° per frame about +Y
+/// (the B-sim head's spin, slowed), so no two frames voxelize alike.
+StrandFrame turnedFrame(const StrandFrame& frame, int f) {
+    const Eigen::Matrix3f turn = Eigen::AngleAxisf(0.00872665f * float(f), Vec3f::UnitY()).toRotationMatrix();
+    StrandFrame moved = frame;
+    for (Vec3f& p : moved.positions) p = turn * p;
+    for (Vec3f& v : moved.velocities) v = turn * v;
+    return moved;
+}
+
+/// --frames N: frames 1..N voxelized and written one after the other
+/// (serial), then again with frame k's file written on a second thread while
+/// frame k+1 voxelizes (pipelined: what a shot's frames can do, the write
+/// off the critical path). Wall and process CPU seconds per frame of each,
+/// `runs` times, interleaved.
+void reportFrames(const StrandFrame& frame, double h, int threads, int frames, int runs, const VoxelizeSettings& vs,
+                  const VdbWriteSettings& ws, const fs::path& dir, double volume) {
+    std::vector<StrandFrame> shot;
+    for (int f = 1; f <= frames; ++f) shot.push_back(turnedFrame(frame, f));
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    auto write = [&](int f, DensityGrid&& grid) {
+        VdbFrameInfo info;
+        info.frame = f;
+        info.time = f / 24.0;
+        info.scene = "B-vdb";
+        info.strandCount = shot[size_t(f - 1)].strandCount();
+        info.hairVolume = volume;
+        char name[32];
+        std::snprintf(name, sizeof name, "hair.%04d.vdb", f);
+        writeDensityVdb(dir / name, std::move(grid), info, ws);
+    };
+    std::vector<double> serial, serialCpu, piped, pipedCpu;
+    for (int r = 0; r < runs; ++r) {
+        auto t = std::chrono::steady_clock::now();
+        double c = bench::processCpuSeconds();
+        for (int f = 1; f <= frames; ++f) write(f, voxelize(shot[size_t(f - 1)], GridTransform::uniform(h), vs));
+        serial.push_back(seconds(t) / frames);
+        serialCpu.push_back((bench::processCpuSeconds() - c) / frames);
+
+        t = std::chrono::steady_clock::now();
+        c = bench::processCpuSeconds();
+        std::thread writer;
+        DensityGrid writing;  // the grid the writer thread owns
+        for (int f = 1; f <= frames; ++f) {
+            DensityGrid grid = voxelize(shot[size_t(f - 1)], GridTransform::uniform(h), vs);
+            if (writer.joinable()) writer.join();
+            writing = std::move(grid);
+            writer = std::thread([&, f] { write(f, std::move(writing)); });
+        }
+        writer.join();
+        piped.push_back(seconds(t) / frames);
+        pipedCpu.push_back((bench::processCpuSeconds() - c) / frames);
+    }
+    const bench::Stats s = bench::stats(serial), p = bench::stats(piped);
+    std::printf("%d frames at %.2f mm, %d thread%s, per frame: serial (voxelize, write) %.3f s [%.3f-%.3f] (cpu %.3f s), "
+                "pipelined (write beside the next voxelize) %.3f s [%.3f-%.3f] (cpu %.3f s)\n",
+                frames, h * 1e3, threads, threads == 1 ? "" : "s", s.median, s.min, s.max, bench::stats(serialCpu).median,
+                p.median, p.min, p.max, bench::stats(pipedCpu).median);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     size_t strands = 100000;
     std::vector<double> voxels;
     std::vector<int> threads;
-    int runs = 3, sequence = 0;
+    int runs = 3, sequence = 0, frames = 0;
     VoxelizeSettings vs;
     VdbWriteSettings ws;
     ws.halfFloat = true;  // the scene defaults (pipeline/scene/keys/vdb.yaml)
     ws.compression = VdbCompression::None;
     bool limits = false;
-    fs::path keep;
+    fs::path keep, compare;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string {
@@ -186,6 +285,8 @@ int main(int argc, char** argv) {
         else if (a == "--limits") limits = true;
         else if (a == "--compression") ws.compression = next() == "none" ? VdbCompression::None : VdbCompression::Blosc;
         else if (a == "--keep") keep = next();
+        else if (a == "--compare") compare = next();
+        else if (a == "--frames") frames = std::max(1, std::atoi(next().c_str()));
         else if (a == "--sequence") sequence = std::max(1, std::atoi(next().c_str()));
         else {
             std::fprintf(stderr, "bench_vdb: unknown argument %s (see the comment at the top of bench_vdb.cpp)\n", a.c_str());
@@ -219,6 +320,11 @@ int main(int argc, char** argv) {
     }
     const fs::path dir = keep.empty() ? fs::temp_directory_path() / ("bench_vdb_" + std::to_string(::getpid())) : keep;
     fs::create_directories(dir);
+    if (frames > 0) {
+        reportFrames(frame, voxels.front(), threads.front(), frames, runs, vs, ws, dir, volume);
+        if (keep.empty()) fs::remove_all(dir);
+        return 0;
+    }
     if (sequence > 0) {
         // Frame f: the strands rotated by the head's spin at time f / 24 s.
         const double h = voxels.front();
@@ -267,6 +373,7 @@ int main(int argc, char** argv) {
                 activeVoxels = grid.activeVoxelCount();
                 blocks = grid.blockCount();
                 massError = std::abs(grid.totalVolume() - volume) / volume;
+                if (!compare.empty() && r == 0) compareWith(compare, grid);  // outside the timings
                 VdbFrameInfo info;
                 info.frame = 1;
                 info.scene = "B-vdb";
