@@ -7,6 +7,7 @@
 #include "sim/collision/mesh_parts.h"
 #include "sim/collision/segment_escape.h"
 #include "sim/followers/follower_pinch.h"
+#include "sim/guides/rod_kernels.h"
 
 #include <gtest/gtest.h>
 
@@ -122,4 +123,59 @@ TEST(SegmentEscape, WithNoPlaceOutsideTheLeastDeepIsTakenAtItsLength) {
     EXPECT_NEAR(e.position.norm() / L, 1.f, 1e-5f);
     EXPECT_NEAR(e.distance, -0.005f, 2e-6f) << "the least deep place, +x, found by climbing from the held one";
     EXPECT_GT(e.position.x() / L, 0.99f);
+}
+
+TEST(SegmentEscape, TheRodPinsAVertexCaughtInAWedgeOutsideBothParts) {
+    // A wedge of free space 10° wide between two half-spaces, each a part
+    // of one head (the union's outside is the wedge): a guide rooted on its
+    // bisector 3 mm from the apex, its 9.6 mm segments pointing back past
+    // the apex, deep in the upper part, at rest, no gravity. rod::rodStep's
+    // slide along one face runs into the other, so the vertex is pinned;
+    // straight out from the surface under its parent (the old pin) points
+    // across the wedge into the other part. Held at its length, it is
+    // outside both.
+    class HalfSpace final : public Collider {
+      public:
+        explicit HalfSpace(const Vec3f& n) : n_(n.normalized()) {}
+        float signedDistance(const Vec3f& p, Vec3f* normal) const override {
+            if (normal) *normal = n_;
+            return p.dot(n_);
+        }
+        Vec3f n_;
+    };
+    const float beta = 5.f * kPi / 180.f, L = 0.0096f, r = 1e-4f;
+    // Solid above y = x tan β and below y = -x tan β: outward normals (sin β, ∓cos β, 0).
+    const auto upper = std::make_shared<HalfSpace>(Vec3f(std::sin(beta), -std::cos(beta), 0.f));
+    const auto lower = std::make_shared<HalfSpace>(Vec3f(std::sin(beta), std::cos(beta), 0.f));
+    const PartsCollider wedge({upper, lower});
+    strand::HeadQuery head;
+    head.collider = &wedge;
+    const int n = 3;
+    std::vector<float> rest(size_t(n - 1), L), invMass(size_t(n), 1.f / (1e-4f * L));
+    invMass[0] = 0.f;
+    std::vector<rod::Vec2f> curvature(size_t(n - 1), rod::Vec2f::Zero());
+    rod::RodStrand strand;
+    strand.vertices = n;
+    strand.restLength = rest.data();
+    strand.invMass = invMass.data();
+    strand.restCurvature = curvature.data();
+    strand.ghostDir = Vec3f::UnitX();
+    std::vector<Vec3f> x(static_cast<size_t>(n), Vec3f::Zero()), v(static_cast<size_t>(n), Vec3f::Zero());
+    x[0] = Vec3f(0.003f, 0.f, 0.f);
+    const Vec3f back = Vec3f(-1.f, 0.2f, 0.f).normalized();
+    for (int i = 1; i < n; ++i) x[size_t(i)] = x[size_t(i - 1)] + L * back;
+    ASSERT_LT(upper->signedDistance(x[1], nullptr), -0.001f);
+    rod::RodScratch scratch;
+    const int pinned = rod::rodStep(strand, x.data(), v.data(), x[0], rod::Mat3f::Identity(), Vec3f::Zero(), 1.f / 72,
+                                    0.f, 0.f, &head, r, scratch);
+    EXPECT_GE(pinned, 1) << "the case the pin rule is for";
+    for (int i = 1; i < n; ++i) {
+        const Vec3f& p = x[size_t(i)];
+        EXPECT_NEAR((p - x[size_t(i - 1)]).norm() / L, 1.f, 1e-4f) << "vertex " << i << " at its length";
+        EXPECT_GE(upper->signedDistance(p, nullptr), -1e-3f) << "vertex " << i << " within 1 mm of outside the upper part";
+        EXPECT_GE(lower->signedDistance(p, nullptr), -1e-3f) << "vertex " << i << " within 1 mm of outside the lower part";
+    }
+    std::printf("rod: %d pinned; vertex 1 %.3f / %.3f mm, vertex 2 %.3f / %.3f mm outside upper / lower\n", pinned,
+                1e3f * upper->signedDistance(x[1], nullptr), 1e3f * lower->signedDistance(x[1], nullptr),
+                1e3f * upper->signedDistance(x[2], nullptr), 1e3f * lower->signedDistance(x[2], nullptr));
 }
