@@ -104,17 +104,23 @@ SegmentEscape escapeSegment(const Collider& collider, const Vec3f& parent, float
     Vec3f outsideDir = best >= 0 ? dirs[size_t(best)] : Vec3f::Zero();
     Climb least{dirs[size_t(deepest)], bestDepth};
     if (best < 0) {
-        // None outside: climb φ from the least deep lattice direction and
-        // from the held place's; the first to get out gives the direction.
-        Climb fromHeld{Vec3f::Zero(), -std::numeric_limits<float>::infinity()};
-        if (held && (*held - parent).norm() > 0.f) {
-            const Vec3f h = (*held - parent).normalized();
-            fromHeld = climb(phi, h, phi(h), radius);
-        }
+        // None outside: climb φ from the least deep lattice direction, then
+        // from the wanted one; the first to get out gives the direction.
+        // Neither depends on `held`, so whether a place outside exists, and
+        // which, is a function of the present alone (followers rebuilt from
+        // the cache record only where the pinned vertices were held).
         const Climb fromLattice = climb(phi, least.dir, least.phi, radius);
-        if (fromHeld.phi >= radius) outsideDir = fromHeld.dir;
-        else if (fromLattice.phi >= radius) outsideDir = fromLattice.dir;
-        least = fromHeld.phi + kTie >= fromLattice.phi ? fromHeld : fromLattice;
+        const Climb fromWanted = fromLattice.phi >= radius ? fromLattice : climb(phi, u, phi(u), radius);
+        if (fromLattice.phi >= radius) outsideDir = fromLattice.dir;
+        else if (fromWanted.phi >= radius) outsideDir = fromWanted.dir;
+        least = fromWanted.phi > fromLattice.phi ? fromWanted : fromLattice;
+        // No place outside: the least deep place climbed to from the held
+        // one, unless another is less deep by more than a tie.
+        if (outsideDir.squaredNorm() == 0.f && held && (*held - parent).norm() > 0.f) {
+            const Vec3f h = (*held - parent).normalized();
+            const Climb fromHeld = climb(phi, h, phi(h), radius);
+            if (fromHeld.phi + kTie >= least.phi) least = fromHeld;
+        }
     }
     SegmentEscape out;
     if (outsideDir.squaredNorm() > 0.f) {

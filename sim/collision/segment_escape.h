@@ -14,7 +14,8 @@
 // the strand; the places outside both are a thin band about the crease,
 // the gap between them, which a lattice of directions alone can miss. So the
 // search is: a fixed lattice of directions, then, when none is outside, a
-// compass search on the sphere of directions climbing φ (a direct search:
+// compass search on the sphere of directions climbing φ from the least
+// deep lattice direction and from the wanted one (a direct search:
 // φ = min_k φ_k has a kink along the crease, where a gradient step of one
 // part oscillates), and bisection along the great circle toward u_w from
 // the outside direction found. Deterministic: the same inputs give the same
@@ -34,10 +35,12 @@ struct SegmentEscape {
 
 /// The end of the segment of `length` from `parent` by the rule above:
 /// outside `collider` with clearance `radius` and nearest the direction of
-/// `wanted`, else the least deep place. `held` (may be null): where a vertex
-/// with no place outside would rather stay (its last place): the search for
-/// the least deep place starts from its direction too, and on a tie (within
-/// 10 µm) keeps it.
+/// `wanted`, else the least deep place. Whether a place outside is found,
+/// and which, depends on the present alone (parent, length, wanted, the
+/// collider). `held` (may be null): where a vertex with no place outside
+/// would rather stay (its last place): the climb to the least deep place
+/// then starts from its direction too, and keeps what it reaches unless
+/// another start reaches a place less deep by more than 10 µm.
 SegmentEscape escapeSegment(const Collider& collider, const Vec3f& parent, float length, float radius,
                             const Vec3f& wanted, const Vec3f* held);
 
