@@ -47,7 +47,7 @@ set(_hp_slow_tests
   test_camera:CameraAuto.RenderedBorderHasNoCoverage            # 3 Embree frames
   test_camera:CameraAuto.RunSimulatesTheClipFirstAndChunksFrameAlike  # 3 hairpipe runs
   test_mesh_parts:MeshParts.FollowersIgnoreThePartsTheirRootsLieInside  # followers pinned deep inside a sphere
-  test_fold_head:FoldHead.TipClipKeepsLengthsOnOneAndTwoThreads  # 2 x 29 frames, winding numbers on each
+  test_fold_head:FoldHead.TipClipKeepsLengthsAndClearanceOnOneAndTwoThreads  # 2 x 29 frames, winding numbers on each
   test_fold_head:FoldHead.JumpClipIsOneCutKeepsLengthsAndClearanceOnOneAndTwoThreads  # 2 x 37 frames
 )
 foreach(_entry IN LISTS _hp_slow_tests)

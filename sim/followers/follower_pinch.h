@@ -8,12 +8,15 @@
 //   bend: the segment turns about its parent to the direction nearest the
 //         one it wanted whose end is outside every collider,
 //           u* = argmax_{|u| = 1, φ(x_p + L u) >= r} u · u_wanted,
-//         found on a fixed lattice of directions and refined by bisection
-//         along the great circle toward u_wanted;
+//         found on a fixed lattice of directions, else by climbing φ on the
+//         sphere of directions (the gap of a pinch can be thinner than the
+//         lattice's spacing), and refined by bisection along the great
+//         circle toward u_wanted (sim/collision/segment_escape.h);
 //   pin:  when no direction is outside, the vertex is held at its length
-//         toward its last place (its position in the previous frame), or,
-//         without one, toward the least deep lattice direction; counted as
-//         pinned (and as inside, with its depth, when it is).
+//         at the least deep place the climb finds from its last place (its
+//         position in the previous frame) and from the least deep lattice
+//         direction, the last place's on a tie; counted as pinned (and as
+//         inside, with its depth, when it is).
 // The segment length is exact in every case: x = x_p + L u with |u| = 1.
 #pragma once
 

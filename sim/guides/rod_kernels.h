@@ -194,8 +194,10 @@ Eigen::MatrixXd equilibriumMatrix(const RodStrand& s, const Vec3f* x, const Mat3
 ///     y += W Jᵀ Δλ;
 ///  3. exact lengths and head clearance root to tip (strand::placeSegment);
 ///     a vertex that cannot be placed outside the head at its length is
-///     pinned: put back at its length toward its place at the step's start
-///     (counted in *pinned);
+///     pinned: put back at its length toward its place at the step's start,
+///     or, if the head took that place too, at the place at its length
+///     outside the head nearest it, else the least deep
+///     (sim/collision/segment_escape.h) (counted in *pinned);
 ///  4. v = (y - x)/h, Coulomb friction against the head's surface velocity,
 ///     drag v·exp(-drag·h); x = y.
 /// Returns the number of pinned vertices.

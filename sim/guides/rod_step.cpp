@@ -16,6 +16,8 @@
 #include "sim/guides/rod_kernels.h"
 #include "sim/guides/rod_band.h"
 
+#include "sim/collision/segment_escape.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -179,6 +181,16 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
     }
 }
 
+/// The head as one strand sees it, as a Collider (world points).
+class HeadView final : public Collider {
+  public:
+    explicit HeadView(const strand::HeadQuery& head) : head_(head) {}
+    float signedDistance(const Vec3f& p, Vec3f* normal) const override { return head_.distance(p, normal); }
+
+  private:
+    const strand::HeadQuery& head_;
+};
+
 /// Steps 3–4 at vertex i > 0 of one strand: exact length and head
 /// clearance (pinned where both cannot hold: returns true), then its
 /// velocity (y - start)/hv. parent: vertex i-1, placed; y: vertex i after
@@ -200,15 +212,17 @@ bool placeVertex(const RodStepTarget& t, int i, const Vec3f& parent, Vec3f& y, c
             // No place at its length outside the head: held at its length
             // toward its last valid place, where it was at the step's
             // start, carried along with the head's motion.
-            // If the head took that place too, straight out from the
-            // surface under the parent (outside whenever the head is
-            // locally convex there).
+            // If the head took that place too, the place at its length
+            // outside every part the strand collides with nearest it, else
+            // the least deep (segment_escape.h): straight out from the
+            // surface under the parent would point into the other surface
+            // where two close on the strand (a head tipping onto its neck).
             const Vec3f last = head ? Vec3f(head->toPrevious.inverse() * old) : old;
             y = strand::followTheLeader(parent, last, l);
-            Vec3f normal;
             if (head && head->distance(y, nullptr) < 0.f) {
-                head->distance(parent, &normal);
-                y = parent + l * normal.normalized();
+                const HeadView view(*head);
+                const Vec3f held = y;
+                y = escapeSegment(view, parent, l, radius, held, &held).position;
             }
             contact = strand::Contact{};
             pinned = true;
