@@ -368,6 +368,12 @@ TEST(Preview, VoxelTransmittanceMatchesCpuVoxelization) {
     }
     const int res = 64;
     const float alpha = 0.85f;
+    // One renderer for the three set-ups: its voxelization programs are
+    // compiled for the voxel mode and splat (render/preview/voxel_programs.h)
+    // and must follow each change of the settings.
+    PreviewRenderer renderer{PreviewSettings{}};
+    PreviewFrame frame;
+    frame.strands = &strands;
     for (auto [mode, splat] : {std::pair{VoxelMode::Binary, VoxelSplat::Nearest},
                                std::pair{VoxelMode::Additive, VoxelSplat::Nearest},
                                std::pair{VoxelMode::Additive, VoxelSplat::Trilinear}}) {
@@ -377,7 +383,9 @@ TEST(Preview, VoxelTransmittanceMatchesCpuVoxelization) {
         s.shadow.alpha = alpha;
         s.shadow.mode = mode;
         s.shadow.splat = splat;
-        const VoxelSnapshot snap = voxelsOf(s, v, strands);
+        renderer.setSettings(s);
+        renderer.draw(v, frame);
+        const VoxelSnapshot snap = renderer.readVoxels();
         ASSERT_EQ(snap.resolution, res);
         const std::vector<float> cpu = cpuVoxelize(lines, snap.grid, res, mode, splat);
         double gpuTotal = 0.0, cpuTotal = 0.0, error = 0.0;

@@ -7,6 +7,7 @@
 #include "core/log.h"
 #include "render/preview/gl_program.h"
 #include "render/preview/preview_gpu.h"
+#include "render/preview/voxel_programs.h"
 
 #include <epoxy/gl.h>
 
@@ -48,8 +49,9 @@ double wallMilliseconds() {
 struct PreviewRenderer::Impl {
     PreviewSettings settings;
     PreviewStats stats;
-    GlProgram strand, strandLines, strandVoxel, strandShade, voxelLines, fur, furVoxel, head, headDepth, prefix, resolveMs, resolveSs,
+    GlProgram strand, strandLines, strandShade, fur, head, headDepth, prefix, resolveMs, resolveSs,
         present;
+    VoxelPrograms voxel;  ///< specialised for settings.shadow (voxel_programs.h)
     StrandBuffers strands;
     HeadBuffers headBuffers;
     RenderTargets targets;
@@ -74,22 +76,9 @@ struct PreviewRenderer::Impl {
     explicit Impl(const PreviewSettings& s) : settings(s) {
         if (!epoxy_has_gl_extension("GL_ARB_shader_image_load_store") && epoxy_gl_version() < 42)
             throw Error("preview: the OpenGL driver lacks image load/store (needed for voxel shadows)");
-        const Files furStages = {{ShaderStage::Vertex, "fur.vert"},
-                                 {ShaderStage::TessControl, "fur.tesc"},
-                                 {ShaderStage::TessEvaluation, "fur.tese"}};
-        auto with = [](Files f, std::initializer_list<std::pair<ShaderStage, std::string>> more) {
-            f.insert(f.end(), more);
-            return f;
-        };
-        furVoxel = GlProgram("generated hair voxelization",
-                             with(furStages, {{ShaderStage::Geometry, "fur.geom"},
-                                              {ShaderStage::Fragment, "voxelize.frag"}}),
-                             {"VOXEL_PASS"});
         head = GlProgram("head", {{ShaderStage::Vertex, "head.vert"}, {ShaderStage::Fragment, "head.frag"}});
         headDepth = GlProgram("head shadow map", {{ShaderStage::Vertex, "head.vert"}, {ShaderStage::Fragment, "head.frag"}},
                               {"DEPTH_ONLY"});
-        voxelLines = GlProgram("captured strand voxelization",
-                               {{ShaderStage::Vertex, "voxel_lines.vert"}, {ShaderStage::Fragment, "voxelize.frag"}});
         prefix = GlProgram("voxel sum", {{ShaderStage::Compute, "prefix.comp"}});
         const Files resolveStages = {{ShaderStage::Vertex, "fullscreen.vert"}, {ShaderStage::Fragment, "resolve.frag"}};
         resolveMs = GlProgram("resolve (multisampled)", resolveStages, {"MULTISAMPLE"});
@@ -98,6 +87,7 @@ struct PreviewRenderer::Impl {
 
         strands.create();
         compileHairPrograms(std::min(strands.maxPatchVertices, 26));  // 24-vertex strands (docs/benchmarks.md)
+        voxel.ensure(settings.shadow, strandPatchSize);
         headBuffers.create();
         glCreateBuffers(1, &cameraUbo);
         glNamedBufferStorage(cameraUbo, sizeof(FrameUniforms), nullptr, GL_DYNAMIC_STORAGE_BIT);
@@ -145,11 +135,10 @@ struct PreviewRenderer::Impl {
                               {ShaderStage::TessEvaluation, "strand.tese"}};
         std::vector<std::string> defines = shading;
         defines.push_back(cat("PATCH_SIZE ", patchSize));
-        Files camera = stages, lines = stages, voxel = stages;
+        Files camera = stages, lines = stages;
         camera.push_back({ShaderStage::Geometry, "ribbon.geom"});
         camera.push_back({ShaderStage::Fragment, "hair.frag"});
         lines.push_back({ShaderStage::Fragment, "hair.frag"});
-        voxel.push_back({ShaderStage::Fragment, "voxelize.frag"});
         std::vector<std::string> thick = defines, thin = defines;
         thick.push_back("THICK_PASS");
         thin.push_back("THIN_PASS");
@@ -161,7 +150,6 @@ struct PreviewRenderer::Impl {
         }
         strand = GlProgram("strand ribbons", camera, thick);
         strandLines = GlProgram("strand lines", lines, thin);
-        strandVoxel = GlProgram("strand voxelization", voxel, {cat("PATCH_SIZE ", patchSize), "CAPTURE"});
         fur = GlProgram("generated hair",
                         {{ShaderStage::Vertex, "fur.vert"},
                          {ShaderStage::TessControl, "fur.tesc"},
@@ -230,11 +218,6 @@ struct PreviewRenderer::Impl {
             captured.ensure(lightPieceVertexBound(strands, *strandFrame, slots[0].grid, slotResolution[0],
                                                   std::clamp(settings.tessellationLevel, 1, 64),
                                                   settings.tessellationPixels * float(supersample())));
-        const int mode = sh.mode == VoxelMode::Binary ? 0 : (sh.splat == VoxelSplat::Trilinear ? 2 : 1);
-        for (const GlProgram* p : {&strandVoxel, &voxelLines, &furVoxel}) {
-            glProgramUniform1i(p->id(), p->uniform("uMode"), mode);
-            glProgramUniform1i(p->id(), p->uniform("uCrossings"), sh.weight == VoxelWeight::Crossings ? 1 : 0);
-        }
         for (int k = 0; k < n; ++k) {
             glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightUbo[k]);
             if (mapOn) {
@@ -264,7 +247,7 @@ struct PreviewRenderer::Impl {
             if (share && k == 0) {
                 // The program is bound before capturing starts (GL forbids
                 // changing it while transform feedback is active).
-                strandVoxel.use();
+                voxel.strands.use();
                 glBindVertexArray(strands.vao);
                 glPatchParameteri(GL_PATCH_VERTICES, strands.patchSize);
                 glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, captured.feedback);
@@ -273,13 +256,13 @@ struct PreviewRenderer::Impl {
                 glEndTransformFeedback();
                 glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
             } else if (share) {
-                voxelLines.use();
+                voxel.captured.use();
                 glBindVertexArray(captured.vao);
                 glDrawTransformFeedback(GL_LINES, captured.feedback);
             } else {
-                drawStrands(strandVoxel);
+                drawStrands(voxel.strands);
             }
-            drawFur(furVoxel);
+            drawFur(voxel.fur);
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
             mark("voxelize");
             prefix.use();
@@ -503,6 +486,7 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
     glNamedBufferSubData(cameraUbo, 0, sizeof(u), &u);
     hairDefines = settings.specializeShading ? hairShadingDefines(u) : std::vector<std::string>{};
     compileHairPrograms(strandPatchSize);  // follows a changed shading rate, lights or hair model
+    voxel.ensure(settings.shadow, strandPatchSize);  // follows a changed patch size or voxel settings
     if (voxelsOn || mapOn) {
         for (size_t k = 0; k < slots.size(); ++k) {
             FrameUniforms l = u;
