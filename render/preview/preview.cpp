@@ -49,8 +49,8 @@ double wallMilliseconds() {
 struct PreviewRenderer::Impl {
     PreviewSettings settings;
     PreviewStats stats;
-    GlProgram strand, strandLines, strandShade, fur, head, headDepth, prefix, resolveMs, resolveSs,
-        present;
+    GlProgram strand, strandLines, strandShade, fur, head, headDepth, prefix, present;
+    GlProgram resolveMs[2], resolveSs[2];  ///< [sorted]: sorted hair needs no accumulation or revealage
     VoxelPrograms voxel;  ///< specialised for settings.shadow (voxel_programs.h)
     StrandBuffers strands;
     HeadBuffers headBuffers;
@@ -81,8 +81,10 @@ struct PreviewRenderer::Impl {
                               {"DEPTH_ONLY"});
         prefix = GlProgram("voxel sum", {{ShaderStage::Compute, "prefix.comp"}});
         const Files resolveStages = {{ShaderStage::Vertex, "fullscreen.vert"}, {ShaderStage::Fragment, "resolve.frag"}};
-        resolveMs = GlProgram("resolve (multisampled)", resolveStages, {"MULTISAMPLE"});
-        resolveSs = GlProgram("resolve", resolveStages);
+        resolveMs[0] = GlProgram("resolve (multisampled)", resolveStages, {"MULTISAMPLE"});
+        resolveSs[0] = GlProgram("resolve", resolveStages);
+        resolveMs[1] = GlProgram("resolve (multisampled, sorted)", resolveStages, {"MULTISAMPLE", "SORTED"});
+        resolveSs[1] = GlProgram("resolve (sorted)", resolveStages, {"SORTED"});
         present = GlProgram("present", {{ShaderStage::Vertex, "fullscreen.vert"}, {ShaderStage::Fragment, "present.frag"}});
 
         strands.create();
@@ -289,8 +291,10 @@ struct PreviewRenderer::Impl {
         glDisable(GL_BLEND);
         glDepthMask(GL_TRUE);
         glClearBufferfv(GL_COLOR, 0, zero);
-        glClearBufferfv(GL_COLOR, 1, zero);
-        glClearBufferfv(GL_COLOR, 2, one);
+        if (settings.blend == HairBlend::Weighted) {  // sorted hair blends into 0 (the resolve reads neither)
+            glClearBufferfv(GL_COLOR, 1, zero);
+            glClearBufferfv(GL_COLOR, 2, one);
+        }
         glClearBufferfv(GL_COLOR, 3, inf);
         glClearBufferfv(GL_DEPTH, 0, one);
         mark("camera clear");
@@ -362,7 +366,8 @@ struct PreviewRenderer::Impl {
         glViewport(0, 0, targets.width, targets.height);
         glDisable(GL_DEPTH_TEST);
         glDisable(GL_BLEND);
-        const GlProgram& p = targets.samples > 1 ? resolveMs : resolveSs;
+        const int sorted = settings.blend == HairBlend::Sorted ? 1 : 0;
+        const GlProgram& p = targets.samples > 1 ? resolveMs[sorted] : resolveSs[sorted];
         p.use();
         glProgramUniform1i(p.id(), p.uniform("uSamples"), targets.samples);
         glProgramUniform1i(p.id(), p.uniform("uSupersample"), targets.supersample);
