@@ -53,6 +53,13 @@ struct PreviewRenderer::Impl {
     GlProgram resolveMs[2], resolveSs[2];  ///< [sorted]: sorted hair needs no accumulation or revealage
     VoxelPrograms voxel;  ///< specialised for settings.shadow (voxel_programs.h)
     StrandBuffers strands;
+    /// Sorted hair: the same strands as whole-strand patches for the light
+    /// passes, which need no order (the voxel grid sums): a sixth of the
+    /// sorted 4-segment patches at 24 vertices a strand, and llvmpipe's
+    /// tessellation costs per patch (docs/benchmarks.md). Its own copy of
+    /// the vertices (16 bytes each).
+    StrandBuffers lightStrands;
+    bool lightStrandsUsed = false;  ///< this frame's light passes draw lightStrands
     HeadBuffers headBuffers;
     RenderTargets targets;
     ShadowTargets shadows;
@@ -88,8 +95,9 @@ struct PreviewRenderer::Impl {
         present = GlProgram("present", {{ShaderStage::Vertex, "fullscreen.vert"}, {ShaderStage::Fragment, "present.frag"}});
 
         strands.create();
+        lightStrands.create();
         compileHairPrograms(std::min(strands.maxPatchVertices, 26));  // 24-vertex strands (docs/benchmarks.md)
-        voxel.ensure(settings.shadow, strandPatchSize);
+        voxel.ensure(settings.shadow, strandPatchSize, 0);
         headBuffers.create();
         glCreateBuffers(1, &cameraUbo);
         glNamedBufferStorage(cameraUbo, sizeof(FrameUniforms), nullptr, GL_DYNAMIC_STORAGE_BIT);
@@ -109,6 +117,7 @@ struct PreviewRenderer::Impl {
     ~Impl() {
         if (fence) glDeleteSync(fence);
         strands.destroy();
+        lightStrands.destroy();
         headBuffers.destroy();
         targets.destroy();
         shadows.destroy();
@@ -179,12 +188,13 @@ struct PreviewRenderer::Impl {
     int samples() const { return std::clamp(settings.msaa, 1, maxSamples); }
     int supersample() const { return std::clamp(settings.supersample, 1, 4); }
 
-    void drawStrands(const GlProgram& program) {
-        if (!strandsVisible || !strands.indexCount) return;
+    void drawStrands(const GlProgram& program) { drawStrands(program, strands); }
+    void drawStrands(const GlProgram& program, const StrandBuffers& b) {
+        if (!strandsVisible || !b.indexCount) return;
         program.use();
-        glBindVertexArray(strands.vao);
-        glPatchParameteri(GL_PATCH_VERTICES, strands.patchSize);
-        glDrawElements(GL_PATCHES, GLsizei(strands.indexCount), GL_UNSIGNED_INT, nullptr);
+        glBindVertexArray(b.vao);
+        glPatchParameteri(GL_PATCH_VERTICES, b.patchSize);
+        glDrawElements(GL_PATCHES, GLsizei(b.indexCount), GL_UNSIGNED_INT, nullptr);
     }
 
     void drawFur(const GlProgram& program) {
@@ -215,9 +225,10 @@ struct PreviewRenderer::Impl {
         const int n = int(slots.size());
         shadows.ensure(std::clamp(sh.shadowMapSize, 16, 16384), n, slotResolution);
         glDisable(GL_BLEND);
-        const bool share = voxelsOn && sh.shareTessellation && n > 1 && strandsVisible && strands.indexCount;
+        const StrandBuffers& ls = lightStrandsUsed ? lightStrands : strands;
+        const bool share = voxelsOn && sh.shareTessellation && n > 1 && strandsVisible && ls.indexCount;
         if (share)
-            captured.ensure(lightPieceVertexBound(strands, *strandFrame, slots[0].grid, slotResolution[0],
+            captured.ensure(lightPieceVertexBound(ls, *strandFrame, slots[0].grid, slotResolution[0],
                                                   std::clamp(settings.tessellationLevel, 1, 64),
                                                   settings.tessellationPixels * float(supersample())));
         for (int k = 0; k < n; ++k) {
@@ -250,11 +261,11 @@ struct PreviewRenderer::Impl {
                 // The program is bound before capturing starts (GL forbids
                 // changing it while transform feedback is active).
                 voxel.strands.use();
-                glBindVertexArray(strands.vao);
-                glPatchParameteri(GL_PATCH_VERTICES, strands.patchSize);
+                glBindVertexArray(ls.vao);
+                glPatchParameteri(GL_PATCH_VERTICES, ls.patchSize);
                 glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, captured.feedback);
                 glBeginTransformFeedback(GL_LINES);
-                glDrawElements(GL_PATCHES, GLsizei(strands.indexCount), GL_UNSIGNED_INT, nullptr);
+                glDrawElements(GL_PATCHES, GLsizei(ls.indexCount), GL_UNSIGNED_INT, nullptr);
                 glEndTransformFeedback();
                 glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
             } else if (share) {
@@ -262,7 +273,7 @@ struct PreviewRenderer::Impl {
                 glBindVertexArray(captured.vao);
                 glDrawTransformFeedback(GL_LINES, captured.feedback);
             } else {
-                drawStrands(voxel.strands);
+                drawStrands(voxel.strands, ls);
             }
             drawFur(voxel.fur);
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
@@ -491,7 +502,13 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
     glNamedBufferSubData(cameraUbo, 0, sizeof(u), &u);
     hairDefines = settings.specializeShading ? hairShadingDefines(u) : std::vector<std::string>{};
     compileHairPrograms(strandPatchSize);  // follows a changed shading rate, lights or hair model
-    voxel.ensure(settings.shadow, strandPatchSize);  // follows a changed patch size or voxel settings
+    lightStrandsUsed = voxelsOn && drawStrandsNow && settings.blend == HairBlend::Sorted;
+    if (lightStrandsUsed) lightStrands.upload(*frame.strands, 0);
+    // Follows a changed patch size or voxel settings. The whole strands are
+    // cut into at least a piece per kSortedPatchSegments segments, as many as
+    // the sorted patches would give (fewer bend the grid's hair off the curve).
+    voxel.ensure(settings.shadow, lightStrandsUsed ? lightStrands.patchSize : strandPatchSize,
+                 lightStrandsUsed ? kSortedPatchSegments : 0);
     if (voxelsOn || mapOn) {
         for (size_t k = 0; k < slots.size(); ++k) {
             FrameUniforms l = u;

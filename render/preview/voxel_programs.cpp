@@ -11,13 +11,15 @@ std::vector<std::string> VoxelPrograms::defines(const PreviewShadowSettings& sha
     return {cat("VOXEL_MODE ", mode), cat("VOXEL_CROSSINGS ", shadow.weight == VoxelWeight::Crossings ? 1 : 0)};
 }
 
-void VoxelPrograms::ensure(const PreviewShadowSettings& shadow, int strandPatchSize) {
+void VoxelPrograms::ensure(const PreviewShadowSettings& shadow, int strandPatchSize, int minSegmentsPerPiece) {
     const std::vector<std::string> wanted = defines(shadow);
     const bool settingsChanged = wanted != defines_ || !captured.id();
-    if (settingsChanged || strandPatchSize != patchSize_ || !strands.id()) {
+    if (settingsChanged || strandPatchSize != patchSize_ || minSegmentsPerPiece != minSegmentsPerPiece_ ||
+        !strands.id()) {
         std::vector<std::string> d = wanted;
         d.push_back(cat("PATCH_SIZE ", strandPatchSize));
         d.push_back("CAPTURE");
+        if (minSegmentsPerPiece > 0) d.push_back(cat("MIN_SEGMENTS_PER_PIECE ", minSegmentsPerPiece));
         strands = GlProgram("strand voxelization",
                             {{ShaderStage::Vertex, "strand.vert"},
                              {ShaderStage::TessControl, "strand.tesc"},
@@ -25,6 +27,7 @@ void VoxelPrograms::ensure(const PreviewShadowSettings& shadow, int strandPatchS
                              {ShaderStage::Fragment, "voxelize.frag"}},
                             d);
         patchSize_ = strandPatchSize;
+        minSegmentsPerPiece_ = minSegmentsPerPiece;
     }
     if (settingsChanged) {
         captured = GlProgram("captured strand voxelization",

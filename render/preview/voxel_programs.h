@@ -24,13 +24,15 @@ struct VoxelPrograms {
     /// The defines of `shadow`'s mode, splat and weight ("VOXEL_MODE n",
     /// "VOXEL_CROSSINGS 0/1").
     static std::vector<std::string> defines(const PreviewShadowSettings& shadow);
-    /// Compiles what `shadow` and the strand patch size need unless already
-    /// compiled for them. Needs a current context.
-    void ensure(const PreviewShadowSettings& shadow, int strandPatchSize);
+    /// Compiles what `shadow`, the strand patch size and the fewest pieces
+    /// per segment need (strand.tesc MIN_SEGMENTS_PER_PIECE: at least one
+    /// piece per this many segments; 0 = none) unless already compiled for
+    /// them. Needs a current context.
+    void ensure(const PreviewShadowSettings& shadow, int strandPatchSize, int minSegmentsPerPiece);
 
   private:
     std::vector<std::string> defines_;
-    int patchSize_ = 0;
+    int patchSize_ = 0, minSegmentsPerPiece_ = 0;
 };
 
 }  // namespace hp
