@@ -1,7 +1,10 @@
 // Resolves the multisampled (and possibly supersampled) target into one
 // pixel: per sample, hair = weighted-blended colour with alpha 1 - revealage
 // over the opaque head; averaged; the environment fills the rest. Z is the
-// nearest sample's camera depth. MULTISAMPLE selects sampler2DMS.
+// nearest sample's camera depth. MULTISAMPLE selects sampler2DMS. SORTED:
+// sorted hair was blended over the opaque colour in place, so the pixel is
+// that colour alone (accumulation and revealage are neither cleared nor read:
+// their clear values, 0 and 1, give the same sum).
 #ifdef MULTISAMPLE
 #define SAMPLER sampler2DMS
 #else
@@ -27,19 +30,21 @@ void main() {
             ivec2 p = pixel * uSupersample + ivec2(sx, sy);
             for (int s = 0; s < uSamples; ++s) {
 #ifdef MULTISAMPLE
-                vec4 opaque = texelFetch(uOpaque, p, s);
-                vec4 accum = texelFetch(uAccum, p, s);
-                float reveal = texelFetch(uReveal, p, s).r;
-                depth = min(depth, texelFetch(uDepth, p, s).r);
+                const int q = s;
 #else
-                vec4 opaque = texelFetch(uOpaque, p, 0);
-                vec4 accum = texelFetch(uAccum, p, 0);
-                float reveal = texelFetch(uReveal, p, 0).r;
-                depth = min(depth, texelFetch(uDepth, p, 0).r);
+                const int q = 0;
 #endif
+                vec4 opaque = texelFetch(uOpaque, p, q);
+                depth = min(depth, texelFetch(uDepth, p, q).r);
+#ifdef SORTED
+                sum += opaque;
+#else
+                vec4 accum = texelFetch(uAccum, p, q);
+                float reveal = texelFetch(uReveal, p, q).r;
                 float hairAlpha = 1.0 - reveal;
                 vec3 hair = accum.a > 0.0 ? accum.rgb / accum.a * hairAlpha : vec3(0.0);
                 sum += vec4(hair, hairAlpha) + opaque * reveal;
+#endif
             }
         }
     sum /= float(uSamples * uSupersample * uSupersample);

@@ -52,6 +52,12 @@ void main() {
     }
     float most = float(segments) * uTess.x;
     float pieces = uTess.y > 0.0 ? clamp(ceil(pixels / uTess.y), 1.0, most) : most;
+#ifdef MIN_SEGMENTS_PER_PIECE
+    // Light passes draw whole strands (render/preview/preview.cpp
+    // lightStrands): at least one piece per this many segments, as the
+    // camera's sorted patches of that many segments each get.
+    pieces = max(pieces, min(ceil(float(segments) / float(MIN_SEGMENTS_PER_PIECE)), most));
+#endif
     float lines = ceil(pieces / 64.0);
     bool cull = any(outside) || behind || segments < 1;
 #if defined(THIN_PASS)

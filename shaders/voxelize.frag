@@ -14,8 +14,13 @@ layout(location = 0) in vec3 gWorld;
 layout(location = 1) in vec3 gTangent;
 layout(location = 2) in float gRadius;
 layout(r32ui, binding = 0) uniform coherent uimage3D uVoxels;
-uniform int uMode;
-uniform int uCrossings;
+// The mode and the weight are compile-time constants (VOXEL_MODE,
+// VOXEL_CROSSINGS, set by render/preview/preview.cpp for the frame's
+// settings): llvmpipe runs both sides of a branch on a uniform under an
+// execution mask, so as uniforms every fragment paid the trilinear splat's 8
+// atomics and the crossing weight whatever the settings.
+const int uMode = VOXEL_MODE;
+const int uCrossings = VOXEL_CROSSINGS;
 
 // A fragment stands for the piece of strand inside one raster pixel (GL's
 // diamond-exit rule gives one fragment per pixel along the line's major

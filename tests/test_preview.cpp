@@ -368,6 +368,12 @@ TEST(Preview, VoxelTransmittanceMatchesCpuVoxelization) {
     }
     const int res = 64;
     const float alpha = 0.85f;
+    // One renderer for the three set-ups: its voxelization programs are
+    // compiled for the voxel mode and splat (render/preview/voxel_programs.h)
+    // and must follow each change of the settings.
+    PreviewRenderer renderer{PreviewSettings{}};
+    PreviewFrame frame;
+    frame.strands = &strands;
     for (auto [mode, splat] : {std::pair{VoxelMode::Binary, VoxelSplat::Nearest},
                                std::pair{VoxelMode::Additive, VoxelSplat::Nearest},
                                std::pair{VoxelMode::Additive, VoxelSplat::Trilinear}}) {
@@ -377,7 +383,9 @@ TEST(Preview, VoxelTransmittanceMatchesCpuVoxelization) {
         s.shadow.alpha = alpha;
         s.shadow.mode = mode;
         s.shadow.splat = splat;
-        const VoxelSnapshot snap = voxelsOf(s, v, strands);
+        renderer.setSettings(s);
+        renderer.draw(v, frame);
+        const VoxelSnapshot snap = renderer.readVoxels();
         ASSERT_EQ(snap.resolution, res);
         const std::vector<float> cpu = cpuVoxelize(lines, snap.grid, res, mode, splat);
         double gpuTotal = 0.0, cpuTotal = 0.0, error = 0.0;
@@ -406,6 +414,41 @@ TEST(Preview, VoxelTransmittanceMatchesCpuVoxelization) {
         EXPECT_LT(double(apart) / double(compared), 0.001) << what << ": voxels more than one fragment apart";
         std::cout << what << ": fragments gpu/cpu " << gpuTotal / cpuTotal << ", mean |dT| "
                   << error / double(compared) << ", >1 fragment apart " << apart << " of " << compared << "\n";
+    }
+}
+
+/// Sorted hair is voxelized from whole-strand patches (render/preview/
+/// preview.cpp lightStrands), cut into at least a piece per 4 segments, as
+/// many as the camera's sorted 4-segment patches give. A zigzag of 24
+/// segments, its peaks at vertices 4, 12 and 20 and its zeros at 0, 8, 16
+/// and 24, spans ~45 raster pixels of the light pass: by length alone it
+/// would be 3 pieces, chords through the zeros, and no hair at the peaks.
+TEST(Preview, LightPassKeepsAPiecePerFourSegments) {
+    HP_REQUIRE_GL();
+    View v = test::frontView(64, 48);
+    v.lights[0].direction = Vec3f(0.f, 0.f, -1.f);  // the grid's u, v follow world x, y
+    StrandFrame strands;
+    addLine(strands, Vec3f(-0.1f, -0.1f, -0.01f), Vec3f(0.1f, 0.1f, 0.01f), 0.0001f);  // widens the grid: 0.8 mm voxels
+    const float amplitude = 0.005f;
+    std::vector<Vec3f> zigzag(25);
+    std::vector<float> radii(25, 0.0001f);
+    for (int i = 0; i < 25; ++i)
+        zigzag[size_t(i)] = Vec3f(-0.005f + 0.01f * float(i) / 24.f, 0.05f + amplitude * (1.f - std::abs(float(i % 8) - 4.f) / 4.f), 0.f);
+    strands.addStrand(1, zigzag.data(), radii.data(), zigzag.size());
+    PreviewSettings s;
+    s.shadow.resolution = 256;
+    ASSERT_EQ(s.blend, HairBlend::Sorted);
+    const VoxelSnapshot snap = voxelsOf(s, v, strands);
+    ASSERT_EQ(snap.resolution, 256);
+    for (int peak : {4, 12, 20}) {
+        const Vec3f g = snap.grid.toGrid(zigzag[size_t(peak)]) * 256.f;
+        const Vec3f zero = snap.grid.toGrid(zigzag[size_t(peak - 4)]) * 256.f;
+        ASSERT_GT(std::abs(g.y() - zero.y()), 4.f) << "the peak lies several voxels off the zeros' line";
+        float mass = 0.f;  // raw hair within a voxel of the peak
+        for (int z = 0; z < 256; ++z)
+            for (int y = int(g.y()) - 1; y <= int(g.y()) + 1; ++y)
+                for (int x = int(g.x()) - 1; x <= int(g.x()) + 1; ++x) mass += snap.rawAt(x, y, z);
+        EXPECT_GT(mass, 0.f) << "no hair voxelized at the zigzag's peak at vertex " << peak;
     }
 }
 

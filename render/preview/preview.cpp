@@ -7,6 +7,7 @@
 #include "core/log.h"
 #include "render/preview/gl_program.h"
 #include "render/preview/preview_gpu.h"
+#include "render/preview/voxel_programs.h"
 
 #include <epoxy/gl.h>
 
@@ -48,9 +49,17 @@ double wallMilliseconds() {
 struct PreviewRenderer::Impl {
     PreviewSettings settings;
     PreviewStats stats;
-    GlProgram strand, strandLines, strandVoxel, strandShade, voxelLines, fur, furVoxel, head, headDepth, prefix, resolveMs, resolveSs,
-        present;
+    GlProgram strand, strandLines, strandShade, fur, head, headDepth, prefix, present;
+    GlProgram resolveMs[2], resolveSs[2];  ///< [sorted]: sorted hair needs no accumulation or revealage
+    VoxelPrograms voxel;  ///< specialised for settings.shadow (voxel_programs.h)
     StrandBuffers strands;
+    /// Sorted hair: the same strands as whole-strand patches for the light
+    /// passes, which need no order (the voxel grid sums): a sixth of the
+    /// sorted 4-segment patches at 24 vertices a strand, and llvmpipe's
+    /// tessellation costs per patch (docs/benchmarks.md). Its own copy of
+    /// the vertices (16 bytes each).
+    StrandBuffers lightStrands;
+    bool lightStrandsUsed = false;  ///< this frame's light passes draw lightStrands
     HeadBuffers headBuffers;
     RenderTargets targets;
     ShadowTargets shadows;
@@ -74,30 +83,21 @@ struct PreviewRenderer::Impl {
     explicit Impl(const PreviewSettings& s) : settings(s) {
         if (!epoxy_has_gl_extension("GL_ARB_shader_image_load_store") && epoxy_gl_version() < 42)
             throw Error("preview: the OpenGL driver lacks image load/store (needed for voxel shadows)");
-        const Files furStages = {{ShaderStage::Vertex, "fur.vert"},
-                                 {ShaderStage::TessControl, "fur.tesc"},
-                                 {ShaderStage::TessEvaluation, "fur.tese"}};
-        auto with = [](Files f, std::initializer_list<std::pair<ShaderStage, std::string>> more) {
-            f.insert(f.end(), more);
-            return f;
-        };
-        furVoxel = GlProgram("generated hair voxelization",
-                             with(furStages, {{ShaderStage::Geometry, "fur.geom"},
-                                              {ShaderStage::Fragment, "voxelize.frag"}}),
-                             {"VOXEL_PASS"});
         head = GlProgram("head", {{ShaderStage::Vertex, "head.vert"}, {ShaderStage::Fragment, "head.frag"}});
         headDepth = GlProgram("head shadow map", {{ShaderStage::Vertex, "head.vert"}, {ShaderStage::Fragment, "head.frag"}},
                               {"DEPTH_ONLY"});
-        voxelLines = GlProgram("captured strand voxelization",
-                               {{ShaderStage::Vertex, "voxel_lines.vert"}, {ShaderStage::Fragment, "voxelize.frag"}});
         prefix = GlProgram("voxel sum", {{ShaderStage::Compute, "prefix.comp"}});
         const Files resolveStages = {{ShaderStage::Vertex, "fullscreen.vert"}, {ShaderStage::Fragment, "resolve.frag"}};
-        resolveMs = GlProgram("resolve (multisampled)", resolveStages, {"MULTISAMPLE"});
-        resolveSs = GlProgram("resolve", resolveStages);
+        resolveMs[0] = GlProgram("resolve (multisampled)", resolveStages, {"MULTISAMPLE"});
+        resolveSs[0] = GlProgram("resolve", resolveStages);
+        resolveMs[1] = GlProgram("resolve (multisampled, sorted)", resolveStages, {"MULTISAMPLE", "SORTED"});
+        resolveSs[1] = GlProgram("resolve (sorted)", resolveStages, {"SORTED"});
         present = GlProgram("present", {{ShaderStage::Vertex, "fullscreen.vert"}, {ShaderStage::Fragment, "present.frag"}});
 
         strands.create();
+        lightStrands.create();
         compileHairPrograms(std::min(strands.maxPatchVertices, 26));  // 24-vertex strands (docs/benchmarks.md)
+        voxel.ensure(settings.shadow, strandPatchSize, 0);
         headBuffers.create();
         glCreateBuffers(1, &cameraUbo);
         glNamedBufferStorage(cameraUbo, sizeof(FrameUniforms), nullptr, GL_DYNAMIC_STORAGE_BIT);
@@ -117,6 +117,7 @@ struct PreviewRenderer::Impl {
     ~Impl() {
         if (fence) glDeleteSync(fence);
         strands.destroy();
+        lightStrands.destroy();
         headBuffers.destroy();
         targets.destroy();
         shadows.destroy();
@@ -145,11 +146,10 @@ struct PreviewRenderer::Impl {
                               {ShaderStage::TessEvaluation, "strand.tese"}};
         std::vector<std::string> defines = shading;
         defines.push_back(cat("PATCH_SIZE ", patchSize));
-        Files camera = stages, lines = stages, voxel = stages;
+        Files camera = stages, lines = stages;
         camera.push_back({ShaderStage::Geometry, "ribbon.geom"});
         camera.push_back({ShaderStage::Fragment, "hair.frag"});
         lines.push_back({ShaderStage::Fragment, "hair.frag"});
-        voxel.push_back({ShaderStage::Fragment, "voxelize.frag"});
         std::vector<std::string> thick = defines, thin = defines;
         thick.push_back("THICK_PASS");
         thin.push_back("THIN_PASS");
@@ -161,7 +161,6 @@ struct PreviewRenderer::Impl {
         }
         strand = GlProgram("strand ribbons", camera, thick);
         strandLines = GlProgram("strand lines", lines, thin);
-        strandVoxel = GlProgram("strand voxelization", voxel, {cat("PATCH_SIZE ", patchSize), "CAPTURE"});
         fur = GlProgram("generated hair",
                         {{ShaderStage::Vertex, "fur.vert"},
                          {ShaderStage::TessControl, "fur.tesc"},
@@ -189,12 +188,13 @@ struct PreviewRenderer::Impl {
     int samples() const { return std::clamp(settings.msaa, 1, maxSamples); }
     int supersample() const { return std::clamp(settings.supersample, 1, 4); }
 
-    void drawStrands(const GlProgram& program) {
-        if (!strandsVisible || !strands.indexCount) return;
+    void drawStrands(const GlProgram& program) { drawStrands(program, strands); }
+    void drawStrands(const GlProgram& program, const StrandBuffers& b) {
+        if (!strandsVisible || !b.indexCount) return;
         program.use();
-        glBindVertexArray(strands.vao);
-        glPatchParameteri(GL_PATCH_VERTICES, strands.patchSize);
-        glDrawElements(GL_PATCHES, GLsizei(strands.indexCount), GL_UNSIGNED_INT, nullptr);
+        glBindVertexArray(b.vao);
+        glPatchParameteri(GL_PATCH_VERTICES, b.patchSize);
+        glDrawElements(GL_PATCHES, GLsizei(b.indexCount), GL_UNSIGNED_INT, nullptr);
     }
 
     void drawFur(const GlProgram& program) {
@@ -225,16 +225,12 @@ struct PreviewRenderer::Impl {
         const int n = int(slots.size());
         shadows.ensure(std::clamp(sh.shadowMapSize, 16, 16384), n, slotResolution);
         glDisable(GL_BLEND);
-        const bool share = voxelsOn && sh.shareTessellation && n > 1 && strandsVisible && strands.indexCount;
+        const StrandBuffers& ls = lightStrandsUsed ? lightStrands : strands;
+        const bool share = voxelsOn && sh.shareTessellation && n > 1 && strandsVisible && ls.indexCount;
         if (share)
-            captured.ensure(lightPieceVertexBound(strands, *strandFrame, slots[0].grid, slotResolution[0],
+            captured.ensure(lightPieceVertexBound(ls, *strandFrame, slots[0].grid, slotResolution[0],
                                                   std::clamp(settings.tessellationLevel, 1, 64),
                                                   settings.tessellationPixels * float(supersample())));
-        const int mode = sh.mode == VoxelMode::Binary ? 0 : (sh.splat == VoxelSplat::Trilinear ? 2 : 1);
-        for (const GlProgram* p : {&strandVoxel, &voxelLines, &furVoxel}) {
-            glProgramUniform1i(p->id(), p->uniform("uMode"), mode);
-            glProgramUniform1i(p->id(), p->uniform("uCrossings"), sh.weight == VoxelWeight::Crossings ? 1 : 0);
-        }
         for (int k = 0; k < n; ++k) {
             glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightUbo[k]);
             if (mapOn) {
@@ -264,22 +260,22 @@ struct PreviewRenderer::Impl {
             if (share && k == 0) {
                 // The program is bound before capturing starts (GL forbids
                 // changing it while transform feedback is active).
-                strandVoxel.use();
-                glBindVertexArray(strands.vao);
-                glPatchParameteri(GL_PATCH_VERTICES, strands.patchSize);
+                voxel.strands.use();
+                glBindVertexArray(ls.vao);
+                glPatchParameteri(GL_PATCH_VERTICES, ls.patchSize);
                 glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, captured.feedback);
                 glBeginTransformFeedback(GL_LINES);
-                glDrawElements(GL_PATCHES, GLsizei(strands.indexCount), GL_UNSIGNED_INT, nullptr);
+                glDrawElements(GL_PATCHES, GLsizei(ls.indexCount), GL_UNSIGNED_INT, nullptr);
                 glEndTransformFeedback();
                 glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
             } else if (share) {
-                voxelLines.use();
+                voxel.captured.use();
                 glBindVertexArray(captured.vao);
                 glDrawTransformFeedback(GL_LINES, captured.feedback);
             } else {
-                drawStrands(strandVoxel);
+                drawStrands(voxel.strands, ls);
             }
-            drawFur(furVoxel);
+            drawFur(voxel.fur);
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
             mark("voxelize");
             prefix.use();
@@ -306,8 +302,10 @@ struct PreviewRenderer::Impl {
         glDisable(GL_BLEND);
         glDepthMask(GL_TRUE);
         glClearBufferfv(GL_COLOR, 0, zero);
-        glClearBufferfv(GL_COLOR, 1, zero);
-        glClearBufferfv(GL_COLOR, 2, one);
+        if (settings.blend == HairBlend::Weighted) {  // sorted hair blends into 0 (the resolve reads neither)
+            glClearBufferfv(GL_COLOR, 1, zero);
+            glClearBufferfv(GL_COLOR, 2, one);
+        }
         glClearBufferfv(GL_COLOR, 3, inf);
         glClearBufferfv(GL_DEPTH, 0, one);
         mark("camera clear");
@@ -379,7 +377,8 @@ struct PreviewRenderer::Impl {
         glViewport(0, 0, targets.width, targets.height);
         glDisable(GL_DEPTH_TEST);
         glDisable(GL_BLEND);
-        const GlProgram& p = targets.samples > 1 ? resolveMs : resolveSs;
+        const int sorted = settings.blend == HairBlend::Sorted ? 1 : 0;
+        const GlProgram& p = targets.samples > 1 ? resolveMs[sorted] : resolveSs[sorted];
         p.use();
         glProgramUniform1i(p.id(), p.uniform("uSamples"), targets.samples);
         glProgramUniform1i(p.id(), p.uniform("uSupersample"), targets.supersample);
@@ -503,6 +502,13 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
     glNamedBufferSubData(cameraUbo, 0, sizeof(u), &u);
     hairDefines = settings.specializeShading ? hairShadingDefines(u) : std::vector<std::string>{};
     compileHairPrograms(strandPatchSize);  // follows a changed shading rate, lights or hair model
+    lightStrandsUsed = voxelsOn && drawStrandsNow && settings.blend == HairBlend::Sorted;
+    if (lightStrandsUsed) lightStrands.upload(*frame.strands, 0);
+    // Follows a changed patch size or voxel settings. The whole strands are
+    // cut into at least a piece per kSortedPatchSegments segments, as many as
+    // the sorted patches would give (fewer bend the grid's hair off the curve).
+    voxel.ensure(settings.shadow, lightStrandsUsed ? lightStrands.patchSize : strandPatchSize,
+                 lightStrandsUsed ? kSortedPatchSegments : 0);
     if (voxelsOn || mapOn) {
         for (size_t k = 0; k < slots.size(); ++k) {
             FrameUniforms l = u;
