@@ -459,6 +459,7 @@ TEST(SimSettings, SceneKeysMapOntoGuideSettings) {
     EXPECT_EQ(s.formulation, GuideFormulation::Rigid);
     EXPECT_EQ(s.substeps, 4);
     EXPECT_EQ(s.rodIntegrator, RodIntegrator::Euler);
+    EXPECT_EQ(GuideSettings{}.rodIntegrator, RodIntegrator::Bdf2) << "BDF2 by default (issue 29)";
     EXPECT_TRUE(s.taperedFibre);
     EXPECT_FALSE(GuideSettings{}.taperedFibre) << "the root's section all along by default";
     EXPECT_FLOAT_EQ(s.damping, 2.5f);

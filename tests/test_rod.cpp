@@ -78,21 +78,20 @@ TEST(Rod, HangingChainFirstModePeriodMatchesBessel) {
     const Pendulum p = pendulum();
     RecordProperty("pendulum_period_error", std::to_string(p.error));
     ASSERT_GE(p.crossings, 6u) << "the tip should swing through the vertical";
-    // Measured 2.87% with the default implicit Euler (the 23-link chain and
-    // its integrator against the continuous chain; 0.29% with BDF2); the
-    // bound was already this close.
+    // Measured 0.29% with the default BDF2 (the 23-link chain and its
+    // integrator against the continuous chain; 2.87% with implicit Euler,
+    // for which the bound was set).
     EXPECT_LE(p.error, 0.03) << "period " << p.period << " s, chain " << p.reference << " s";
     EXPECT_LE(p.maxStretch, lengthBound(23));
 }
 
 TEST(Rod, UndampedSwingKeepsItsEnergyAtTheChainsFirstModeFrequency) {
     // The hanging chain (E = 0, no drag) released in its first mode at 10%
-    // of L. With BDF2 (simulation.rod_integrator: bdf2) the only loss is the integrator's, of
-    // order (ω1·h)³ per period: ω1 = 2π/T1 = 7.5 rad/s, h = 0.01 s gives
-    // δ ≈ (π/2)(ω1·h)³ = 7e-4, 99.7% of the energy after 2 s.
-    GuideSettings s = rodSettings(0.f, 0.f, false);
-    s.rodIntegrator = RodIntegrator::Bdf2;
-    const Swing w = swing(s, 0.1);
+    // of L, with the default integrator (BDF2, simulation.rod_integrator:
+    // bdf2): the only loss is the integrator's, of order (ω1·h)³ per period:
+    // ω1 = 2π/T1 = 7.5 rad/s, h = 0.01 s gives δ ≈ (π/2)(ω1·h)³ = 7e-4, 99.7%
+    // of the energy after 2 s.
+    const Swing w = swing(rodSettings(0.f, 0.f, false), 0.1);
     RecordProperty("energy_kept_2s", std::to_string(w.energyKept2s));
     RecordProperty("log_decrement", std::to_string(w.logDecrement));
     RecordProperty("period_error", std::to_string(w.periodError));

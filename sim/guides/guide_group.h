@@ -121,6 +121,11 @@ class GuideGroup {
     /// Vertices pinned in the last substeps (no place outside the head at
     /// their length), then cleared. Only the rod formulation pins.
     virtual size_t takePinned() { return 0; }
+    /// The group's positions in set.x were moved outside its step (the
+    /// hair grid's volume push) from `before` (indexed like set.x). A group
+    /// that keeps a position history moves it alike, so that its next step
+    /// does not read the move as motion; nothing by default.
+    virtual void displaced(const Vec3f* /*before*/) {}
     /// State a group keeps beside set.x / set.v (the rod's BDF2 history),
     /// appended to and read back from a checkpoint; none by default.
     virtual void save(BlobWriter&) const {}

@@ -130,6 +130,7 @@ struct GuideSolver::Impl final : solver::StrandModel {
     std::vector<Vec3f> substepStart, beforeWisps;  ///< the wisp contact's scratch
     solver::Skeleton skeleton;
     size_t strandContacts = 0;  ///< of the current step
+    std::vector<Vec3f> beforePush;  ///< set.x before the grid's volume push (GuideGroup::displaced)
     volume::GridStats gridStats;  ///< of the current step: densest node, vertex pushes (summed over substeps)
 
     explicit Impl(const GuideSettings& s) : skeleton(*this, set, "guide solver", s) {
@@ -161,6 +162,7 @@ struct GuideSolver::Impl final : solver::StrandModel {
     /// then restores lengths and clearance, and computes velocities from
     /// positions, so the volume push adds no velocity.
     void couple(const solver::Substep& sub) {
+        beforePush = set.x;
         volume::GridInput in;
         in.x = set.x.data();
         in.v = set.v.data();
@@ -174,6 +176,7 @@ struct GuideSolver::Impl final : solver::StrandModel {
         });
         gridStats.maxDensity = std::max(gridStats.maxDensity, st.maxDensity);
         gridStats.pushed += st.pushed;
+        if (st.pushed) forGroups([&](guides::GuideGroup& grp) { grp.displaced(beforePush.data()); });
         ++set.version;  // the rope's Bullet nodes reload x and v
     }
 

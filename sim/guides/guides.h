@@ -97,7 +97,7 @@ struct GuideSettings : StepSettings {
     /// default: with it the default scene's settled groom stands up (docs/physics.md).
     bool taperedFibre = false;
     int rodSubsteps = 2;            ///< rod: XPBD steps per solver substep
-    RodIntegrator rodIntegrator = RodIntegrator::Euler;  ///< rod: the time integrator (docs/physics.md: why Euler stays the default)
+    RodIntegrator rodIntegrator = RodIntegrator::Bdf2;  ///< rod: the time integrator (docs/physics.md: BDF2 keeps a swing's energy)
     int preloadProbes = 3;          ///< rod: probe steps refining the pre-load (rod::preload)
     float bendDamping = 0.f;        ///< rigid only: joint spring damping, N·m·s/rad
     float damping = 1.0f;           ///< velocity decay rate, 1/s: v *= exp(-damping·t), any step size (rod: air drag)

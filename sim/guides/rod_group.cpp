@@ -107,6 +107,11 @@ class RodGroup final : public GuideGroup {
         for (size_t g = begin_; g < end_; ++g) computeCurvature(g, s.preload ? h : 0.f, contact);
     }
     void substep(const SubstepContext& ctx) override;
+    void displaced(const Vec3f* before) override {
+        if (!bdf2() || restart_) return;
+        const size_t first = set_.vertex(begin_, 0);
+        for (size_t k = 0; k < xBack_.size(); ++k) xBack_[k] += set_.x[first + k] - before[first + k];
+    }
     size_t takePinned() override { return std::exchange(pinned_, size_t(0)); }
 
   private:
@@ -116,10 +121,14 @@ class RodGroup final : public GuideGroup {
     void restartHistory() {
         restart_ = false;
         if (!bdf2()) return;
-        const float h = set_.settings.timeStep / float(std::max(1, set_.settings.substeps)) /
-                        float(std::max(1, set_.settings.rodSubsteps));
+        const float h = historyStep();
         const size_t first = set_.vertex(begin_, 0);
         rod::bdf2Start(&set_.x[first], &set_.v[first], int(xBack_.size()), h, xBack_.data(), vBack_.data());
+    }
+    /// The rod's own step, s.
+    float historyStep() const {
+        return set_.settings.timeStep / float(std::max(1, set_.settings.substeps)) /
+               float(std::max(1, set_.settings.rodSubsteps));
     }
     rod::RodStrand strand(size_t g) const {
         rod::RodStrand s;

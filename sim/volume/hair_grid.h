@@ -18,7 +18,8 @@
 //                                               hairs crossing a unit section)
 //   grid      V_c = P_c / M_c,   r_c = λ_c / λ₀,   e_c = max(0, r_c − 1)
 //   friction  v_i ← v_i + s·(V̄_i − v_i),  V̄_i = Σ_c w_ic V_c,  s = 1 − exp(−k·h)
-//   volume    x_i ← x_i − c·Δ²·∇ē(x_i) / max(1, r̄_i),   c = c_max·(1 − exp(−h/τ))
+//   volume    (I − c·L)·E = e,   x_i ← x_i − c·Δ²·∇Ē(x_i) / max(1, r̄_i),
+//             c = c_max·(1 − exp(−h/τ))
 //
 // Friction (PIC blend) conserves momentum exactly: Σ_i m_i V̄_i =
 // Σ_c V_c Σ_i w_ic m_i = Σ_c P_c = Σ_i m_i v_i. It never adds kinetic
@@ -27,10 +28,16 @@
 // The volume step moves positions only, never velocities (like the head's
 // projection), so it adds no kinetic energy; the strand solver's next step
 // restores lengths and clearance. Dividing by r̄ makes it a step of linear
-// diffusion of the excess density (∂λ/∂t = D∇²λ where λ > λ₀, D = c·Δ²/h).
-// Explicit diffusion on a grid is stable for c ≤ 1/6; c_max = 1/2 trades
-// some grid-scale jitter for a push that can hold hair up against gravity
-// (hair_grid.cpp says what was measured). One push a substep is not a
+// diffusion of the excess density (∂λ/∂t = D∇²λ where λ > λ₀, D = c·Δ²/h),
+// taken implicitly: E is the excess at the end of the step, relaxed on the
+// grid by a few Jacobi sweeps (L the 7-point Laplacian in units of Δ⁻²;
+// excess_diffusion.h), so the push is stable for any c. Read explicitly
+// (E = e) it is stable only for c ≤ 1/6, and the default τ gives c ≈ 0.4:
+// with the rod's BDF2, which keeps what implicit Euler's numerical damping
+// removed, the grid-scale jitter grew (a ball of strands piled to 863
+// hairs/cm², 2.3x without the grid). The rod keeps a position history
+// (BDF2), and moves it with the push (GuideGroup::displaced), so that the
+// push is not read as motion and extrapolated. One push a substep is not a
 // constraint: a pile under gravity settles where c·Δ·(r − 1)/r, the push a
 // substep, matches the fall g·h² a substep, above the target.
 //
@@ -49,6 +56,7 @@
 #include <Eigen/Geometry>
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -100,12 +108,15 @@ class HairGrid {
   private:
     struct Node {
         float m, l, px, py, pz;  ///< mass, hair length, momentum (all zero between calls)
+        float e;                 ///< the relaxed density excess E (excess_diffusion.h)
     };
     VolumeSettings s_;
     std::vector<Vec3f> local_;   ///< head-local positions
     std::vector<Cell> cells_;    ///< per vertex
     std::vector<unsigned> order_, slabStart_, fill_;
     std::vector<Node> nodes_;
+    std::vector<float> excess_, relaxed_, sweepScratch_;  ///< the volume step's box of nodes
+    std::vector<uint8_t> occupied_;
 };
 
 }  // namespace hp::volume

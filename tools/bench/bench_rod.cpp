@@ -62,9 +62,7 @@ int main(int argc, char** argv) {
     }
     const Pendulum p = pendulum();
     const Energy e = energy();
-    hp::GuideSettings swingSettings = rodSettings(0.f, 0.f, false);
-    swingSettings.rodIntegrator = hp::RodIntegrator::Bdf2;  // what keeps the swing; Euler keeps 0.39
-    const Swing w = swing(swingSettings, 0.1);
+    const Swing w = swing(rodSettings(0.f, 0.f, false), 0.1);  // the default integrator (BDF2; Euler keeps 0.39)
     maxStretch = std::max({maxStretch, p.maxStretch, e.maxStretch, w.maxStretch});
     std::string choices;
     for (const std::string& integrator : integrators)
