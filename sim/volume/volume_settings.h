@@ -18,12 +18,12 @@ struct VolumeSettings {
     float targetDensity = 223.f;
     float friction = 10.f;         ///< k: velocities blend toward the grid's at rate k, 1/s
     float relaxTime = 0.01f;       ///< τ: the volume step's time constant, s (0: off)
-    /// Wisps against wisps (sim/volume/wisp_contact.h): vertices of different
-    /// guides kept this many wisp diameters apart (a wisp of hairsPerGuide
-    /// hairs at targetDensity); 0: off. Off by default and not a scene key
-    /// yet: it stops the crossing wisps only with the grid's density push
-    /// off (relaxTime 0; docs/physics.md).
-    float contactScale = 0.f;
+    /// Wisps against wisps (sim/volume/wisp_contact.h), with the grid
+    /// (enabled): vertices of different guides kept this many wisp diameters
+    /// apart (a wisp of hairsPerGuide hairs at targetDensity); 0: off. Scene
+    /// key simulation.volume.contact_scale. 1.5: one diameter lets the
+    /// crossing wisps through (80%), 1.5 and 2 hold them (docs/physics.md).
+    float contactScale = 1.5f;
     int contactIterations = 4;     ///< Jacobi sweeps of the wisp contact a substep
 
     /// Throws hp::Error naming the first setting out of range.
