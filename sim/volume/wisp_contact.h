@@ -73,7 +73,12 @@ class WispContact {
 
   private:
     std::vector<Eigen::Vector3i> cell_;
-    std::vector<uint32_t> bucketStart_, order_, fill_, key_;
+    struct Sorted {
+        Eigen::Vector3f x;
+        uint32_t guide;
+    };
+    std::vector<uint32_t> bucketStart_, order_, fill_, key_, nbrStart_, nbr_, inline_;
+    std::vector<Sorted> sorted_;  ///< positions and guides in bucket order
     std::vector<Eigen::Vector3f> move_;
 };
 
