@@ -21,9 +21,10 @@ struct VolumeSettings {
     /// Wisps against wisps (sim/volume/wisp_contact.h), with the grid
     /// (enabled): vertices of different guides kept this many wisp diameters
     /// apart (a wisp of hairsPerGuide hairs at targetDensity); 0: off. Scene
-    /// key simulation.volume.contact_scale. 1.5: one diameter lets the
-    /// crossing wisps through (80%), 1.5 and 2 hold them (docs/physics.md).
-    float contactScale = 1.5f;
+    /// key simulation.volume.contact_scale. Off by default: in the default
+    /// shot it keeps the hair moving after the head stops (docs/physics.md);
+    /// 1.5 holds the crossing wisps (1 diameter lets 80% through).
+    float contactScale = 0.f;
     int contactIterations = 4;     ///< Jacobi sweeps of the wisp contact a substep
 
     /// Throws hp::Error naming the first setting out of range.

@@ -36,9 +36,9 @@
 // Neighbours: the pairs closer than d·1.1 are listed once a substep from a
 // hashed grid (vertices sorted by cell with a stable counting sort), and
 // listed again only if the sweeps have moved two vertices together by more
-// than the 0.1·d margin; on by default with the grid (scene key
-// simulation.volume.contact_scale, 1.5: docs/physics.md has what was
-// measured).
+// than the 0.1·d margin. Off by default (scene key
+// simulation.volume.contact_scale, 0; 1.5 holds the crossing wisps):
+// docs/physics.md has what was measured, and why it is off.
 //
 // Determinism: each Jacobi sweep gathers every vertex's move from its
 // neighbour list (read only; a list's order is the fixed scan order of the

@@ -8,9 +8,10 @@
 // largest segment stretch |len/rest - 1| and the deepest vertex penetration
 // over the timed steps, NaN count, threads — for every formulation (rod,
 // rope, rigid), with and without strand-strand collision, with the hair-hair
-// grid off and on (--volume off,grid,on: grid is the hair-hair grid alone,
-// on the grid with the wisp contact, the scene's default; the library's
-// default is off; the settings' runs interleave), on 1 and 2 threads.
+// grid off and on (--volume off,on,contact: on is the hair-hair grid alone,
+// the scene's default; contact the grid with the wisp contact at 1.5 wisp
+// diameters; the library's default is off; the settings' runs interleave),
+// on 1 and 2 threads.
 //
 // --collider picks how the head collides, so one run compares them:
 //   sphere  the analytic sphere (the benchmark's own head, the default);
@@ -24,7 +25,7 @@
 //           the head (the default scene's case: the head on its grid, the
 //           body through Bullet).
 //
-//   bench_sim [--guides 94,845] [--formulation rod,rope,rigid] [--strand-collision off,on] [--volume off,grid,on]
+//   bench_sim [--guides 94,845] [--formulation rod,rope,rigid] [--strand-collision off,on] [--volume off,on,contact]
 //             [--threads 1,2] [--runs 3] [--warmup 20] [--steps 250]
 //             [--substeps 1] [--iterations 20] [--rod-substeps 2] [--rod-integrator bdf2,euler]
 //             [--per-world 16] [--rate 90]
@@ -218,7 +219,7 @@ int main(int argc, char** argv) {
                   auto settingsFor = [&](const std::string& vol) {
                     GuideSettings s;
                     s.volume.enabled = vol != "off";
-                    if (vol == "grid") s.volume.contactScale = 0.f;  // the grid alone, no wisp contact
+                    if (vol == "contact") s.volume.contactScale = 1.5f;  // the grid and the wisp contact
                     s.formulation = parseFormulation(form);
                     if (!integrator.empty()) s.rodIntegrator = parseRodIntegrator(integrator);
                     s.strandCollision = coll == "on";
