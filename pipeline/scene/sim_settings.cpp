@@ -53,6 +53,7 @@ GuideSettings guideSettings(const Scene& scene) {
         {"simulation.volume.target_density", &VolumeSettings::targetDensity},
         {"simulation.volume.friction", &VolumeSettings::friction},
         {"simulation.volume.relax_time", &VolumeSettings::relaxTime},
+        {"simulation.volume.contact_scale", &VolumeSettings::contactScale},
     });
 
     const float segment = s.length / float(s.segments);

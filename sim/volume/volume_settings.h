@@ -18,11 +18,12 @@ struct VolumeSettings {
     float targetDensity = 223.f;
     float friction = 10.f;         ///< k: velocities blend toward the grid's at rate k, 1/s
     float relaxTime = 0.01f;       ///< τ: the volume step's time constant, s (0: off)
-    /// Wisps against wisps (sim/volume/wisp_contact.h): vertices of different
-    /// guides kept this many wisp diameters apart (a wisp of hairsPerGuide
-    /// hairs at targetDensity); 0: off. Off by default and not a scene key
-    /// yet: it stops the crossing wisps only with the grid's density push
-    /// off (relaxTime 0; docs/physics.md).
+    /// Wisps against wisps (sim/volume/wisp_contact.h), with the grid
+    /// (enabled): vertices of different guides kept this many wisp diameters
+    /// apart (a wisp of hairsPerGuide hairs at targetDensity); 0: off. Scene
+    /// key simulation.volume.contact_scale. Off by default: in the default
+    /// shot it keeps the hair moving after the head stops (docs/physics.md);
+    /// 1.5 holds the crossing wisps (1 diameter lets 80% through).
     float contactScale = 0.f;
     int contactIterations = 4;     ///< Jacobi sweeps of the wisp contact a substep
 

@@ -33,10 +33,17 @@
 // the grid's density push spreads hair). The solver turns the moves into
 // velocity (Δv = Δx/h), then restores lengths.
 //
+// Neighbours: the pairs closer than d·1.1 are listed once a substep from a
+// hashed grid (vertices sorted by cell with a stable counting sort), and
+// listed again only if the sweeps have moved two vertices together by more
+// than the 0.1·d margin. Off by default (scene key
+// simulation.volume.contact_scale, 0; 1.5 holds the crossing wisps):
+// docs/physics.md has what was measured, and why it is off.
+//
 // Determinism: each Jacobi sweep gathers every vertex's move from its
-// neighbours (read only) in a fixed order (vertices bucketed by hashed
-// cell with a stable counting sort, cells visited in a fixed order), then
-// applies all moves: the same bits on any thread count.
+// neighbour list (read only; a list's order is the fixed scan order of the
+// 27 cells around, whatever the thread that built it), then applies all
+// moves: the same bits on any thread count.
 #pragma once
 
 #include <Eigen/Core>
@@ -73,7 +80,12 @@ class WispContact {
 
   private:
     std::vector<Eigen::Vector3i> cell_;
-    std::vector<uint32_t> bucketStart_, order_, fill_, key_;
+    struct Sorted {
+        Eigen::Vector3f x;
+        uint32_t guide;
+    };
+    std::vector<uint32_t> bucketStart_, order_, fill_, key_, nbrStart_, nbr_, inline_;
+    std::vector<Sorted> sorted_;  ///< positions and guides in bucket order
     std::vector<Eigen::Vector3f> move_;
 };
 

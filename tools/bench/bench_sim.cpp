@@ -8,7 +8,10 @@
 // largest segment stretch |len/rest - 1| and the deepest vertex penetration
 // over the timed steps, NaN count, threads — for every formulation (rod,
 // rope, rigid), with and without strand-strand collision, with the hair-hair
-// grid off and on (--volume; the library default is off), on 1 and 2 threads.
+// grid off and on (--volume off,on,contact: on is the hair-hair grid alone,
+// the scene's default; contact the grid with the wisp contact at 1.5 wisp
+// diameters; the library's default is off; the settings' runs interleave),
+// on 1 and 2 threads.
 //
 // --collider picks how the head collides, so one run compares them:
 //   sphere  the analytic sphere (the benchmark's own head, the default);
@@ -22,7 +25,7 @@
 //           the head (the default scene's case: the head on its grid, the
 //           body through Bullet).
 //
-//   bench_sim [--guides 94,845] [--formulation rod,rope,rigid] [--strand-collision off,on] [--volume off,on]
+//   bench_sim [--guides 94,845] [--formulation rod,rope,rigid] [--strand-collision off,on] [--volume off,on,contact]
 //             [--threads 1,2] [--runs 3] [--warmup 20] [--steps 250]
 //             [--substeps 1] [--iterations 20] [--rod-substeps 2] [--rod-integrator bdf2,euler]
 //             [--per-world 16] [--rate 90]
@@ -209,13 +212,16 @@ int main(int argc, char** argv) {
         for (const std::string& form : formList)
           for (const std::string& integrator : form == "rod" ? integratorList : std::vector<std::string>{""})
             for (const std::string& coll : collList)
-                for (const std::string& th : threadList)
-                  for (const std::string& vol : volList) {
+                for (const std::string& th : threadList) {
+                  // The --volume settings' runs interleave (off, on, off, on, ...) so
+                  // that a shared machine's load falls on each alike.
+                  std::vector<std::vector<RunResult>> byVol(volList.size());
+                  auto settingsFor = [&](const std::string& vol) {
                     GuideSettings s;
-                    s.volume.enabled = vol == "on";
+                    s.volume.enabled = vol != "off";
+                    if (vol == "contact") s.volume.contactScale = 1.5f;  // the grid and the wisp contact
                     s.formulation = parseFormulation(form);
                     if (!integrator.empty()) s.rodIntegrator = parseRodIntegrator(integrator);
-                    const std::string label = integrator.empty() ? form : form + " (" + integrator + ")";
                     s.strandCollision = coll == "on";
                     s.threads = std::stoi(th);
                     s.substeps = substeps;
@@ -223,8 +229,15 @@ int main(int argc, char** argv) {
                     s.strandsPerWorld = perWorld;
                     s.rodSubsteps = rodSubsteps;
                     s.preload = preload;
-                    std::vector<RunResult> results;
-                    for (int r = 0; r < runs; ++r) results.push_back(runOnce(s, std::stoul(gs), rate, warmup, steps, collider, digest));
+                    return s;
+                  };
+                  for (int r = 0; r < runs; ++r)
+                    for (size_t vi = 0; vi < volList.size(); ++vi)
+                      byVol[vi].push_back(runOnce(settingsFor(volList[vi]), std::stoul(gs), rate, warmup, steps, collider, digest));
+                  for (size_t vi = 0; vi < volList.size(); ++vi) {
+                    const std::string& vol = volList[vi];
+                    const std::vector<RunResult>& results = byVol[vi];
+                    const std::string label = integrator.empty() ? form : form + " (" + integrator + ")";
                     std::vector<double> sps, cpu;
                     StepStats worst = results[0].stats;
                     for (const RunResult& r : results) {
@@ -250,6 +263,7 @@ int main(int argc, char** argv) {
                     }
                     std::printf("\n");
                     std::fflush(stdout);
+                  }
                 }
     return 0;
 }
