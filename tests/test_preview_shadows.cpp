@@ -30,6 +30,27 @@ void dump(const std::string& name, const Image& img) {
 
 using test::renderOnce;
 
+/// A slab of straight vertical strands (y from -0.12 to 0.12 m, 8 vertices)
+/// of one radius, jittered on a columns × rows lattice over x0..x1 × z0..z1
+/// by a deterministic generator seeded with `seed`.
+StrandFrame strandSlab(int columns, int rows, float x0, float x1, float z0, float z1, float radius, uint32_t seed) {
+    StrandFrame slab;
+    auto random = [&seed] {  // deterministic, in [0, 1)
+        seed = seed * 1664525u + 1013904223u;
+        return float(seed >> 8) / float(1u << 24);
+    };
+    for (int i = 0; i < columns; ++i)
+        for (int k = 0; k < rows; ++k) {
+            const float x = x0 + (x1 - x0) * (float(i) + random()) / float(columns);
+            const float z = z0 + (z1 - z0) * (float(k) + random()) / float(rows);
+            std::vector<Vec3f> p;
+            for (int j = 0; j < 8; ++j) p.push_back(Vec3f(x, -0.12f + 0.24f * float(j) / 7.f, z));
+            const std::vector<float> r(p.size(), radius);
+            slab.addStrand(uint32_t(slab.strandCount()), p.data(), r.data(), p.size());
+        }
+    return slab;
+}
+
 /// Image position of a world point (pixels, y down).
 Vec2f project(const View& v, const Vec3f& p) {
     const Vec4f c = v.camera.projection() * v.camera.view() * p.homogeneous();
@@ -62,21 +83,7 @@ TEST(PreviewShadows, SecondLightThroughHairIsBeerLambert) {
     const float radius = 0.0001f;
     const int columns = 100, rows = 20;
     const float x0 = 0.04f, x1 = 0.16f, z0 = 0.04f, z1 = 0.08f;
-    StrandFrame slab;
-    uint32_t seed = 2024;
-    auto random = [&seed] {  // deterministic, in [0, 1)
-        seed = seed * 1664525u + 1013904223u;
-        return float(seed >> 8) / float(1u << 24);
-    };
-    for (int i = 0; i < columns; ++i)
-        for (int k = 0; k < rows; ++k) {
-            const float x = x0 + (x1 - x0) * (float(i) + random()) / float(columns);
-            const float z = z0 + (z1 - z0) * (float(k) + random()) / float(rows);
-            std::vector<Vec3f> p;
-            for (int j = 0; j < 8; ++j) p.push_back(Vec3f(x, -0.12f + 0.24f * float(j) / 7.f, z));
-            const std::vector<float> r(p.size(), radius);
-            slab.addStrand(uint32_t(slab.strandCount()), p.data(), r.data(), p.size());
-        }
+    const StrandFrame slab = strandSlab(columns, rows, x0, x1, z0, z1, radius, 2024u);
     const double density = double(columns * rows) / double((x1 - x0) * (z1 - z0));
     const double path = double(z1 - z0) * std::sqrt(2.0);
     const double crossings = density * 2.0 * radius * path;
@@ -224,21 +231,7 @@ TEST(PreviewShadows, ScalpBounceIsTheSkinsLightThroughTheHair) {
     const float radius = 0.0001f;
     const int columns = 100, rows = 10;
     const float x0 = -0.06f, x1 = 0.06f, z0 = 0.02f, z1 = 0.04f;
-    StrandFrame slab;
-    uint32_t seed = 7;
-    auto random = [&seed] {
-        seed = seed * 1664525u + 1013904223u;
-        return float(seed >> 8) / float(1u << 24);
-    };
-    for (int i = 0; i < columns; ++i)
-        for (int k = 0; k < rows; ++k) {
-            const float x = x0 + (x1 - x0) * (float(i) + random()) / float(columns);
-            const float z = z0 + (z1 - z0) * (float(k) + random()) / float(rows);
-            std::vector<Vec3f> p;
-            for (int j = 0; j < 8; ++j) p.push_back(Vec3f(x, -0.12f + 0.24f * float(j) / 7.f, z));
-            const std::vector<float> r(p.size(), radius);
-            slab.addStrand(uint32_t(slab.strandCount()), p.data(), r.data(), p.size());
-        }
+    const StrandFrame slab = strandSlab(columns, rows, x0, x1, z0, z1, radius, 7u);
     const double crossings = double(columns * rows) / double((x1 - x0) * (z1 - z0)) * 2.0 * radius * double(z1 - z0);
     TriangleMesh plane;
     plane.positions = {Vec3f(-0.2f, -0.2f, 0.f), Vec3f(0.2f, -0.2f, 0.f), Vec3f(0.2f, 0.2f, 0.f), Vec3f(-0.2f, 0.2f, 0.f)};
