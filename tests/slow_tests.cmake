@@ -26,6 +26,7 @@ set(_hp_slow_tests
   test_shot_simulation:ShotSimulation.CheckpointRestoreContinuesBitForBit
   test_hair_grid:Volume.BallOfStrandsDroppedOnSphereStaysLessDense   # two 3 s drops of 48 strands
   test_shot_simulation:ShotSimulation.HairHangsUnderGravityAndSwingsWithTheHead  # three shots, 120 frames
+  test_shot_simulation:ShotSimulation.DefaultShotCrownHairDoesNotStandMidShakeOrTurned  # the whole default shot, 84 frames
   test_sim_guards:SimGuards.LongViolentRunStaysBoundedAndFinite  # 10^4+ steps
   test_rod:Rod.HeavyElasticaTipMatchesShootingToTheChainsDiscretisation  # 12 runs of 6 s settling
   test_resources:Resources.ResidentMemoryDoesNotGrowOverThirtyFrames  # 30 frames

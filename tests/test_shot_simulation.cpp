@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -101,8 +103,8 @@ TEST(ShotSimulation, HairHangsUnderGravityAndSwingsWithTheHead) {
     // pre-load the same groom sags, so the test can tell the two apart. The
     // default bound (1.5/ℓ_b per joint) lets the crown strands that the
     // settling left standing fall onto the head and the rest sag part way:
-    // the guide vertices' mean motion in 1 s is measured at 7.8 mm against
-    // the unloaded groom's 25.8 mm; the test asks for at most half of it, so
+    // the guide vertices' mean motion in 1 s is measured at 7.2 mm against
+    // the unloaded groom's 24.9 mm; the test asks for at most half of it, so
     // a bound that held little would fail.
     struct Drift {
         float largest, mean;
@@ -122,8 +124,8 @@ TEST(ShotSimulation, HairHangsUnderGravityAndSwingsWithTheHead) {
     RecordProperty("no_preload_sag_um", int(sagged.largest * 1e6f));
     RecordProperty("no_preload_mean_sag_um", int(sagged.mean * 1e6f));
     // Held: less than the clearance the solver keeps from the head
-    // (hair.guides.collision_radius, 1 mm; measured 0.04 mm). Sagged: the
-    // unbalanced weight bends the groom by centimetres (measured 55 mm).
+    // (hair.guides.collision_radius, 1 mm; measured 0.06 mm). Sagged: the
+    // unbalanced weight bends the groom by centimetres (measured 53 mm).
     const float clearance = float(scene.number("hair.guides.collision_radius"));
     EXPECT_LT(exact.largest, clearance) << "pre-loaded hair on a still head, 1 s";
     EXPECT_GT(sagged.largest, 10.f * clearance) << "without the pre-load the groom sags under gravity";
@@ -236,4 +238,41 @@ TEST(ShotSimulation, CurlyWetModelRunsThroughTheDriver) {
     EXPECT_GT(soaked, 0.4) << "the profile is at least 0.4 (the root) everywhere";
     EXPECT_LT(soaked, 1.0) << "and below 1 except at the tip";
     EXPECT_NEAR(half / soaked, 0.5, 0.01) << "frame 32 is halfway up the curve";
+}
+
+namespace {
+
+/// The share of frame f's strands (guides and followers) whose highest vertex
+/// stands more than `rise` above its root along world up (+y).
+double standingShare(const StrandFrame& f, float rise) {
+    size_t standing = 0;
+    for (size_t s = 0; s < f.strandCount(); ++s) {
+        const uint32_t first = f.first(s), n = f.vertexCount(s);
+        float top = f.positions[first].y();
+        for (uint32_t i = 1; i < n; ++i) top = std::max(top, f.positions[first + i].y());
+        standing += top - f.positions[first].y() > rise ? 1 : 0;
+    }
+    return f.strandCount() ? double(standing) / double(f.strandCount()) : 0.0;
+}
+
+}  // namespace
+
+TEST(ShotSimulation, DefaultShotCrownHairDoesNotStandMidShakeOrTurned) {
+    // Issue 29's criterion on the whole default shot (300 guides, 30 000
+    // followers, the default pre-load): at most 1% of the strands stand more
+    // than 2 cm above their root on frame 36 (mid-shake) and frame 84 (the
+    // head turned 75° and held). The standing strands are the crown's hooks
+    // (docs/physics.md, "Pre-load"); a groom settled until at rest lets them
+    // down (measured 0.68% and 0.43%); cut short at 2 s (the scene's old
+    // hair.groom.settle) frame 36 stood 1.15%. Frame 36 moves with where the
+    // settling stops (0.55-1.37% over eight stopping points, physics.md), so
+    // this guards the shipped scene, with little margin.
+    const Scene scene = Scene::load(test::sourcePath("scenes/default.yaml"));
+    ShotSimulation sim(scene, scene.number("fps"), 1);
+    const double mid = standingShare(sim.advanceTo(36), 0.02f);
+    const double turned = standingShare(sim.advanceTo(84), 0.02f);
+    RecordProperty("standing_frame36_permille", int(std::lround(mid * 1e3)));
+    RecordProperty("standing_frame84_permille", int(std::lround(turned * 1e3)));
+    EXPECT_LE(mid, 0.01) << "strands standing more than 2 cm above their root on frame 36";
+    EXPECT_LE(turned, 0.01) << "strands standing more than 2 cm above their root on frame 84";
 }
