@@ -6,25 +6,25 @@
 
 namespace hp {
 
-void SplitStats::add(double y, double indirect, double c, double indirectCost) {
+void SplitStats::add(double y, double i1, double i2, double c, double indirectCost) {
     n += 1.0;
     sumY += y, sumY2 += y * y;
-    sumI += indirect, sumI2 += indirect * indirect;
+    sumI2 += i1 * i1;
+    sumSplit += 0.5 * (i1 - i2) * (i1 - i2);
     cost += c, costIndirect += indirectCost;
-}
-
-void SplitStats::centre() {
-    // Σ(y − ȳ)² = Σy² − (Σy)² / n.
-    devY = n > 0.0 ? std::max(0.0, sumY2 - sumY * sumY / n) : 0.0;
-    devI = n > 0.0 ? std::max(0.0, sumI2 - sumI * sumI / n) : 0.0;
 }
 
 void SplitStats::add(const SplitStats& o) {
     n += o.n;
     sumY += o.sumY, sumY2 += o.sumY2;
-    sumI += o.sumI, sumI2 += o.sumI2;
+    sumI2 += o.sumI2, sumSplit += o.sumSplit;
     cost += o.cost, costIndirect += o.costIndirect;
-    devY += o.devY, devI += o.devI;
+    devY += o.devY;
+}
+
+void SplitStats::centre() {
+    // Σ(y − ȳ)² = Σy² − (Σy)² / n.
+    devY = n > 0.0 ? std::max(0.0, sumY2 - sumY * sumY / n) : 0.0;
 }
 
 float efficientSplitRate(const SplitStats& s, float minRate, float maxRate) {
@@ -32,7 +32,7 @@ float efficientSplitRate(const SplitStats& s, float minRate, float maxRate) {
     const double inv = 1.0 / s.n;
     const double V = s.devY * inv;   // Var(Y)
     const double M = s.sumI2 * inv;  // E[I²]
-    const double W = s.devI * inv;   // Var(I)
+    const double W = s.sumSplit * inv;  // E[Var(I | first hit)]
     const double c1 = s.costIndirect * inv;
     const double c0 = std::max(s.cost * inv - c1, 1e-3 * c1);  // at least the camera ray
     // Var − M ≤ 0: the indirect part is all of the noise, roulette only adds to it.

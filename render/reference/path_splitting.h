@@ -21,39 +21,43 @@
 
 namespace hp {
 
-/// Per-pixel sums over the training samples (each traced with rate 1) of
-/// the sample's scalar value Y (R + G + B), of its indirect part I, and of
-/// the cost of the whole sample and of its indirect part (in ray units:
-/// render/reference/reference_shading.h, SampleResult::cost).
-/// devY and devI are sums of squared deviations from each pixel's own mean,
-/// filled by centre(): pooled over several pixels they add up the pixels'
+/// Per-pixel sums over the training samples. Each training sample traces
+/// two indirect paths from its camera hit, with estimates I₁ and I₂ (R + G +
+/// B); Y = D + I₁ is then what a one-path sample would have been (D: the
+/// camera hit's own light sampling), I = I₁ its indirect part, and
+/// (I₁ − I₂)² / 2 has the mean E[Var(I | first hit)], the part of I's
+/// variance that more paths from the same hit average out (the first hit's
+/// own randomness, which fibre and where across it, they share). Costs are
+/// of a one-path sample, whole and indirect part, in ray units
+/// (render/reference/reference_shading.h, SampleResult::cost).
+/// devY is the sum of squared deviations of Y from the pixel's own mean,
+/// filled by centre(): pooled over several pixels it adds up the pixels'
 /// variances, where raw sums of squares would add the differences between
 /// the pixels' means (an edge between hair and skin) as if it were noise.
 struct SplitStats {
     double n = 0.0;
     double sumY = 0.0, sumY2 = 0.0;
-    double sumI = 0.0, sumI2 = 0.0;
+    double sumI2 = 0.0;       ///< Σ I²
+    double sumSplit = 0.0;    ///< Σ (I₁ − I₂)² / 2
     double cost = 0.0, costIndirect = 0.0;
-    double devY = 0.0, devI = 0.0;
+    double devY = 0.0;
 
-    void add(double y, double indirect, double cost, double indirectCost);
+    void add(double y, double i1, double i2, double cost, double indirectCost);
     void add(const SplitStats& o);
-    /// Sets devY and devI from this pixel's sums.
+    /// Sets devY from this pixel's sums.
     void centre();
 };
 
 /// The rate r of indirect paths a camera sample continues with (r < 1:
 /// Russian roulette of the indirect part; r > 1: splitting), clamped to
-/// [minRate, maxRate]. With V = Var(Y) = devY / n, M = E[I²] = sumI2 / n,
-/// W = Var(I) = devI / n (within pixels, after centre()), c1 the
-/// indirect cost and c0 the rest:
+/// [minRate, maxRate]. With V = Var(Y) = devY / n (within pixels, after
+/// centre()), M = E[I²] = sumI2 / n, W = E[Var(I | first hit)] =
+/// sumSplit / n, c1 the indirect cost and c0 the rest:
 /// - roulette (r ≤ 1): Var_r = V + M (1 − r) / r exactly (I survives with
 ///   probability r, weighted 1/r); Var_r (c0 + r c1) is least at
 ///   r = √(M c0 / ((V − M) c1)).
-/// - splitting (r ≥ 1): Var_r ≈ (V − W) + W / r, taking all of I's variance
-///   as the part that independent continuations average out (an upper
-///   bound: the first hit's own randomness is shared), least at
-///   r = √(W c0 / ((V − W) c1)).
+/// - splitting (r ≥ 1): Var_r = (V − W) + W / r for whole r (the paths are
+///   independent given the first hit), least at r = √(W c0 / ((V − W) c1)).
 /// Roulette is chosen when its optimum is below 1, else splitting when its
 /// optimum is above 1, else 1. No indirect light or no samples: 1.
 float efficientSplitRate(const SplitStats& s, float minRate, float maxRate);

@@ -135,8 +135,10 @@ uint64_t sampleTile(const ShadingContext& ctx, const sampling::SamplerLayout& la
             const size_t k = size_t(y) * size_t(film.width) + size_t(x);
             if (!film.active[k]) continue;
             PixelState& px = film.pixels[k];
-            const float rate = film.rates.empty() ? 1.f : film.rates[k];
             SplitStats* train = film.rates.empty() && !film.splitStats.empty() ? &film.splitStats[k] : nullptr;
+            // Training samples trace two paths (each weighted 1/2) to measure
+            // what splitting would average out (path_splitting.h).
+            const float rate = train ? 2.f : film.rates.empty() ? 1.f : film.rates[k];
             sampling::PixelSampler sampler(layout, x, y);
             for (uint32_t i = px.n; i < target; ++i) {
                 if (i == target / 2) px.firstHalf = px.sum;
@@ -146,7 +148,13 @@ uint64_t sampleTile(const ShadingContext& ctx, const sampling::SamplerLayout& la
                 const SceneHit hit = ctx.scene.intersect(cam.position, dir, 0.f, std::numeric_limits<float>::infinity());
                 const SampleResult r = shadeSample(ctx, cam.position, dir, hit, sampler, rate);
                 rays += r.rays;
-                if (train) train->add(r.radiance.sum(), r.indirect.sum(), r.cost(), r.indirectCost());
+                if (train) {
+                    // As one path: D + I₁, and half the indirect cost of two.
+                    const float i1 = r.pathCount > 0 ? r.paths[0] : 0.f, i2 = r.pathCount > 1 ? r.paths[1] : i1;
+                    const float d = r.radiance.sum() - r.indirect.sum();
+                    const float c1 = 0.5f * r.indirectCost();
+                    train->add(d + i1, i1, i2, r.cost() - c1, c1);
+                }
                 px.sum += r.radiance.cast<double>();
                 if (layers) film.diffuse[k] += r.diffuse.cast<double>(), film.specular[k] += r.specular.cast<double>();
                 if (r.hit) {
@@ -254,9 +262,9 @@ Image ReferenceRenderer::render(const View& shotView, const ReferenceGeometry& g
     // The sampler's levels are the passes (render/reference/sampling.h).
     const auto layout = sampling::SamplerLayout::make(settings.sampler, settings.seed, settings.frame, film.width,
                                                       film.height, first);
-    // Efficiency-aware splitting: the first half of the first pass (rate 1,
-    // the same samples as without) trains each region's rate, the rest of the
-    // samples use it (path_splitting.h).
+    // Efficiency-aware splitting: the first half of the first pass (two
+    // paths a sample) trains each region's rate, the rest of the samples use
+    // it (path_splitting.h).
     const bool training = !film.splitStats.empty();
     for (uint32_t target = training ? std::max(1u, first / 2) : first;; target *= 2) {
         std::atomic<size_t> done{0};

@@ -288,12 +288,16 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
         if (splits > 1 || rated) {
             const float w = 1.f / (rated ? indirectRate : float(splits));
             for (int k = 0; k < splits; ++k) {
+                const Vec3f before = r.radiance;
                 Vec3f b = beta;
-                if (!step(b, w) || intoHead || next.kind == SceneHit::Kind::None || last) continue;
-                const SampleResult sub = tracePhysical(ctx, origin, d, next, sampler, b, bounce + 1);
-                r.radiance += w * sub.radiance;
-                r.rays += sub.rays;
-                r.strandRays += sub.strandRays;
+                if (step(b, w) && !intoHead && next.kind != SceneHit::Kind::None && !last) {
+                    const SampleResult sub = tracePhysical(ctx, origin, d, next, sampler, b, bounce + 1);
+                    r.radiance += w * sub.radiance;
+                    r.rays += sub.rays;
+                    r.strandRays += sub.strandRays;
+                }
+                // The first two paths' own estimates (unweighted), for training.
+                if (bounce == 0 && k < 2) r.paths[k] = (r.radiance - before).sum() / w, r.pathCount = k + 1;
             }
             break;
         }

@@ -34,6 +34,12 @@ struct SampleResult {
     /// all but the camera hit's own light sampling) and its rays.
     Vec3f indirect = Vec3f::Zero();
     uint32_t indirectRays = 0;
+    /// With several indirect paths from the camera hit: the first two
+    /// paths' own estimates of the indirect light (R + G + B, each as if it
+    /// were the only path), to measure the variance that splitting averages
+    /// out (render/reference/path_splitting.h).
+    float paths[2] = {0.f, 0.f};
+    int pathCount = 0;
     /// Of `rays`, those leaving a strand (all in the indirect part).
     uint32_t strandRays = 0;
     /// The work of the sample in units of a camera or shadow ray: a ray
