@@ -85,11 +85,12 @@ struct ReferenceSettings {
     int bounceSplits = 1;
     /// physical: efficiency-aware Russian roulette and splitting of the
     /// indirect path at the camera hit (render/reference/path_splitting.h):
-    /// the first half of the first pass traces one path a sample and
+    /// the first half of the first pass traces two paths a sample and
     /// measures each region's variance and cost; later samples continue
     /// N paths with E[N] = r, r in [splitMinRate, splitMaxRate] chosen per
-    /// pixel, each weighted 1/r (unbiased). Off: every sample one path
-    /// (or bounceSplits).
+    /// pixel, each weighted 1/r (unbiased). Measured a loss at equal time
+    /// on the default shot (docs/benchmarks.md), so off by default: every
+    /// sample one path (or bounceSplits).
     bool efficiencySplitting = false;
     float splitMinRate = 0.25f, splitMaxRate = 4.f;
     /// How pixels share the sampler's sequences: independent (white-noise
