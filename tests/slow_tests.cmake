@@ -7,6 +7,7 @@
 set(_hp_slow_tests
   test_convergence:Convergence.ErrorFallsAsOneOverRootN       # a 4096-spp image and four more
   test_convergence:Convergence.TwoSeedsAtTheThresholdAgreeWithinIt  # four adaptive renders to ~700 spp
+  test_path_splitting:PathSplitting.ImageMeanMatchesThePlainEstimator  # 80 physical renders (4 policies x 20 seeds)
   test_hair_bsdf:HairBsdf.WhiteFurnaceByQuadratureLosesAtMostOnePercent  # 16 materials by quadrature
   test_preview_physical:PreviewPhysical.FittedPreviewPredictsThePhysicalRender  # a 128-spp physical render
   test_hair_bsdf:HairBsdf.WhiteFurnaceConservesEnergy          # 10^6 BSDF samples

@@ -136,22 +136,26 @@ TEST(Reference, ShadowRaysCountEachStrandCrossingOnce) {
 TEST(Reference, SameBitsForOneAndTwoThreads) {
     HairOnHead shot = hairOnHead(80, 60);
     shot.view.environment = Vec3f(0.1f, 0.1f, 0.12f);
-    // Physical twice more: with the ZSobol layout (one sequence for the
-    // image) and with split bounces.
+    // Physical three times more: with the ZSobol layout (one sequence for the
+    // image), with split bounces and with efficiency-aware rates (trained
+    // between passes).
     struct Case {
         ReferenceMode mode;
         sampling::SamplerType sampler;
         int splits;
+        bool efficiency;
     };
-    for (const Case& c : {Case{ReferenceMode::KajiyaKay, sampling::SamplerType::Independent, 1},
-                          Case{ReferenceMode::Physical, sampling::SamplerType::Independent, 1},
-                          Case{ReferenceMode::Physical, sampling::SamplerType::ZSobol, 1},
-                          Case{ReferenceMode::Physical, sampling::SamplerType::Independent, 3}}) {
+    for (const Case& c : {Case{ReferenceMode::KajiyaKay, sampling::SamplerType::Independent, 1, false},
+                          Case{ReferenceMode::Physical, sampling::SamplerType::Independent, 1, false},
+                          Case{ReferenceMode::Physical, sampling::SamplerType::ZSobol, 1, false},
+                          Case{ReferenceMode::Physical, sampling::SamplerType::Independent, 3, false},
+                          Case{ReferenceMode::Physical, sampling::SamplerType::Independent, 1, true}}) {
         const ReferenceMode mode = c.mode;
         ReferenceSettings s;
         s.mode = mode;
         s.sampler = c.sampler;
         s.bounceSplits = c.splits;
+        s.efficiencySplitting = c.efficiency;
         s.samplesPerPixel = 4;
         s.bounces = 3;
         s.tileSize = 8;
@@ -162,7 +166,8 @@ TEST(Reference, SameBitsForOneAndTwoThreads) {
         tbb::task_arena(2).execute([&] { two = ReferenceRenderer().render(shot.view, &shot.strands, &shot.head, s); });
         ASSERT_EQ(one.pixels.size(), two.pixels.size());
         EXPECT_EQ(0, std::memcmp(one.pixels.data(), two.pixels.data(), one.pixels.size() * sizeof(float)))
-            << referenceModeName(mode) << " " << sampling::samplerName(c.sampler) << " splits " << c.splits;
+            << referenceModeName(mode) << " " << sampling::samplerName(c.sampler) << " splits " << c.splits
+            << " efficiency " << c.efficiency;
         double coverage = 0.0;
         for (int y = 0; y < one.height; ++y)
             for (int x = 0; x < one.width; ++x) coverage += one.at(x, y, 3);

@@ -51,6 +51,7 @@ ReferenceSettings referenceSettings(const Scene& s, const ShotSettings& shot) {
     r.filter.sigma = float(s.number("reference.filter.sigma"));
     r.bounces = int(s.integer("reference.depth"));
     r.bounceSplits = int(s.integer("reference.bounce_splits"));
+    r.efficiencySplitting = s.text("reference.splitting") == "efficiency";
     r.sampler = s.text("reference.sampler") == "independent" ? sampling::SamplerType::Independent
                                                               : sampling::SamplerType::ZSobol;
     r.seed = s.has("reference.seed") ? uint64_t(s.integer("reference.seed")) : uint64_t(shot.seed);

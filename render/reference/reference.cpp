@@ -3,6 +3,7 @@
 #include "core/errors.h"
 #include "render/reference/embree_scene.h"
 #include "render/reference/adaptive_sampling.h"
+#include "render/reference/path_splitting.h"
 #include "render/reference/reference_shading.h"
 
 #include <pmmintrin.h>
@@ -103,6 +104,10 @@ struct Film {
     std::vector<Eigen::Vector3d> diffuse, specular;  ///< with the diffuse/specular layers
     std::vector<int64_t> ids;                        ///< with the id layer
     std::vector<uint8_t> active;
+    /// Efficiency-aware splitting: the training samples' statistics while
+    /// `rates` is empty, then each pixel's rate of indirect paths.
+    std::vector<SplitStats> splitStats;
+    std::vector<float> rates;
 
     Film(int w, int h, const ReferenceSettings& s, float farClip)
         : width(w), height(h), pixels(size_t(w) * size_t(h)), active(pixels.size(), 1) {
@@ -110,6 +115,7 @@ struct Film {
         if (s.diffuseSpecularLayers)
             diffuse.assign(pixels.size(), Eigen::Vector3d::Zero()), specular = diffuse;
         if (s.strandIdLayer) ids.assign(pixels.size(), -1);
+        if (s.efficiencySplitting && s.mode == ReferenceMode::Physical) splitStats.resize(pixels.size());
     }
 };
 
@@ -129,6 +135,10 @@ uint64_t sampleTile(const ShadingContext& ctx, const sampling::SamplerLayout& la
             const size_t k = size_t(y) * size_t(film.width) + size_t(x);
             if (!film.active[k]) continue;
             PixelState& px = film.pixels[k];
+            SplitStats* train = film.rates.empty() && !film.splitStats.empty() ? &film.splitStats[k] : nullptr;
+            // Training samples trace two paths (each weighted 1/2) to measure
+            // what splitting would average out (path_splitting.h).
+            const float rate = train ? 2.f : film.rates.empty() ? 1.f : film.rates[k];
             sampling::PixelSampler sampler(layout, x, y);
             for (uint32_t i = px.n; i < target; ++i) {
                 if (i == target / 2) px.firstHalf = px.sum;
@@ -136,8 +146,15 @@ uint64_t sampleTile(const ShadingContext& ctx, const sampling::SamplerLayout& la
                 const Vec2f offset = sampleFilterOffset(s.filter, sampler.next2D());
                 const Vec3f dir = camera.direction(float(x) + 0.5f + offset.x(), float(y) + 0.5f + offset.y());
                 const SceneHit hit = ctx.scene.intersect(cam.position, dir, 0.f, std::numeric_limits<float>::infinity());
-                const SampleResult r = shadeSample(ctx, cam.position, dir, hit, sampler);
+                const SampleResult r = shadeSample(ctx, cam.position, dir, hit, sampler, rate);
                 rays += r.rays;
+                if (train) {
+                    // As one path: D + I₁, and half the indirect cost of two.
+                    const float i1 = r.pathCount > 0 ? r.paths[0] : 0.f, i2 = r.pathCount > 1 ? r.paths[1] : i1;
+                    const float d = r.radiance.sum() - r.indirect.sum();
+                    const float c1 = 0.5f * r.indirectCost();
+                    train->add(d + i1, i1, i2, r.cost() - c1, c1);
+                }
                 px.sum += r.radiance.cast<double>();
                 if (layers) film.diffuse[k] += r.diffuse.cast<double>(), film.specular[k] += r.specular.cast<double>();
                 if (r.hit) {
@@ -245,7 +262,11 @@ Image ReferenceRenderer::render(const View& shotView, const ReferenceGeometry& g
     // The sampler's levels are the passes (render/reference/sampling.h).
     const auto layout = sampling::SamplerLayout::make(settings.sampler, settings.seed, settings.frame, film.width,
                                                       film.height, first);
-    for (uint32_t target = first;; target *= 2) {
+    // Efficiency-aware splitting: the first half of the first pass (two
+    // paths a sample) trains each region's rate, the rest of the samples use
+    // it (path_splitting.h).
+    const bool training = !film.splitStats.empty();
+    for (uint32_t target = training ? std::max(1u, first / 2) : first;; target *= 2) {
         std::atomic<size_t> done{0};
         tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& range) {
             for (size_t t = range.begin(); t != range.end(); ++t) {
@@ -263,6 +284,14 @@ Image ReferenceRenderer::render(const View& shotView, const ReferenceGeometry& g
                 }
             }
         });
+        if (training && film.rates.empty()) {
+            // 5×5 pixels pool their statistics; rates are fixed from here on.
+            const std::vector<SplitStats> pooled = poolSplitStats(film.splitStats, film.width, film.height, 2);
+            film.rates.resize(pooled.size());
+            for (size_t k = 0; k < pooled.size(); ++k)
+                film.rates[k] = efficientSplitRate(pooled[k], settings.splitMinRate, settings.splitMaxRate);
+            if (target < first) continue;  // the training half: the first pass goes on
+        }
         ++st.passes;
         size_t sampling = 0;
         if (adaptive) {
@@ -286,6 +315,13 @@ Image ReferenceRenderer::render(const View& shotView, const ReferenceGeometry& g
         converged += p.error < settings.noiseThreshold;
     }
     const double pixels = double(film.pixels.size());
+    if (!film.rates.empty()) {
+        double rateSum = 0.0;
+        st.minSplitRate = std::numeric_limits<float>::max(), st.maxSplitRate = 0.f;
+        for (float r : film.rates)
+            rateSum += r, st.minSplitRate = std::min(st.minSplitRate, r), st.maxSplitRate = std::max(st.maxSplitRate, r);
+        st.meanSplitRate = rateSum / pixels;
+    }
     st.meanSamples = samples / pixels;
     st.meanError = error / pixels;
     st.convergedFraction = double(converged) / pixels;

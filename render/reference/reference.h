@@ -83,6 +83,16 @@ struct ReferenceSettings {
     /// physical: independent indirect paths from each camera sample's first
     /// hit, each counted 1/N (unbiased; 1 = one path, as before).
     int bounceSplits = 1;
+    /// physical: efficiency-aware Russian roulette and splitting of the
+    /// indirect path at the camera hit (render/reference/path_splitting.h):
+    /// the first half of the first pass traces two paths a sample and
+    /// measures each region's variance and cost; later samples continue
+    /// N paths with E[N] = r, r in [splitMinRate, splitMaxRate] chosen per
+    /// pixel, each weighted 1/r (unbiased). Measured a loss at equal time
+    /// on the default shot (docs/benchmarks.md), so off by default: every
+    /// sample one path (or bounceSplits).
+    bool efficiencySplitting = false;
+    float splitMinRate = 0.25f, splitMaxRate = 4.f;
     /// How pixels share the sampler's sequences: independent (white-noise
     /// error) or zsobol (blue noise across pixels), render/reference/sampling.h.
     sampling::SamplerType sampler = sampling::SamplerType::Independent;
@@ -128,6 +138,10 @@ struct ReferenceStats {
     double convergedFraction = 0.0;  ///< pixels whose error ended below the threshold
     double meanError = 0.0;      ///< the error layer averaged over the image
     bool timeLimitReached = false;
+    /// With efficiencySplitting: the indirect paths' rates chosen for the
+    /// pixels (1 without).
+    float minSplitRate = 1.f, maxSplitRate = 1.f;
+    double meanSplitRate = 1.0;  ///< over the image
 };
 
 /// Channel names of the output image, in order: R G B A Z, samples (the

@@ -1,5 +1,6 @@
 #include "render/reference/reference_shading.h"
 
+#include "render/reference/path_splitting.h"
 #include "render/reference/vertex_bsdf.h"
 
 #include <algorithm>
@@ -115,7 +116,7 @@ SampleResult shadeKajiyaKay(const ShadingContext& ctx, const Vec3f& o, const Vec
 /// same light are weighted by the power heuristic (Veach and Guibas 1995),
 /// so together they count it once; delta lights are light-sampled only.
 SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit hit, sampling::PixelSampler& sampler,
-                           Vec3f beta = Vec3f::Ones(), int firstBounce = 0) {
+                           Vec3f beta = Vec3f::Ones(), int firstBounce = 0, float indirectRate = 1.f) {
     SampleResult r;
     const ReferenceSettings& s = ctx.settings;
     const EnvironmentLight& env = ctx.environment;
@@ -134,6 +135,10 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
     bool hittable = false;
     for (const SampledLight& l : ctx.lights) hittable = hittable || (!l.delta() && !firstHitLight(l));
     hittable = (hittable && bsdfSampling) || (env.active() && skyBsdfSampling);
+    // The camera hit's own light sampling, to tell the indirect part apart.
+    Vec3f direct = Vec3f::Zero();
+    uint32_t directRays = 0;
+    bool directKnown = false;
     for (int bounce = firstBounce;; ++bounce) {
         const bool last = bounce >= s.bounces;
         const Vec3f p = o + hit.t * d;
@@ -200,6 +205,7 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
                 if (bounce == 0) r.specular += spec.cwiseProduct(li);
             }
         }
+        if (bounce == firstBounce) direct = r.radiance, directRays = r.rays, directKnown = true;
         if (last && !hittable) break;
 
         // BSDF sampling: the path's next direction, with `throughput`
@@ -232,6 +238,7 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
             next = SceneHit{};
             if (!intoHead) {
                 ++r.rays;
+                r.strandRays += !onHead;
                 next = ctx.scene.intersect(origin, d, 0.f, kInf, onHead ? RayStart{} : start);
             }
             if (bsdfSampling || skyBsdfSampling) {
@@ -273,15 +280,24 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
         // continuations of the camera hit, each counted 1/N: an estimate of
         // the indirect light with 1/N of one's variance, without paying again
         // for the camera ray, the first hit's shading and its direct light.
-        const int splits = bounce == 0 ? std::max(1, s.bounceSplits) : 1;
-        if (splits > 1) {
-            const float w = 1.f / float(splits);
+        // Efficiency-aware rate (path_splitting.h): N paths with E[N] = rate,
+        // each counted 1/rate; N = 0 is Russian roulette of the indirect part.
+        const bool rated = bounce == 0 && indirectRate != 1.f;
+        const int splits = rated ? splitCount(indirectRate, sampler.next1D())
+                                 : bounce == 0 ? std::max(1, s.bounceSplits) : 1;
+        if (splits > 1 || rated) {
+            const float w = 1.f / (rated ? indirectRate : float(splits));
             for (int k = 0; k < splits; ++k) {
+                const Vec3f before = r.radiance;
                 Vec3f b = beta;
-                if (!step(b, w) || intoHead || next.kind == SceneHit::Kind::None || last) continue;
-                const SampleResult sub = tracePhysical(ctx, origin, d, next, sampler, b, bounce + 1);
-                r.radiance += w * sub.radiance;
-                r.rays += sub.rays;
+                if (step(b, w) && !intoHead && next.kind != SceneHit::Kind::None && !last) {
+                    const SampleResult sub = tracePhysical(ctx, origin, d, next, sampler, b, bounce + 1);
+                    r.radiance += w * sub.radiance;
+                    r.rays += sub.rays;
+                    r.strandRays += sub.strandRays;
+                }
+                // The first two paths' own estimates (unweighted), for training.
+                if (bounce == 0 && k < 2) r.paths[k] = (r.radiance - before).sum() / w, r.pathCount = k + 1;
             }
             break;
         }
@@ -291,13 +307,14 @@ SampleResult tracePhysical(const ShadingContext& ctx, Vec3f o, Vec3f d, SceneHit
         if (intoHead || hit.kind == SceneHit::Kind::None || last) break;
     }
     r.diffuse = r.radiance - r.specular;
+    if (directKnown) r.indirect = r.radiance - direct, r.indirectRays = r.rays - directRays;
     return r;
 }
 
 }  // namespace
 
 SampleResult shadeSample(const ShadingContext& ctx, const Vec3f& origin, const Vec3f& dir, const SceneHit& hit,
-                         sampling::PixelSampler& sampler) {
+                         sampling::PixelSampler& sampler, float indirectRate) {
     SampleResult r;
     if (hit.kind == SceneHit::Kind::None) {
         // The sky seen: the map itself in physical mode, its mean in the preview's.
@@ -307,7 +324,7 @@ SampleResult shadeSample(const ShadingContext& ctx, const Vec3f& origin, const V
         return r;
     }
     r = ctx.settings.mode == ReferenceMode::KajiyaKay ? shadeKajiyaKay(ctx, origin, dir, hit)
-                                                      : tracePhysical(ctx, origin, dir, hit, sampler);
+                                                      : tracePhysical(ctx, origin, dir, hit, sampler, Vec3f::Ones(), 0, indirectRate);
     r.rays += 1;
     r.hit = true;
     const Camera& cam = ctx.view.camera;

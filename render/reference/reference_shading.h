@@ -30,11 +30,32 @@ struct SampleResult {
     float depth = 0.f;               ///< view-space depth of the first hit
     int64_t strandId = -1;           ///< stable id of the strand hit first (with the id layer only), −1 for head or nothing
     uint32_t rays = 0;
+    /// physical: what the first hit's continuation added (part of radiance,
+    /// all but the camera hit's own light sampling) and its rays.
+    Vec3f indirect = Vec3f::Zero();
+    uint32_t indirectRays = 0;
+    /// With several indirect paths from the camera hit: the first two
+    /// paths' own estimates of the indirect light (R + G + B, each as if it
+    /// were the only path), to measure the variance that splitting averages
+    /// out (render/reference/path_splitting.h).
+    float paths[2] = {0.f, 0.f};
+    int pathCount = 0;
+    /// Of `rays`, those leaving a strand (all in the indirect part).
+    uint32_t strandRays = 0;
+    /// The work of the sample in units of a camera or shadow ray: a ray
+    /// leaving a strand starts inside the dense hair, and Embree takes about
+    /// 2.4 times as long over it (docs/benchmarks.md, "The cost per sample":
+    /// 9.7k cycles against 3.0k camera and 4.1k shadow rays).
+    float cost() const { return float(rays) + 1.4f * float(strandRays); }
+    float indirectCost() const { return float(indirectRays) + 1.4f * float(strandRays); }
 };
 
 /// Shades the camera ray (origin, unit dir) whose first hit is `hit`, with
 /// the context's mode; further random numbers come from `sampler`.
+/// `indirectRate` (physical): the camera hit continues N indirect paths,
+/// E[N] = rate, each weighted 1/rate (render/reference/path_splitting.h);
+/// exactly 1 traces one path and draws no extra random number.
 SampleResult shadeSample(const ShadingContext& ctx, const Vec3f& origin, const Vec3f& dir, const SceneHit& hit,
-                         sampling::PixelSampler& sampler);
+                         sampling::PixelSampler& sampler, float indirectRate = 1.f);
 
 }  // namespace hp

@@ -15,6 +15,7 @@
 //                   [--noise-threshold T (adaptive; 0: --spp fixed)] [--min-samples 16]
 //                   [--max-samples 1024] [--time-limit S] [--filter gaussian|box]
 //                   [--seeds A,B] [--sampler zsobol|independent] [--bounce-splits 1]
+//                   [--splitting off|efficiency] [--split-rates MIN,MAX]
 //
 // B-converge (docs/benchmarks.md): with --seeds A,B every render is made with
 // both sampler seeds and the two images are compared on the hair mask (FLIP,
@@ -68,7 +69,8 @@ double median(std::vector<double> v) {
 int main(int argc, char** argv) {
     std::vector<std::string> strandCounts{"10000", "100000"}, modes{"physical", "kajiya-kay"};
     int width = 1920, height = 1080, spp = 16, bounces = 4, repeat = 1, threads = 2, bounceSplits = 1;
-    bool withHead = true, shadows = true;
+    bool withHead = true, shadows = true, efficiencySplitting = false;
+    float splitMin = ReferenceSettings{}.splitMinRate, splitMax = ReferenceSettings{}.splitMaxRate;
     float melanin = 1.3f;
     float shadowRoulette = ReferenceSettings{}.shadowRouletteThreshold;
     uint64_t seed = 1;
@@ -95,6 +97,11 @@ int main(int argc, char** argv) {
         else if (a == "--spp") spp = std::stoi(next());
         else if (a == "--bounces") bounces = std::stoi(next());
         else if (a == "--bounce-splits") bounceSplits = std::stoi(next());
+        else if (a == "--splitting") efficiencySplitting = next() == "efficiency";
+        else if (a == "--split-rates") {
+            const std::vector<std::string> r = split(next());
+            splitMin = std::stof(r.at(0)), splitMax = std::stof(r.at(1));
+        }
         else if (a == "--repeat") repeat = std::max(1, std::stoi(next()));
         else if (a == "--threads") threads = std::stoi(next());
         else if (a == "--out") out = next();
@@ -148,6 +155,8 @@ int main(int argc, char** argv) {
             s.samplesPerPixel = spp;
             s.bounces = bounces;
             s.bounceSplits = bounceSplits;
+            s.efficiencySplitting = efficiencySplitting;
+            s.splitMinRate = splitMin, s.splitMaxRate = splitMax;
             s.frame = 1;
             s.noiseThreshold = noiseThreshold;
             s.minSamples = minSamples;
@@ -190,6 +199,9 @@ int main(int argc, char** argv) {
                         median(bcpu), median(rcpu), double(st.rays) / (double(width) * height * st.meanSamples),
                         double(st.sceneBytes) / (1 << 20), double(st.peakBytes) / (1 << 20), peakRssMiB(),
                         st.meanSamples, st.maxSamples, flip2, ssim2, rmse2);
+            if (s.efficiencySplitting && s.mode == ReferenceMode::Physical)
+                std::printf("# efficiency splitting: indirect paths a camera sample %.3f mean, %.3f..%.3f\n",
+                            st.meanSplitRate, st.minSplitRate, st.maxSplitRate);
             std::fflush(stdout);
             if (!out.empty()) {
                 std::filesystem::create_directories(out);
