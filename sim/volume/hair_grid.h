@@ -99,22 +99,29 @@ class HairGrid {
     float blendFraction(float h) const;
     float pushFraction(float h) const;
 
-    /// Base node and trilinear fractions of a head-local position (i < 0: not gridded).
+  private:
+    /// A gridded vertex in the passes' order: base node (i, j, k), its
+    /// index in the lattice, trilinear fractions.
     struct Cell {
         int i, j, k;
+        uint32_t node;
         float tx, ty, tz;
-    };
-
-  private:
-    struct Node {
-        float m, l, px, py, pz;  ///< mass, hair length, momentum (all zero between calls)
-        float e;                 ///< the relaxed density excess E (excess_diffusion.h)
+        uint32_t vertex;  ///< index into GridInput
     };
     VolumeSettings s_;
-    std::vector<Vec3f> local_;   ///< head-local positions
-    std::vector<Cell> cells_;    ///< per vertex
-    std::vector<unsigned> order_, slabStart_, fill_;
-    std::vector<Node> nodes_;
+    std::vector<Vec3f> local_;       ///< head-local positions, per vertex
+    std::vector<uint32_t> rowOf_;    ///< node row (j, k) of each vertex's base node; ~0: not gridded
+    std::vector<unsigned> rowStart_, fill_;
+    /// Gridded vertices sorted by node row (hair_grid.cpp): their cells and
+    /// (m, v), copied in that order so that every pass reads them in a stream.
+    std::vector<Cell> cells_;
+    std::vector<Eigen::Vector4f> massVel_;
+    std::vector<float> ratio_;       ///< r̄ = λ̄/λ₀ each sorted vertex reads
+    /// Per node (m, P): mass and momentum, one SSE packet, so the splat
+    /// adds w·(m, m·v) in one operation; zero between calls. The hair
+    /// length is M·lengthPerMass (the same for every vertex), not stored:
+    /// the passes wait on the lattice's memory, not on arithmetic.
+    std::vector<Eigen::Vector4f> nodes_;
     std::vector<float> excess_, relaxed_, sweepScratch_;  ///< the volume step's box of nodes
     std::vector<uint8_t> occupied_;
 };
