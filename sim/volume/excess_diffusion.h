@@ -36,13 +36,15 @@
 // thread count.
 #pragma once
 
-#include "sim/volume/hair_grid.h"
-
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace hp::volume {
+
+/// Runs f(begin, end) over [0, count) in parallel chunks (the caller's arena).
+using ParallelFor = std::function<void(size_t count, const std::function<void(size_t, size_t)>& f)>;
 
 /// A box of nx × ny × nz grid nodes, x fastest (node (i, j, k) at
 /// (k·ny + j)·nx + i).
@@ -58,10 +60,20 @@ struct NodeBox {
 void jacobiSweep(const NodeBox& box, const float* e, const uint8_t* occupied, float c, const float* in, float* out,
                  int k0, int k1);
 
+/// relaxExcess's scratch, reused call after call.
+struct RelaxScratch {
+    std::vector<float> values;          ///< the second buffer of the sweeps
+    std::vector<uint32_t> nodes;        ///< the occupied nodes, plane by plane, ascending
+    std::vector<uint8_t> inside;        ///< per listed node: its neighbours in the box (bits −x, +x, −y, +y, −z, +z)
+    std::vector<uint32_t> planeStart;   ///< nz + 1 offsets into nodes
+};
+
 /// E after `sweeps` Jacobi sweeps from E⁰ = 0 (the file comment), the
-/// planes of each sweep run through `parallel`. `scratch` is resized as
-/// needed; `out` receives E (box.size() values).
+/// planes of each sweep run through `parallel`; `out` receives E
+/// (box.size() values). The sweeps visit the occupied nodes only, from a
+/// list made once a call (the others hold 0 throughout): the same values,
+/// term by term, as jacobiSweep over the whole box.
 void relaxExcess(const NodeBox& box, const float* e, const uint8_t* occupied, float c, int sweeps, float* out,
-                 std::vector<float>& scratch, const ParallelFor& parallel);
+                 RelaxScratch& scratch, const ParallelFor& parallel);
 
 }  // namespace hp::volume

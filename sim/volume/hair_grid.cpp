@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 
 namespace hp {
 
@@ -45,6 +46,10 @@ constexpr float kMaxPush = 0.5f;
 /// 4 sweeps 338, 1.5%; 8 sweeps 300, 1.6%.
 constexpr int kSweeps = 4;
 
+/// Lattices of at most this many nodes per gridded vertex are cleared
+/// with one memset (845 B-sim guides: 20k vertices on 100k-180k nodes; the
+/// memset took half the time of clearing each vertex's eight nodes).
+constexpr size_t kClearByFill = 32;
 /// Vertices below which apply() runs on the calling thread.
 constexpr size_t kParallelVertices = 8192;
 
@@ -354,7 +359,13 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     }
     st.pushed = pushed;
 
-    // Leave the array all zeros for the next call: clear what the splat touched.
+    // Leave the array all zeros for the next call. A lattice of at most
+    // kClearByFill nodes a vertex is cleared whole (a memset streams at
+    // memory speed), a sparser one node by node where the splat wrote.
+    if (nodes <= kClearByFill * gridded) {
+        std::memset(static_cast<void*>(N), 0, nodes * sizeof(Eigen::Vector4f));
+        return st;
+    }
     bySlab([&, N, C, sx, plane](size_t first, size_t end) {
         for (size_t o = first; o < end; ++o)
             for (int dk = 0; dk < 2; ++dk)

@@ -51,6 +51,7 @@
 // same cells every step.
 #pragma once
 
+#include "sim/volume/excess_diffusion.h"
 #include "sim/volume/volume_settings.h"
 
 #include <Eigen/Geometry>
@@ -64,8 +65,7 @@ namespace hp::volume {
 
 using Vec3f = Eigen::Vector3f;
 
-/// Runs f(begin, end) over [0, count) in parallel chunks (the caller's arena).
-using ParallelFor = std::function<void(size_t count, const std::function<void(size_t, size_t)>& f)>;
+// ParallelFor (f(begin, end) over [0, count) in the caller's arena): excess_diffusion.h.
 
 /// The vertices the grid couples (structure of arrays, `count` entries each).
 struct GridInput {
@@ -122,7 +122,8 @@ class HairGrid {
     /// length is M·lengthPerMass (the same for every vertex), not stored:
     /// the passes wait on the lattice's memory, not on arithmetic.
     std::vector<Eigen::Vector4f> nodes_;
-    std::vector<float> excess_, relaxed_, sweepScratch_;  ///< the volume step's box of nodes
+    std::vector<float> excess_, relaxed_;  ///< the volume step's box of nodes
+    RelaxScratch sweepScratch_;
     std::vector<uint8_t> occupied_;
 };
 
