@@ -62,7 +62,7 @@ TEST(ExcessDiffusion, SweepsMatchTheNeumannSeriesOnEigenmodes) {
         const Mode m(8, p[0], p[1], p[2]);
         const std::vector<uint8_t> occupied(m.box.size(), 1);
         std::vector<float> E(m.box.size());
-        RelaxScratch scratch;
+        OccupiedNodes scratch;
         for (float c : {0.05f, 0.43f, 2.f})
             for (int sweeps : {1, 2, 3, 4, 8}) {
                 relaxExcess(m.box, m.e.data(), occupied.data(), c, sweeps, E.data(), scratch, serial);
@@ -82,7 +82,7 @@ TEST(ExcessDiffusion, TheStepNeverGrowsAModeWhereTheExplicitOneDoes) {
     ASSERT_LT(m.mu, -11.5);
     const std::vector<uint8_t> occupied(m.box.size(), 1);
     std::vector<float> E(m.box.size());
-    RelaxScratch scratch;
+    OccupiedNodes scratch;
     for (float c : {0.1f, 0.25f, 0.5f, 2.f, 20.f}) {
         for (int sweeps = 1; sweeps <= 9; ++sweeps) {
             relaxExcess(m.box, m.e.data(), occupied.data(), c, sweeps, E.data(), scratch, serial);
@@ -115,7 +115,7 @@ TEST(ExcessDiffusion, NodesWithoutHairHoldNoExcessAndBlockIt) {
     box.nx = 9;
     box.ny = box.nz = 1;
     std::vector<float> e(9, 0.f), E(9);
-    RelaxScratch scratch;
+    OccupiedNodes scratch;
     std::vector<uint8_t> occupied(9, 1);
     e[1] = 5.f;
     occupied[4] = 0;
@@ -144,7 +144,7 @@ TEST(ExcessDiffusion, SameBitsOnAnyThreadCountAndChunkOrder) {
         for (size_t b = count; b > 0; --b) f(b - 1, b);
     };
     std::vector<float> ref(box.size());
-    RelaxScratch scratch;
+    OccupiedNodes scratch;
     relaxExcess(box, e.data(), occupied.data(), 0.43f, 6, ref.data(), scratch, serial);
     for (int threads : {1, 2}) {
         tbb::task_arena arena(threads);
@@ -187,7 +187,7 @@ TEST(ExcessDiffusion, ListedSweepsMatchWholeBoxSweeps) {
             std::swap(a, b);
         }
         std::vector<float> E(box.size(), -1.f);
-        RelaxScratch scratch;
+        OccupiedNodes scratch;
         relaxExcess(box, e.data(), occupied.data(), 0.43f, sweeps, E.data(), scratch, serial);
         EXPECT_EQ(0, std::memcmp(E.data(), a.data(), E.size() * sizeof(float))) << sweeps << " sweeps";
     }

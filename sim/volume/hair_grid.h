@@ -110,6 +110,7 @@ class HairGrid {
     };
     VolumeSettings s_;
     std::vector<Vec3f> local_;       ///< head-local positions, per vertex
+    std::vector<Cell> vertexCells_;  ///< per vertex
     std::vector<uint32_t> rowOf_;    ///< node row (j, k) of each vertex's base node; ~0: not gridded
     std::vector<unsigned> rowStart_, fill_;
     /// Gridded vertices sorted by node row (hair_grid.cpp): their cells and
@@ -122,9 +123,8 @@ class HairGrid {
     /// length is M·lengthPerMass (the same for every vertex), not stored:
     /// the passes wait on the lattice's memory, not on arithmetic.
     std::vector<Eigen::Vector4f> nodes_;
-    std::vector<float> excess_, relaxed_;  ///< the volume step's box of nodes
-    RelaxScratch sweepScratch_;
-    std::vector<uint8_t> occupied_;
+    OccupiedNodes occupied_;         ///< the volume step's nodes with hair
+    std::vector<float> relaxed_;     ///< its E on the box of nodes
 };
 
 }  // namespace hp::volume
