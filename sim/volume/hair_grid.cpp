@@ -73,9 +73,10 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
         if (serial) f(0, count);
         else parallel(count, f);
     };
-    local_.resize(n);
+    // Head-local positions are computed where they are read (twice: cheaper
+    // than storing and loading them).
     const Eigen::Isometry3f toLocal = in.head.inverse();
-    auto valid = [&](size_t i) { return in.mass[i] > 0.f && local_[i].allFinite(); };
+    auto valid = [&](size_t i, const Vec3f& p) { return in.mass[i] > 0.f && p.allFinite(); };
 
     // Head-local positions and their bounds (min and max do not depend on
     // the order or the chunks).
@@ -87,10 +88,10 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     run(n, [&](size_t b, size_t e) {
         Vec3f lo = Vec3f::Constant(INFINITY), hi = Vec3f::Constant(-INFINITY);
         for (size_t i = b; i < e; ++i) {
-            local_[i] = toLocal * in.x[i];
-            if (valid(i)) {
-                lo = lo.cwiseMin(local_[i]);
-                hi = hi.cwiseMax(local_[i]);
+            const Vec3f p = toLocal * in.x[i];
+            if (valid(i, p)) {
+                lo = lo.cwiseMin(p);
+                hi = hi.cwiseMax(p);
             }
         }
         for (int a = 0; a < 3; ++a) {
@@ -124,8 +125,8 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     };
     // Written field by field into the array: a Cell built on the stack and
     // copied whole stalled on store forwarding (perf: 70% of this pass).
-    auto cellOf = [&](size_t i, Cell& c) {
-        const Vec3f f = (local_[i] - origin) * invD;
+    auto cellOf = [&](size_t i, const Vec3f& p, Cell& c) {
+        const Vec3f f = (p - origin) * invD;
         // int() truncates: floor for f ≥ 0, and f > −1 (rounding below the
         // origin) gives 0 either way after the clamp, with t clamped to 0.
         c.i = std::clamp(int(f.x()), 0, nx - 2);
@@ -156,12 +157,13 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     rowOf_.resize(n);
     run(n, [&](size_t b, size_t e) {
         for (size_t i = b; i < e; ++i) {
-            if (!valid(i)) {
+            const Vec3f p = toLocal * in.x[i];
+            if (!valid(i, p)) {
                 rowOf_[i] = kNone;
                 continue;
             }
             Cell& c = vertexCells_[i];
-            cellOf(i, c);
+            cellOf(i, p, c);
             rowOf_[i] = uint32_t(size_t(c.k) * size_t(ny) + size_t(c.j));
         }
     });
@@ -282,17 +284,20 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     st.maxDensity = maxR.load() * s_.targetDensity;
 
     // The volume step's excess, relaxed implicitly on the box of nodes
-    // above the target grown by the sweeps' reach (excess_diffusion.h:
-    // beyond it E stays 0), kept in relaxed_ for the gather.
+    // above the target grown by the sweeps' reach, kept in relaxed_ for the
+    // gather. K sweeps from E⁰ = 0 reach K − 1 nodes beyond the excess (E¹
+    // is nonzero only on it, each sweep one node further), so beyond that
+    // margin E is 0, and a node at the margin reads 0 from outside it
+    // either way: the same E as on the whole lattice.
     NodeBox eBox;  // empty: no excess anywhere
     int eLo[3] = {0, 0, 0};
     if (push > 0.f && boxHi[0].load() >= 0) {
-        const int sweeps = kSweeps;
+        const int sweeps = kSweeps, reach = kSweeps - 1;
         int hi3[3];
         const int top[3] = {nx - 1, ny - 1, nz - 1};
         for (int a = 0; a < 3; ++a) {
-            eLo[a] = std::max(0, boxLo[a].load() - sweeps);
-            hi3[a] = std::min(top[a], boxHi[a].load() + sweeps);
+            eLo[a] = std::max(0, boxLo[a].load() - reach);
+            hi3[a] = std::min(top[a], boxHi[a].load() + reach);
         }
         eBox.nx = hi3[0] - eLo[0] + 1;
         eBox.ny = hi3[1] - eLo[1] + 1;
@@ -329,7 +334,7 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
                 const float wx[2] = {1.f - c.tx, c.tx}, wy[2] = {1.f - c.ty, c.ty}, wz[2] = {1.f - c.tz, c.tz};
                 const float dw[2] = {-invD, invD};
                 // The eight nodes' E: straight from the box when the cell
-                // lies inside it (most do: the box reaches kSweeps beyond
+                // lies inside it (most do: the box reaches kSweeps − 1 beyond
                 // the excess), else node by node (0 outside).
                 float Ec[8];
                 const unsigned bi = unsigned(c.i - elx), bj = unsigned(c.j - ely), bk = unsigned(c.k - elz);

@@ -109,7 +109,6 @@ class HairGrid {
         uint32_t vertex;  ///< index into GridInput
     };
     VolumeSettings s_;
-    std::vector<Vec3f> local_;       ///< head-local positions, per vertex
     std::vector<Cell> vertexCells_;  ///< per vertex
     std::vector<uint32_t> rowOf_;    ///< node row (j, k) of each vertex's base node; ~0: not gridded
     std::vector<unsigned> rowStart_, fill_;
