@@ -28,7 +28,7 @@ void VolumeSettings::validate() const {
 namespace hp::volume {
 namespace {
 
-/// At most this many nodes (20 bytes each): hair spread wider than the
+/// At most this many nodes (16 bytes each): hair spread wider than the
 /// grid allows at Δ is gridded at 2Δ, 4Δ, ... for that step instead.
 constexpr double kMaxNodes = 4.0e6;
 /// The volume step's largest fraction per substep (hair_grid.h), so that

@@ -42,13 +42,21 @@
 // substep, matches the fall g·h² a substep, above the target.
 //
 // Determinism: the splat is a sum, so its order is fixed. Vertices are
-// bucketed by the z slab of their base node (a stable counting sort, in
-// vertex order); a vertex of slab k writes node planes k and k+1 only, so
-// even slabs run in parallel, then odd ones. Every node therefore receives
-// its terms in the same order whatever the thread count; the gather reads
-// only. The grid's lattice is fixed to the head (origin a multiple of Δ in
-// head coordinates), so it follows the head and a still head sees the
-// same cells every step.
+// sorted by the node row (j, k) of their base node (a stable counting
+// sort, in vertex order within a row); a row of slab k lies in slab k, and
+// a vertex of slab k writes node planes k and k+1 only, so even slabs run
+// in parallel, then odd ones. Every node therefore receives its terms in
+// the same order whatever the thread count; the gathers read only. The
+// grid's lattice is fixed to the head (origin a multiple of Δ in head
+// coordinates), so it follows the head and a still head sees the same
+// cells every step.
+//
+// Cost: every pass walks the sorted order, with each vertex's cell and
+// (m, v) copied into it, so the nodes a pass touches stay in the cache and
+// its own data streams; a node holds (M, P) only (λ_c = M_c·ℓ/m/Δ³: every
+// vertex carries the same hair length per mass); friction and the density
+// scan share one pass; the volume step sweeps a list of the nodes with
+// hair. Measured in docs/benchmarks.md ("B-sim with the hair-hair grid").
 #pragma once
 
 #include "sim/volume/excess_diffusion.h"
