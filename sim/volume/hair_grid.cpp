@@ -37,13 +37,15 @@ constexpr double kMaxNodes = 4.0e6;
 /// bounds it is the energy the push gives hair it lifts. Measured on
 /// tests/test_hair_grid.cpp with the rod's BDF2 (4 sweeps): c_max 1/2 leaves
 /// the ball at 338 hairs/cm² (1.5x the target) and the crossing wisps gain
-/// 1.5% of the energy their fall releases; c_max 1 (8 sweeps) gains 99% of it.
+/// 1.5% of the energy their fall releases; c_max 1 (8 sweeps) gains 99% of it
+/// (both before the guide solver restored the pushed lengths with the push:
+/// 0.7% at 1/2 since, docs/physics.md).
 constexpr float kMaxPush = 0.5f;
 /// Jacobi sweeps of the implicit volume step (excess_diffusion.h): a smooth
 /// excess gets (1 − ρ^K) of the exact implicit push, ρ = 6c/(1 + 6c) = 0.72
 /// at the default c = 0.43, so 0.73 at 4 sweeps. Measured on the ball and
 /// the crossing wisps (BDF2): 1 sweep 338 hairs/cm², 0.5% energy gain;
-/// 4 sweeps 338, 1.5%; 8 sweeps 300, 1.6%.
+/// 4 sweeps 338, 1.5%; 8 sweeps 300, 1.6% (lengths then restored by the step).
 constexpr int kSweeps = 4;
 
 /// Lattices of at most this many nodes per gridded vertex are cleared
