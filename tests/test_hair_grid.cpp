@@ -549,22 +549,35 @@ TEST(Volume, EnergyDoesNotGrowWithTheGridOn) {
     // Kinetic plus gravitational energy of the crossing wisps (chains: no
     // elastic energy; the density starts below the target), against the
     // energy the swinging wisp releases (5 chains of 15 cm, 100 hairs each,
-    // falling 7.5 cm on average), under both rod integrators. Friction alone
-    // never adds energy (a PIC blend: HairGrid.FrictionNeverAddsKineticEnergy).
-    // The volume step moves positions without a potential of its own, so
-    // hair it pushes up gains height: measured 0.4% of the released energy
-    // with Euler, 1.5% with BDF2 (the push read explicitly: 2% and 335%);
-    // allowed 5%.
-    for (RodIntegrator integrator : {RodIntegrator::Euler, RodIntegrator::Bdf2}) {
-        const CurtainRun off = swingThroughCurtain(false, true, -1.f, 1, integrator),
-                         friction = swingThroughCurtain(true, false, -1.f, 1, integrator),
-                         on = swingThroughCurtain(true, true, -1.f, 1, integrator);
-        const double released = wispReleasedEnergy();
-        const char* name = rodIntegratorName(integrator);
-        std::printf("%s: largest energy rise over the release: grid off %.3g J, friction only %.3g J, on %.3g J "
-                    "(the wisp releases %.3g J)\n",
-                    name, off.maxEnergyRise, friction.maxEnergyRise, on.maxEnergyRise, released);
-        EXPECT_LE(friction.maxEnergyRise, off.maxEnergyRise + 1e-4 * released) << name;
-        EXPECT_LE(on.maxEnergyRise, off.maxEnergyRise + 0.05 * released) << name;
+    // falling 7.5 cm on average), under both rod integrators at 1, 2 and 4
+    // substeps. Friction alone never adds energy (a PIC blend:
+    // HairGrid.FrictionNeverAddsKineticEnergy). The volume step moves
+    // positions without a potential of its own, so hair it pushes up gains
+    // height: measured at 1 / 2 / 4 substeps 0.4 / 1.3 / 2.7% of the
+    // released energy with Euler, 0.7 / 2.0 / 3.6% with BDF2; allowed 5%. Before the
+    // pushed guides' lengths were restored with the push (GuideSolver's
+    // couple()), the step's own length correction became velocity: BDF2
+    // gained 149% / 162% at 2 / 4 substeps. The rope (printed, not
+    // asserted) still gains at 2 and 4 substeps: open (docs/physics.md).
+    const double released = wispReleasedEnergy();
+    for (RodIntegrator integrator : {RodIntegrator::Euler, RodIntegrator::Bdf2})
+        for (int sub : {1, 2, 4}) {
+            const CurtainRun off = swingThroughCurtain(false, true, -1.f, sub, integrator),
+                             friction = swingThroughCurtain(true, false, -1.f, sub, integrator),
+                             on = swingThroughCurtain(true, true, -1.f, sub, integrator);
+            const char* name = rodIntegratorName(integrator);
+            std::printf("%s, %d substeps: largest energy rise over the release: grid off %.3g J, friction only "
+                        "%.3g J, on %.3g J (%.1f%% of the %.3g J the wisp releases)\n",
+                        name, sub, off.maxEnergyRise, friction.maxEnergyRise, on.maxEnergyRise,
+                        100 * on.maxEnergyRise / released, released);
+            EXPECT_LE(friction.maxEnergyRise, off.maxEnergyRise + 1e-4 * released) << name << ", " << sub;
+            EXPECT_LE(on.maxEnergyRise, off.maxEnergyRise + 0.05 * released) << name << ", " << sub << " substeps";
+        }
+    const auto rope = [](GuideSettings& s) { s.formulation = GuideFormulation::Rope; };
+    for (int sub : {1, 2, 4}) {
+        const CurtainRun off = swingThroughCurtain(false, true, -1.f, sub, rope),
+                         on = swingThroughCurtain(true, true, -1.f, sub, rope);
+        std::printf("rope, %d substeps: largest energy rise over the release: grid off %.3g J, on %.3g J (%.1f%%)\n",
+                    sub, off.maxEnergyRise, on.maxEnergyRise, 100 * on.maxEnergyRise / released);
     }
 }

@@ -36,13 +36,16 @@
 // thread count.
 #pragma once
 
-#include "sim/volume/hair_grid.h"
-
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace hp::volume {
+
+/// Runs f(begin, end) over [0, count) in parallel chunks (the caller's arena).
+using ParallelFor = std::function<void(size_t count, const std::function<void(size_t, size_t)>& f)>;
 
 /// A box of nx × ny × nz grid nodes, x fastest (node (i, j, k) at
 /// (k·ny + j)·nx + i).
@@ -58,10 +61,62 @@ struct NodeBox {
 void jacobiSweep(const NodeBox& box, const float* e, const uint8_t* occupied, float c, const float* in, float* out,
                  int k0, int k1);
 
-/// E after `sweeps` Jacobi sweeps from E⁰ = 0 (the file comment), the
-/// planes of each sweep run through `parallel`. `scratch` is resized as
-/// needed; `out` receives E (box.size() values).
+/// The occupied nodes of a box and their excess e, listed plane by plane
+/// (plane k's at [k·plane, k·plane + count[k]), ascending): what the sweeps
+/// visit. Reused call after call.
+struct OccupiedNodes {
+    NodeBox box;
+    std::vector<uint32_t> node;     ///< box index
+    std::vector<uint8_t> inside;    ///< its neighbours in the box (bits −x, +x, −y, +y, −z, +z)
+    std::vector<float> excess;      ///< e there
+    std::vector<uint32_t> count;    ///< per plane
+    std::vector<float> values;      ///< the sweeps' second buffer
+
+    /// Sizes the lists for `b` (counts 0).
+    void reset(const NodeBox& b);
+    /// Lists node (i, j, k) of the box, excess e; within a plane in
+    /// ascending order, any plane from one thread at a time.
+    void add(int i, int j, int k, float e) {
+        const size_t plane = size_t(box.nx) * size_t(box.ny);
+        const size_t t = size_t(k) * plane + count[size_t(k)]++;
+        node[t] = uint32_t(size_t(k) * plane + size_t(j) * size_t(box.nx) + size_t(i));
+        inside[t] = uint8_t(unsigned(i > 0) | unsigned(i + 1 < box.nx) << 1 | unsigned(j > 0) << 2 |
+                            unsigned(j + 1 < box.ny) << 3 | unsigned(k > 0) << 4 | unsigned(k + 1 < box.nz) << 5);
+        excess[t] = e;
+    }
+    /// Lists the nodes with m > 0 of row (j, k) of the box, excess
+    /// max(0, m·toRatio − 1), from x-row `m` (box.nx values, stride
+    /// `stride` floats); rows of a plane in ascending order, any plane from
+    /// one thread at a time.
+    void addRow(int j, int k, const float* m, size_t stride, float toRatio) {
+        const size_t plane = size_t(box.nx) * size_t(box.ny), first = size_t(k) * plane;
+        size_t t = first + count[size_t(k)];
+        uint32_t* nd = node.data();
+        uint8_t* in = inside.data();
+        float* ex = excess.data();
+        const unsigned jk = unsigned(j > 0) << 2 | unsigned(j + 1 < box.ny) << 3 | unsigned(k > 0) << 4 |
+                            unsigned(k + 1 < box.nz) << 5;
+        const uint32_t row = uint32_t(first + size_t(j) * size_t(box.nx));
+        for (int i = 0; i < box.nx; ++i) {
+            const float mi = m[size_t(i) * stride];
+            if (!(mi > 0.f)) continue;
+            nd[t] = row + uint32_t(i);
+            in[t] = uint8_t(jk | unsigned(i > 0) | unsigned(i + 1 < box.nx) << 1);
+            ex[t++] = std::max(0.f, mi * toRatio - 1.f);
+        }
+        count[size_t(k)] = uint32_t(t - first);
+    }
+};
+
+/// E after `sweeps` Jacobi sweeps from E⁰ = 0 (the file comment) on the
+/// listed nodes, 0 on the others; the planes of each sweep run through
+/// `parallel`; `out` receives E (box.size() values). The same values, term
+/// by term, as jacobiSweep over the whole box with the nodes listed as the
+/// occupied ones.
+void relaxListed(OccupiedNodes& list, float c, int sweeps, float* out, const ParallelFor& parallel);
+
+/// relaxListed on the nodes with occupied[n] != 0 and excess e[n].
 void relaxExcess(const NodeBox& box, const float* e, const uint8_t* occupied, float c, int sweeps, float* out,
-                 std::vector<float>& scratch, const ParallelFor& parallel);
+                 OccupiedNodes& scratch, const ParallelFor& parallel);
 
 }  // namespace hp::volume

@@ -42,15 +42,24 @@
 // substep, matches the fall g·h² a substep, above the target.
 //
 // Determinism: the splat is a sum, so its order is fixed. Vertices are
-// bucketed by the z slab of their base node (a stable counting sort, in
-// vertex order); a vertex of slab k writes node planes k and k+1 only, so
-// even slabs run in parallel, then odd ones. Every node therefore receives
-// its terms in the same order whatever the thread count; the gather reads
-// only. The grid's lattice is fixed to the head (origin a multiple of Δ in
-// head coordinates), so it follows the head and a still head sees the
-// same cells every step.
+// sorted by the node row (j, k) of their base node (a stable counting
+// sort, in vertex order within a row); a row of slab k lies in slab k, and
+// a vertex of slab k writes node planes k and k+1 only, so even slabs run
+// in parallel, then odd ones. Every node therefore receives its terms in
+// the same order whatever the thread count; the gathers read only. The
+// grid's lattice is fixed to the head (origin a multiple of Δ in head
+// coordinates), so it follows the head and a still head sees the same
+// cells every step.
+//
+// Cost: every pass walks the sorted order, with each vertex's cell and
+// (m, v) copied into it, so the nodes a pass touches stay in the cache and
+// its own data streams; a node holds (M, P) only (λ_c = M_c·ℓ/m/Δ³: every
+// vertex carries the same hair length per mass); friction and the density
+// scan share one pass; the volume step sweeps a list of the nodes with
+// hair. Measured in docs/benchmarks.md ("B-sim with the hair-hair grid").
 #pragma once
 
+#include "sim/volume/excess_diffusion.h"
 #include "sim/volume/volume_settings.h"
 
 #include <Eigen/Geometry>
@@ -64,8 +73,7 @@ namespace hp::volume {
 
 using Vec3f = Eigen::Vector3f;
 
-/// Runs f(begin, end) over [0, count) in parallel chunks (the caller's arena).
-using ParallelFor = std::function<void(size_t count, const std::function<void(size_t, size_t)>& f)>;
+// ParallelFor (f(begin, end) over [0, count) in the caller's arena): excess_diffusion.h.
 
 /// The vertices the grid couples (structure of arrays, `count` entries each).
 struct GridInput {
@@ -99,24 +107,31 @@ class HairGrid {
     float blendFraction(float h) const;
     float pushFraction(float h) const;
 
-    /// Base node and trilinear fractions of a head-local position (i < 0: not gridded).
+  private:
+    /// A gridded vertex in the passes' order: base node (i, j, k), its
+    /// index in the lattice, trilinear fractions.
     struct Cell {
         int i, j, k;
+        uint32_t node;
         float tx, ty, tz;
-    };
-
-  private:
-    struct Node {
-        float m, l, px, py, pz;  ///< mass, hair length, momentum (all zero between calls)
-        float e;                 ///< the relaxed density excess E (excess_diffusion.h)
+        uint32_t vertex;  ///< index into GridInput
     };
     VolumeSettings s_;
-    std::vector<Vec3f> local_;   ///< head-local positions
-    std::vector<Cell> cells_;    ///< per vertex
-    std::vector<unsigned> order_, slabStart_, fill_;
-    std::vector<Node> nodes_;
-    std::vector<float> excess_, relaxed_, sweepScratch_;  ///< the volume step's box of nodes
-    std::vector<uint8_t> occupied_;
+    std::vector<Cell> vertexCells_;  ///< per vertex
+    std::vector<uint32_t> rowOf_;    ///< node row (j, k) of each vertex's base node; ~0: not gridded
+    std::vector<unsigned> rowStart_, fill_;
+    /// Gridded vertices sorted by node row (hair_grid.cpp): their cells and
+    /// (m, v), copied in that order so that every pass reads them in a stream.
+    std::vector<Cell> cells_;
+    std::vector<Eigen::Vector4f> massVel_;
+    std::vector<float> ratio_;       ///< r̄ = λ̄/λ₀ each sorted vertex reads
+    /// Per node (m, P): mass and momentum, one SSE packet, so the splat
+    /// adds w·(m, m·v) in one operation; zero between calls. The hair
+    /// length is M·lengthPerMass (the same for every vertex), not stored:
+    /// the passes wait on the lattice's memory, not on arithmetic.
+    std::vector<Eigen::Vector4f> nodes_;
+    OccupiedNodes occupied_;         ///< the volume step's nodes with hair
+    std::vector<float> relaxed_;     ///< its E on the box of nodes
 };
 
 }  // namespace hp::volume
