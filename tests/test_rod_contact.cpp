@@ -162,9 +162,10 @@ TEST(RodContact, StraightStrandOnASphereComesToRestAndNeverGainsEnergy) {
 TEST(RodContact, PlanarCurledStrandOnASphereComesToRest) {
     // The curled hook falling in its own plane comes to rest on the sphere.
     // Its energy rises from its lowest by up to 8% of the release (measured,
-    // recorded here, not bounded): where the hook lands and presses on the
-    // sphere, the step's solve does not see the contact, and the placement
-    // that follows changes the bending energy the solve assumed.
+    // recorded here, not bounded), where the hook lands and presses on the
+    // sphere; not yet attributed (the step's solve does not see the
+    // contact, and the placement after it changes the bending energy the
+    // solve assumed: a candidate, not measured phase by phase).
     for (const Case& c : kCases) {
         const Settled r = onSphere(Shape::CurledPlanar, c.bdf2, c.substeps, true, 5.0);
         report("planar curled " + name(c), r);
