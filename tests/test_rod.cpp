@@ -314,3 +314,103 @@ TEST(Rod, Bdf2ContactIsInelastic) {
     RecordProperty("rebound_nm", int(rebound * 1e9f));
     EXPECT_LE(rebound, 1e-4f);
 }
+
+namespace {
+
+/// The largest difference between the bending force the rod step assembles,
+/// F_i = -Σ_j EI_j/l̄_j·C_j·∂C_j/∂x_i (rod::bendConstraint's rows, the frame
+/// held fixed), and the gradient of the bending energy rod::bendEnergy by
+/// central differences, relative to the largest force component, at a
+/// non-planar shape (a helix of 8 segments of 1 cm, root frame = world,
+/// ghost along the first segment), with rest curvatures zero (curled: false)
+/// or those of a tighter helix (curled: true).
+double bendForceError(bool curled, bool holonomy = false) {
+    const int n = 9;
+    const float l = 0.01f;
+    auto helix = [&](float turn, float climb) {
+        std::vector<Vec3f> x(static_cast<size_t>(n));
+        x[0] = Vec3f::Zero();
+        float phi = 0.f;
+        for (int j = 0; j + 1 < n; ++j, phi += turn)
+            x[size_t(j) + 1] = x[size_t(j)] + l * Vec3f(std::cos(phi), std::sin(phi), climb).normalized();
+        return x;
+    };
+    std::vector<Vec3f> x = helix(0.35f, 0.4f);
+    std::vector<float> rest(size_t(n - 1));
+    for (int j = 0; j + 1 < n; ++j) rest[size_t(j)] = (x[size_t(j) + 1] - x[size_t(j)]).norm();
+    std::vector<float> invMass(size_t(n), 1.f);
+    std::vector<rod::Vec2f> c(size_t(n - 1), rod::Vec2f::Zero());
+    rod::RodStrand s;
+    s.vertices = n;
+    s.restLength = rest.data();
+    s.invMass = invMass.data();
+    s.restCurvature = c.data();
+    s.ghostDir = (x[1] - x[0]).normalized();
+    s.bendStiffness = 1e-6;
+    const rod::Mat3f R = rod::Mat3f::Identity();
+    if (curled) {
+        const std::vector<Vec3f> tight = helix(0.7f, 0.1f);
+        rod::restCurvature(s, tight.data(), R, c.data());
+    }
+    // The assembled force: rod::bendConstraint along the transported frame.
+    std::vector<Vec3f> force(static_cast<size_t>(n), Vec3f::Zero());
+    {
+        rod::lanes::V3<float> u{s.ghostDir.x(), s.ghostDir.y(), s.ghostDir.z()};
+        const Vec3f a0 = rod::frameStart(R, s.ghostDir);
+        rod::lanes::V3<float> a{a0.x(), a0.y(), a0.z()};
+        float ulen = 1.f;
+        for (int j = 0; j + 1 < n; ++j) {
+            const Vec3f e = x[size_t(j) + 1] - x[size_t(j)];
+            Vec3f g[2][3];
+            const rod::Vec2f C = rod::bendConstraint(Vec3f(u.x, u.y, u.z), ulen, e, Vec3f(a.x, a.y, a.z),
+                                                     c[size_t(j)], j == 0, g);
+            const float k = float(s.bendStiffness / rod::voronoiLength(s, j));
+            for (int slot = 0; slot < 3; ++slot)
+                if (j - 1 + slot >= 1) force[size_t(j - 1 + slot)] -= k * (C[0] * g[0][slot] + C[1] * g[1][slot]);
+            rod::lanes::advanceFrame(u, ulen, a, rod::lanes::V3<float>{e.x(), e.y(), e.z()});
+        }
+    }
+    if (holonomy) rod::holonomyForce(s, x.data(), R, force.data());
+    double err = 0, scale = 0;
+    const float delta = 1e-5f;
+    for (int i = 1; i < n; ++i)
+        for (int k = 0; k < 3; ++k) {
+            std::vector<Vec3f> p = x, m = x;
+            p[size_t(i)][k] += delta;
+            m[size_t(i)][k] -= delta;
+            const double dE = (rod::bendEnergy(s, p.data(), R) - rod::bendEnergy(s, m.data(), R)) / (2.0 * delta);
+            err = std::max(err, std::abs(-dE - double(force[size_t(i)][k])));
+            scale = std::max(scale, std::abs(double(force[size_t(i)][k])));
+        }
+    return err / scale;
+}
+
+}  // namespace
+
+TEST(Rod, BendForceIsTheEnergyGradientForAStraightRestShape) {
+    // With rest curvature 0 the frame's dependence on the parent segment
+    // drops out of the gradient (κb ⊥ d_{j-1}), so the force the step
+    // assembles is exactly -∇E: only the central difference's error, O(δ²)
+    // and float rounding of E, remains (measured 1e-3 or less).
+    const double straight = bendForceError(false);
+    RecordProperty("relative_error_e6", std::to_string(straight * 1e6));
+    EXPECT_LT(straight, 1e-2);
+}
+
+TEST(Rod, DISABLED_BendForceIsTheEnergyGradientForACurledRestShape) {
+    // Open (issue 29): with rest curvature c_j ≠ 0 the energy depends on the
+    // transported frame a_j, which turns with every segment between the root
+    // and joint j (its holonomy), and rod::bendConstraint's gradient holds
+    // the frame fixed. The step's force is then not the gradient of the
+    // energy: a circulatory part that does work around a closed path, what
+    // keeps a curled strand turning on the head (tests/test_rod_contact.cpp).
+    const double curled = bendForceError(true);
+    RecordProperty("relative_error_e6", std::to_string(curled * 1e6));
+    EXPECT_LT(curled, 1e-2);
+}
+
+TEST(Rod, BendForceWithTheHolonomyIsTheEnergyGradientForACurledRestShape) {
+    const double curled = bendForceError(true, true);
+    RecordProperty("relative_error_e6", std::to_string(curled * 1e6));
+    EXPECT_LT(curled, 1e-2);
+}

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace hp::rod {
 namespace {
@@ -72,6 +73,44 @@ void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec2f* c)
         Vec3f g[2][3];
         c[j] = bendConstraint(u, ulen, e, a, Vec2f::Zero(), ghost, g);  // C_j(x) = 0
     });
+}
+
+void holonomyForce(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec3f* force) {
+    const int S = s.vertices - 1;
+    if (s.bendStiffness <= 0 || S < 2) return;
+    // Per joint: τ_j = ∂E_j/∂ψ_j and the turn's κb_k with its two edge lengths.
+    const size_t m = static_cast<size_t>(S);
+    std::vector<double> tau(m, 0.0);
+    std::vector<Vec3f> kb(m);
+    std::vector<float> parentLen(m);
+    forJoints(s, x, R, [&](int j, const Vec3f& u, float ulen, const Vec3f& e, const Vec3f& a, bool ghost) {
+        Vec3f g[2][3];
+        const Vec2f c = s.restCurvature[j];
+        const Vec2f C = bendConstraint(u, ulen, e, a, c, ghost, g);
+        const Vec2f K = C + c;
+        // E_j = k_j/2 |K_j - c_j|², and turning the frame by δψ about u turns
+        // K by δK = δψ·(K_2, -K_1): τ_j = k_j (c_2 K_1 - c_1 K_2).
+        const double k = stiffnessAt(s, j) / double(voronoiLength(s, j));
+        tau[size_t(j)] = k * (double(c[1]) * K[0] - double(c[0]) * K[1]);
+        const Vec3f d = e.normalized();
+        kb[size_t(j)] = 2.f * u.cross(d) / std::max(1.f + u.dot(d), 1e-4f);
+        parentLen[size_t(j)] = ghost ? 0.f : ulen;
+    });
+    // F = -Σ_k T_k ∇m_k with T_k = Σ_{j>k} τ_j (the frame of joint j is
+    // transported through the turns of joints 0..j-1), from the tip.
+    double T = 0;
+    for (int k = S - 1; k >= 0; --k) {
+        const Vec3f gEdge = kb[size_t(k)] / (2.f * (x[k + 1] - x[k]).norm());  // ∂m_k/∂e_k
+        const float Tf = float(T);
+        force[k + 1] += Tf * gEdge;  // sign: ψ_j = -Σ m_k (space-parallel against time-parallel)
+        force[k] -= Tf * gEdge;
+        if (parentLen[size_t(k)] > 0.f) {
+            const Vec3f gParent = kb[size_t(k)] / (2.f * parentLen[size_t(k)]);  // ∂m_k/∂e_{k-1}
+            force[k] += Tf * gParent;
+            force[k - 1] -= Tf * gParent;
+        }
+        T += tau[size_t(k)];
+    }
 }
 
 double bendEnergy(const RodStrand& s, const Vec3f* x, const Mat3f& rootFrame) {

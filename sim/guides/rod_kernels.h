@@ -224,6 +224,21 @@ int rodSteps(const RodStepTarget* targets, int count, const Vec3f& gravity, floa
 /// run through the same four-lane code the step uses (rod_step.cpp).
 void stretchSolve(Vec3f* x, const float* w, const float* rest, int n);
 
+/// The part of the bending force that rod::bendConstraint's gradient leaves
+/// out where the rest curvature is not zero, added to force[0..vertices-1]:
+/// the frame (a_j, b_j) of joint j is carried by parallel transport from
+/// the root through the turns of joints 0..j-1, so when the strand moves it
+/// also turns about d_{j-1} by the change of the holonomy, δψ_j = -Σ_{k<j} δm_k,
+/// with δm_k the reference twist of joint k (Bergou et al. 2008, "Discrete
+/// elastic rods", and 2010, "Discrete viscous threads"):
+///   ∂m_k/∂e_{k-1} = κb_k/(2|e_{k-1}|),   ∂m_k/∂e_k = κb_k/(2|e_k|).
+/// Turning the frame by δψ turns K_j = (κb·a, κb·b) by δψ·(K_2, -K_1), so
+///   τ_j = ∂E_j/∂ψ_j = EI_j/l̄_j·(c_2 K_1 - c_1 K_2)
+/// and the force is F = Σ_k T_k ∇m_k with T_k = Σ_{j>k} τ_j (the twisting
+/// moment carried past joint k toward the root). Zero when c = 0; with it,
+/// the assembled force plus this one is -∇E (tests/test_rod.cpp).
+void holonomyForce(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec3f* force);
+
 /// Total bending energy Σ EI_j/(2 l̄_j)|C_j|² of a strand, J.
 double bendEnergy(const RodStrand& s, const Vec3f* x, const Mat3f& rootFrame);
 
