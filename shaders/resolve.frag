@@ -2,9 +2,10 @@
 // pixel: per sample, hair = weighted-blended colour with alpha 1 - revealage
 // over the opaque head; averaged; the environment fills the rest. Z is the
 // nearest sample's camera depth. MULTISAMPLE selects sampler2DMS. SORTED:
-// sorted hair was blended over the opaque colour in place, so the pixel is
-// that colour alone (accumulation and revealage are neither cleared nor read:
-// their clear values, 0 and 1, give the same sum).
+// sorted hair was blended over black in place, and the skin behind it,
+// multiplied by what each hair fragment lets through (hair.frag), lies in
+// the accumulation target: the pixel is hair plus that skin, its alpha the
+// hair's over the skin's coverage (revealage is neither cleared nor read).
 #ifdef MULTISAMPLE
 #define SAMPLER sampler2DMS
 #else
@@ -36,10 +37,10 @@ void main() {
 #endif
                 vec4 opaque = texelFetch(uOpaque, p, q);
                 depth = min(depth, texelFetch(uDepth, p, q).r);
-#ifdef SORTED
-                sum += opaque;
-#else
                 vec4 accum = texelFetch(uAccum, p, q);
+#ifdef SORTED
+                sum += vec4(opaque.rgb + accum.rgb, opaque.a + (1.0 - opaque.a) * accum.a);
+#else
                 float reveal = texelFetch(uReveal, p, q).r;
                 float hairAlpha = 1.0 - reveal;
                 vec3 hair = accum.a > 0.0 ? accum.rgb / accum.a * hairAlpha : vec3(0.0);

@@ -293,6 +293,24 @@ struct PreviewRenderer::Impl {
 
     void cameraPass(bool voxelsOn, bool mapOn, float lineWidth) {
         glBindBufferBase(GL_UNIFORM_BUFFER, 0, cameraUbo);
+        const bool sorted = settings.blend == HairBlend::Sorted;
+        {
+            // Sorted hair: the head's depth from the camera (unit 9), so the
+            // hair's shading knows where the camera sees skin behind it
+            // (shaders/hair_shading.glsl skinBehindInView).
+            const float far = 1.f;
+            glDepthMask(GL_TRUE);  // the clear obeys it, and the light passes leave it off
+            glClearNamedFramebufferfv(targets.headFbo, GL_DEPTH, 0, &far);
+            if (sorted) {
+                glBindFramebuffer(GL_FRAMEBUFFER, targets.headFbo);
+                glViewport(0, 0, targets.width * targets.supersample, targets.height * targets.supersample);
+                glEnable(GL_DEPTH_TEST);
+                glDepthFunc(GL_LESS);
+                drawHead(headDepth);
+                mark("camera head depth");
+            }
+            glBindTextureUnit(9, targets.headDepth);
+        }
         glBindFramebuffer(GL_FRAMEBUFFER, targets.msFbo);
         glViewport(0, 0, targets.width * targets.supersample, targets.height * targets.supersample);
         const float zero[4] = {0, 0, 0, 0}, one[4] = {1, 1, 1, 1};
@@ -302,10 +320,8 @@ struct PreviewRenderer::Impl {
         glDisable(GL_BLEND);
         glDepthMask(GL_TRUE);
         glClearBufferfv(GL_COLOR, 0, zero);
-        if (settings.blend == HairBlend::Weighted) {  // sorted hair blends into 0 (the resolve reads neither)
-            glClearBufferfv(GL_COLOR, 1, zero);
-            glClearBufferfv(GL_COLOR, 2, one);
-        }
+        glClearBufferfv(GL_COLOR, 1, zero);  // weighted: accumulation; sorted: the skin
+        if (settings.blend == HairBlend::Weighted) glClearBufferfv(GL_COLOR, 2, one);  // sorted hair reads no revealage
         glClearBufferfv(GL_COLOR, 3, inf);
         glClearBufferfv(GL_DEPTH, 0, one);
         mark("camera clear");
@@ -321,8 +337,12 @@ struct PreviewRenderer::Impl {
         glDepthFunc(GL_LESS);
         glEnable(GL_MULTISAMPLE);
 
-        // Opaque head: colour into attachment 0, nearest depth (min) into 3.
-        const GLenum opaque[] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT3};
+        // Opaque head: colour into attachment 0 (sorted hair: into 1, the
+        // skin kept apart, which each hair fragment multiplies by what it
+        // lets through, shaders/hair.frag), nearest depth (min) into 3.
+        const GLenum none = GL_NONE;
+        const GLenum opaque[] = {sorted ? none : GL_COLOR_ATTACHMENT0, sorted ? GL_COLOR_ATTACHMENT1 : none, none,
+                                 GL_COLOR_ATTACHMENT3};
         glDrawBuffers(4, opaque);
         glEnablei(GL_BLEND, 3);
         glBlendEquationi(3, GL_MIN);
@@ -332,15 +352,19 @@ struct PreviewRenderer::Impl {
 
         // Hair: tested against the head's depth, never writing it; min depth
         // into 3. Sorted: premultiplied colour over attachment 0 (the patches
-        // arrive back to front). Weighted: weighted sums into 1, revealage
-        // products into 2.
+        // arrive back to front), the skin in 1 times each fragment's
+        // transmittance (rgb; its coverage, alpha, kept). Weighted: weighted
+        // sums into 1, revealage products into 2.
         glDepthMask(GL_FALSE);
-        if (settings.blend == HairBlend::Sorted) {
-            const GLenum hair[] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT3};
+        if (sorted) {
+            const GLenum hair[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_NONE, GL_COLOR_ATTACHMENT3};
             glDrawBuffers(4, hair);
             glEnablei(GL_BLEND, 0);
             glBlendEquationi(0, GL_FUNC_ADD);
             glBlendFunci(0, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+            glEnablei(GL_BLEND, 1);
+            glBlendEquationi(1, GL_FUNC_ADD);
+            glBlendFuncSeparatei(1, GL_ZERO, GL_SRC_COLOR, GL_ZERO, GL_ONE);
         } else {
             const GLenum hair[] = {GL_NONE, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
             glDrawBuffers(4, hair);

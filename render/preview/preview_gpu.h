@@ -46,6 +46,10 @@ struct FrameUniforms {
     /// The fitted lobes' N(|φ|; |θo|) tables (HairLobe::azimuth), lobe k's
     /// [a][b] at float k·81 + 9a + b (packed four to a vec4).
     float lobeAzimuth[kHairLobeNodes * kHairLobeNodes][4];  // 4 lobes x 81 floats = 81 vec4
+    /// rgb: the share of the skin behind it a hair fragment lets through
+    /// besides its gaps, the fibre's forward albedo a_f (fitted hair; 0 for
+    /// Kajiya-Kay): shaders/hair.frag.
+    float forward[4];
 };
 
 inline constexpr int kFlagVoxels = 1;
@@ -53,6 +57,9 @@ inline constexpr int kFlagShadowMap = 2;
 inline constexpr int kFlagVoxelFilter = 4;
 /// Some light has no shadow slot: the fitted hair needs slot 0's column for it.
 inline constexpr int kFlagUnshadowedLights = 8;
+/// Sorted hair: the skin is kept apart and seen through the hair's forward
+/// scattering (shaders/hair.frag), so the shading leaves out the scalp's bounce.
+inline constexpr int kFlagSortedHair = 16;
 /// FrameUniforms::counts[3], the hair model (kHair* in shaders/common.glsl).
 inline constexpr int kHairKajiyaKay = 0;
 inline constexpr int kHairKajiyaKayTwoLobes = 1;
@@ -161,6 +168,9 @@ struct RenderTargets {
     int width = 0, height = 0, samples = 0, supersample = 0;
     unsigned msFbo = 0, opaque = 0, accum = 0, reveal = 0, minDepth = 0, depth = 0;
     unsigned resolvedFbo = 0, resolvedColor = 0, resolvedDepth = 0;
+    /// The head's depth from the camera, one sample a pixel (sorted hair:
+    /// whether the camera sees skin behind a hair point, shaders/hair_shading.glsl).
+    unsigned headFbo = 0, headDepth = 0;
 
     void ensure(int w, int h, int samples, int supersample);
     void destroy();

@@ -78,6 +78,9 @@ void fillFrameUniforms(FrameUniforms& u, const UniformInputs& in) {
         set3(u.shadowColor, Vec3f::Ones() - h.dual.forward.cwiseMin(Vec3f::Ones()), h.dual.forwardVariance);
     else
         set4(u.shadowColor, depthPerUnit, depthPerUnit, depthPerUnit, fittedHair ? h.dual.forwardVariance : 0.f);
+    // A fibre in front of the skin lets through, besides its gaps, the
+    // skin's light it scatters forward: a_f (Zinke et al. 2008; hair.frag).
+    if (fittedHair) set3(u.forward, h.dual.forward.cwiseMax(Vec3f::Zero()).cwiseMin(Vec3f::Ones()), 0.f);
     const HairLobe* lobes[4] = {&h.r, &h.trt, &h.tt, &h.dual.back};
     for (int k = 0; k < 4; ++k) {
         const HairLobe& lobe = *lobes[k];
@@ -103,7 +106,8 @@ void fillFrameUniforms(FrameUniforms& u, const UniformInputs& in) {
     u.counts[0] = int(lights);
     u.counts[1] = int(std::min<size_t>(in.slots.size(), kMaxShadowedLights));
     u.counts[2] = (in.voxels ? kFlagVoxels : 0) | (in.shadowMap ? kFlagShadowMap : 0) |
-                  (in.voxels && sh.filter ? kFlagVoxelFilter : 0) | (unshadowed ? kFlagUnshadowedLights : 0);
+                  (in.voxels && sh.filter ? kFlagVoxelFilter : 0) | (unshadowed ? kFlagUnshadowedLights : 0) |
+                  (settings.blend == HairBlend::Sorted ? kFlagSortedHair : 0);
     u.counts[3] = fittedHair ? kHairFitted : h.twoLobes ? kHairKajiyaKayTwoLobes : kHairKajiyaKay;
 }
 
