@@ -34,14 +34,13 @@ layout(std140, binding = 0) uniform Frame {
     ivec4 uCounts;      // light count, shadow slots, flags (kFlag*), hair model (kHair*)
     vec4 uLobeAzimuth[81]; // lobe k's N (1/rad) at |thetaO| = a * 11.25 deg, |phi| = b * 22.5 deg:
                            // float 81k + 9a + b, four to a vec4
-    vec4 uForward;      // rgb: a_f, what a hair fragment lets through of the skin behind it (hair.frag); 0 Kajiya-Kay
 };
 
 const int kFlagVoxels = 1;
 const int kFlagShadowMap = 2;
 const int kFlagVoxelFilter = 4;
 const int kFlagUnshadowedLights = 8;  // some light has no shadow slot
-const int kFlagSortedHair = 16;       // sorted hair: the skin seen through it in hair.frag, no scalp bounce
+const int kFlagSortedHair = 16;       // sorted hair: the skin seen through it (resolve.frag), bounce only beside it
 
 // uCounts.w: Kajiya-Kay with one or two lobes, or the fitted model with dual scattering.
 const int kHairKajiyaKay = 0;

@@ -13,7 +13,10 @@
 //   L = sum over lights of E shadowMap [exp(-C) (f + B(0)) + (T_f - exp(-C)) d_f (f_turned(n) + B(n))],
 //   B(n) = (1 - exp(-(1 - a_f^2) C_b)) d_b f_back(n beta_f^2), n = C / (1 - exp(-C)),
 // plus the scalp's bounce under the hair (scalpBounce below): the skin lit through
-// the hair's column lights the fibres above it.
+// the hair's column lights the fibres above it. Sorted hair takes that path
+// from the skin the camera sees behind the fibre instead (resolve.frag
+// skinThrough), and keeps the bounce where the camera sees none (hair beside
+// the head: skinBehindInView).
 // Evaluated per ribbon vertex (default; Gouraud along the strand, which
 // software rasterizers need for speed) or per fragment (SHADE_PER_FRAGMENT).
 #include "kajiya_kay.glsl"
@@ -58,7 +61,7 @@ vec3 scalpBounce(int s, vec3 world, vec3 t, vec3 n, vec3 l, vec3 af, vec2 c) {
 // The head's depth from the camera (sorted hair; render/preview/preview.cpp cameraPass).
 layout(binding = 9) uniform sampler2D uCameraHead;
 
-// 1 where the camera sees the head behind a hair point: there hair.frag
+// 1 where the camera sees the head behind a hair point: there resolve.frag
 // composites the skin through the hair's forward scattering (skinThrough),
 // which is the scalp's bounce taken from the skin the camera sees; 0 where
 // the hair lies beside the head or past it (its silhouette), where only the
@@ -142,7 +145,7 @@ vec3 shadeHair(vec3 world, vec3 tangent, vec3 albedo) {
     // column through the point (once for all of them).
     float firstColumn = -1.0;
     // The scalp's bounce, except where sorted hair composites the skin the
-    // camera sees behind it (hair.frag): the same path, counted once.
+    // camera sees behind it (resolve.frag): the same path, counted once.
     float bounce = 1.0;
     if (SHADE_MODEL == kHairFitted && (SHADE_FLAGS & kFlagSortedHair) != 0) bounce = 1.0 - skinBehindInView(world);
     if (SHADE_MODEL == kHairFitted && (SHADE_FLAGS & kFlagUnshadowedLights) != 0 && voxelsOn(uCounts.y > 0 ? 0 : -1))

@@ -11,7 +11,7 @@ layout(location = 1) in vec3 vNormal;
 void main() {}
 #else
 layout(location = 0) out vec4 oColor;
-layout(location = 1) out vec4 oSkin;  // sorted hair: the skin apart, seen through the hair (hair.frag)
+layout(location = 1) out vec4 oSkin;  // sorted hair: the skin apart, seen through the hair (resolve.frag)
 layout(location = 3) out vec4 oDepth;
 
 void main() {

@@ -1,6 +1,6 @@
 // The skin under and behind the hair, seen by the camera: where the camera
 // sees the skin behind sorted hair, each fragment lets through its gaps and
-// the light the fibre scatters forward, 1 - a (1 - a_f) (shaders/hair.frag),
+// the light the fibre scatters forward, 1 - a (1 - a_f) (shaders/resolve.frag),
 // against that law on a slab of strands over a plane and against the
 // physical path tracer on the same slab; where it does not (hair beside the
 // head), the scalp's bounce lights the hair as in weighted hair, whose bounce
@@ -118,18 +118,15 @@ TEST(PreviewSkin, ScalpBounceIsTheSkinsLightThroughTheHair) {
 
 // Sorted hair over skin, seen by the camera: a hair fragment of coverage a
 // lets through 1 - a (1 - a_f) of the skin behind it, per channel (a_f: the
-// fibre's forward albedo, Zinke et al. 2008; shaders/hair.frag). The same
-// slab over the same Lambertian plane, lit from the camera with no shadows
-// (the skin's radiance is rho E / pi everywhere); only the plane's albedo
-// differs between two renders, so their difference on the slab's pixels is
-// the skin that reaches the camera, rho E / pi times the product of the
-// fragments' transmittances. Where the hair alone leaves 1 - alpha_hair =
-// prod (1 - a_j) ~ exp(-sum a_j) of the background (fragments of small
-// coverage, the slab's sub-pixel strands), the fibres pass
-//   prod (1 - a_j (1 - a_f)) ~ exp(-(1 - a_f) sum a_j) = (1 - alpha_hair)^(1 - a_f),
-// computed here per pixel from the render of the hair alone. With
-// Kajiya-Kay hair (no forward scattering) the skin shows through the gaps
-// alone, 1 - alpha_hair.
+// fibre's forward albedo, Zinke et al. 2008), which for fragments thinner
+// than a sample multiplies to (1 - A)^(1 - a_f), A the hair's coverage
+// (shaders/resolve.frag skinThrough). The same slab over the same Lambertian
+// plane, lit from the camera with no shadows (the skin's radiance is
+// rho E / pi everywhere); only the plane's albedo differs between two
+// renders, so their difference on the slab's pixels is the skin that reaches
+// the camera, over rho E / pi: against (1 - alpha_hair)^(1 - a_f) per pixel,
+// alpha_hair from a render of the hair alone. With Kajiya-Kay hair (no
+// forward scattering) the skin shows through the gaps alone, 1 - alpha_hair.
 TEST(PreviewSkin, SkinIsSeenThroughTheFibresForwardScattering) {
     HP_REQUIRE_GL();
     const float radius = 0.0001f;
@@ -198,7 +195,7 @@ TEST(PreviewSkin, SkinIsSeenThroughTheFibresForwardScattering) {
 // the camera through the slab (the difference between the plane's albedo and
 // a black plane) crosses the slab twice, to the skin and back, and the
 // preview keeps about exp(-(1 - a_f) C) each way (the skin's lighting,
-// shaders/shadow.glsl hairOnlyVisibility, and hair.frag skinThrough). Letting
+// shaders/shadow.glsl hairOnlyVisibility, and resolve.frag skinThrough). Letting
 // the skin through the gaps alone, as before, kept 0.10 / 0.06 / 0.03 of
 // rho E / pi (R / G / B), 0.10 / 0.08 / 0.06 against the physical render's
 // 0.30 / 0.19 / 0.10; adding the scalp's bounce where the camera sees the skin

@@ -338,8 +338,8 @@ struct PreviewRenderer::Impl {
         glEnable(GL_MULTISAMPLE);
 
         // Opaque head: colour into attachment 0 (sorted hair: into 1, the
-        // skin kept apart, which each hair fragment multiplies by what it
-        // lets through, shaders/hair.frag), nearest depth (min) into 3.
+        // skin kept apart, which the resolve sees through the hair's forward
+        // scattering, shaders/resolve.frag), nearest depth (min) into 3.
         const GLenum none = GL_NONE;
         const GLenum opaque[] = {sorted ? none : GL_COLOR_ATTACHMENT0, sorted ? GL_COLOR_ATTACHMENT1 : none, none,
                                  GL_COLOR_ATTACHMENT3};
@@ -352,19 +352,16 @@ struct PreviewRenderer::Impl {
 
         // Hair: tested against the head's depth, never writing it; min depth
         // into 3. Sorted: premultiplied colour over attachment 0 (the patches
-        // arrive back to front), the skin in 1 times each fragment's
-        // transmittance (rgb; its coverage, alpha, kept). Weighted: weighted
-        // sums into 1, revealage products into 2.
+        // arrive back to front; its alpha is the hair's coverage, which the
+        // resolve lets the skin through). Weighted: weighted sums into 1,
+        // revealage products into 2.
         glDepthMask(GL_FALSE);
         if (sorted) {
-            const GLenum hair[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_NONE, GL_COLOR_ATTACHMENT3};
+            const GLenum hair[] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT3};
             glDrawBuffers(4, hair);
             glEnablei(GL_BLEND, 0);
             glBlendEquationi(0, GL_FUNC_ADD);
             glBlendFunci(0, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-            glEnablei(GL_BLEND, 1);
-            glBlendEquationi(1, GL_FUNC_ADD);
-            glBlendFuncSeparatei(1, GL_ZERO, GL_SRC_COLOR, GL_ZERO, GL_ONE);
         } else {
             const GLenum hair[] = {GL_NONE, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
             glDrawBuffers(4, hair);
@@ -409,6 +406,14 @@ struct PreviewRenderer::Impl {
         // An environment map shows as its mean (render.environment_map).
         const Vec3f env = view.meanEnvironment();
         glProgramUniform3f(p.id(), p.uniform("uEnvironment"), env.x(), env.y(), env.z());
+        if (sorted) {
+            // What a fibre lets through of the skin behind it besides its
+            // gaps: its forward albedo a_f (fitted hair; none for Kajiya-Kay).
+            const Vec3f af = view.hair.shading == HairShading::Fitted
+                                 ? Vec3f(view.hair.dual.forward.cwiseMax(Vec3f::Zero()).cwiseMin(Vec3f::Ones()))
+                                 : Vec3f::Zero();
+            glProgramUniform3f(p.id(), p.uniform("uForward"), af.x(), af.y(), af.z());
+        }
         glBindTextureUnit(0, targets.opaque);
         glBindTextureUnit(1, targets.accum);
         glBindTextureUnit(2, targets.reveal);

@@ -46,10 +46,6 @@ struct FrameUniforms {
     /// The fitted lobes' N(|φ|; |θo|) tables (HairLobe::azimuth), lobe k's
     /// [a][b] at float k·81 + 9a + b (packed four to a vec4).
     float lobeAzimuth[kHairLobeNodes * kHairLobeNodes][4];  // 4 lobes x 81 floats = 81 vec4
-    /// rgb: the share of the skin behind it a hair fragment lets through
-    /// besides its gaps, the fibre's forward albedo a_f (fitted hair; 0 for
-    /// Kajiya-Kay): shaders/hair.frag.
-    float forward[4];
 };
 
 inline constexpr int kFlagVoxels = 1;
@@ -58,7 +54,8 @@ inline constexpr int kFlagVoxelFilter = 4;
 /// Some light has no shadow slot: the fitted hair needs slot 0's column for it.
 inline constexpr int kFlagUnshadowedLights = 8;
 /// Sorted hair: the skin is kept apart and seen through the hair's forward
-/// scattering (shaders/hair.frag), so the shading leaves out the scalp's bounce.
+/// scattering (shaders/resolve.frag), so the shading leaves out the scalp's
+/// bounce where the camera sees skin behind the hair.
 inline constexpr int kFlagSortedHair = 16;
 /// FrameUniforms::counts[3], the hair model (kHair* in shaders/common.glsl).
 inline constexpr int kHairKajiyaKay = 0;

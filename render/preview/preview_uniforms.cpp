@@ -78,9 +78,6 @@ void fillFrameUniforms(FrameUniforms& u, const UniformInputs& in) {
         set3(u.shadowColor, Vec3f::Ones() - h.dual.forward.cwiseMin(Vec3f::Ones()), h.dual.forwardVariance);
     else
         set4(u.shadowColor, depthPerUnit, depthPerUnit, depthPerUnit, fittedHair ? h.dual.forwardVariance : 0.f);
-    // A fibre in front of the skin lets through, besides its gaps, the
-    // skin's light it scatters forward: a_f (Zinke et al. 2008; hair.frag).
-    if (fittedHair) set3(u.forward, h.dual.forward.cwiseMax(Vec3f::Zero()).cwiseMin(Vec3f::Ones()), 0.f);
     const HairLobe* lobes[4] = {&h.r, &h.trt, &h.tt, &h.dual.back};
     for (int k = 0; k < 4; ++k) {
         const HairLobe& lobe = *lobes[k];
