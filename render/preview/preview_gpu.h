@@ -76,6 +76,11 @@ struct UniformInputs {
     bool voxels = false, shadowMap = false;
 };
 
+/// What a fibre lets through of the skin behind it besides its gaps, per
+/// channel: the fitted hair's forward albedo a_f (Zinke et al. 2008), none
+/// for Kajiya-Kay hair (shaders/resolve.frag skinThrough).
+Vec3f skinForwardAlbedo(const HairMaterial& hair);
+
 /// The camera pass's uniforms: camera, lights (lightRad[i].w = light i's
 /// shadow slot, -1 none), materials, each slot's grid, counts and flags.
 void fillFrameUniforms(FrameUniforms& u, const UniformInputs& in);

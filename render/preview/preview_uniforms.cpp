@@ -108,6 +108,11 @@ void fillFrameUniforms(FrameUniforms& u, const UniformInputs& in) {
     u.counts[3] = fittedHair ? kHairFitted : h.twoLobes ? kHairKajiyaKayTwoLobes : kHairKajiyaKay;
 }
 
+Vec3f skinForwardAlbedo(const HairMaterial& hair) {
+    if (hair.shading != HairShading::Fitted) return Vec3f::Zero();
+    return hair.dual.forward.cwiseMax(Vec3f::Zero()).cwiseMin(Vec3f::Ones());
+}
+
 std::vector<std::string> hairShadingDefines(const FrameUniforms& u) {
     // Mesa's llvmpipe (gallivm) runs both sides of a branch under an
     // execution mask even when its condition is uniform: every shaded
