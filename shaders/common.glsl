@@ -40,6 +40,7 @@ const int kFlagVoxels = 1;
 const int kFlagShadowMap = 2;
 const int kFlagVoxelFilter = 4;
 const int kFlagUnshadowedLights = 8;  // some light has no shadow slot
+const int kFlagSortedHair = 16;       // sorted hair: the skin seen through it (resolve.frag), bounce only beside it
 
 // uCounts.w: Kajiya-Kay with one or two lobes, or the fitted model with dual scattering.
 const int kHairKajiyaKay = 0;

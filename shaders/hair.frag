@@ -1,5 +1,6 @@
 // Hair fragments (simulated and generated). Sorted hair: the premultiplied
-// colour (c a, a), blended back to front with the over operator. Weighted
+// colour (c a, a), blended back to front with the over operator over black
+// (the resolve adds the skin behind, kept apart: resolve.frag). Weighted
 // blended order-independent transparency (McGuire & Bavoil 2013):
 // accumulation += (c a, a) * w, revealage *= 1 - a, with w falling with
 // depth behind the scene's front (uBlend). Both: depth = min(depth, z).

@@ -13,7 +13,10 @@
 //   L = sum over lights of E shadowMap [exp(-C) (f + B(0)) + (T_f - exp(-C)) d_f (f_turned(n) + B(n))],
 //   B(n) = (1 - exp(-(1 - a_f^2) C_b)) d_b f_back(n beta_f^2), n = C / (1 - exp(-C)),
 // plus the scalp's bounce under the hair (scalpBounce below): the skin lit through
-// the hair's column lights the fibres above it.
+// the hair's column lights the fibres above it. Sorted hair takes that path
+// from the skin the camera sees behind the fibre instead (resolve.frag
+// skinThrough), and keeps the bounce where the camera sees none (hair beside
+// the head: skinBehindInView).
 // Evaluated per ribbon vertex (default; Gouraud along the strand, which
 // software rasterizers need for speed) or per fragment (SHADE_PER_FRAGMENT).
 #include "kajiya_kay.glsl"
@@ -55,9 +58,25 @@ vec3 scalpBounce(int s, vec3 world, vec3 t, vec3 n, vec3 l, vec3 af, vec2 c) {
     return headBehind(s, world) * af * exp(-uShadowColor.rgb * max(c.y - c.x, 0.0)) * skin;
 }
 
+// The head's depth from the camera (sorted hair; render/preview/preview.cpp cameraPass).
+layout(binding = 9) uniform sampler2D uCameraHead;
+
+// 1 where the camera sees the head behind a hair point: there resolve.frag
+// composites the skin through the hair's forward scattering (skinThrough),
+// which is the scalp's bounce taken from the skin the camera sees; 0 where
+// the hair lies beside the head or past it (its silhouette), where only the
+// bounce brings the skin's light.
+float skinBehindInView(vec3 world) {
+    vec4 c = uViewProj * vec4(world, 1.0);
+    vec3 p = c.xyz / c.w * 0.5 + 0.5;
+    if (any(lessThan(p.xy, vec2(0.0))) || any(greaterThan(p.xy, vec2(1.0)))) return 0.0;
+    return texture(uCameraHead, p.xy).r < 1.0 ? 1.0 : 0.0;
+}
+
 // Light i's share, its shadow slot s (-1 none) and type given: constants
 // when the program is compiled for its lights (HAIR_LIGHTS below).
-vec3 shadeLight(int i, int s, bool point, vec3 world, vec3 t, vec3 n, vec3 v, vec3 albedo, float firstColumn) {
+vec3 shadeLight(int i, int s, bool point, vec3 world, vec3 t, vec3 n, vec3 v, vec3 albedo, float firstColumn,
+                float bounce) {
     vec3 radiance;
     vec3 l = toLightOfType(i, point, world, radiance);
     if (SHADE_MODEL != kHairFitted) return kajiyaKay(albedo, t, n, l, v) * radiance * slotVisibility(s, world);
@@ -110,7 +129,7 @@ vec3 shadeLight(int i, int s, bool point, vec3 world, vec3 t, vec3 n, vec3 v, ve
     vec3 fStraight = fittedHairBoth(albedo, t, l, v, spread, uLobeShape[0].z * crossed, fScattered);
     vec3 backStraight = hairLobeBoth(3, t, l, v, spread, 0.0, backScattered);
     vec3 f = direct * (fStraight + backStraight * depthFactor) + scattered * (fScattered + backScattered * depthFactor) +
-             scalpBounce(s, world, t, n, l, af, c);
+             bounce * scalpBounce(s, world, t, n, l, af, c);
     return f * radiance * headVisibility(s, world);
 }
 
@@ -125,16 +144,20 @@ vec3 shadeHair(vec3 world, vec3 tangent, vec3 albedo) {
     // Lights without a shadow slot take the hair's thickness from slot 0's
     // column through the point (once for all of them).
     float firstColumn = -1.0;
+    // The scalp's bounce, except where sorted hair composites the skin the
+    // camera sees behind it (resolve.frag): the same path, counted once.
+    float bounce = 1.0;
+    if (SHADE_MODEL == kHairFitted && (SHADE_FLAGS & kFlagSortedHair) != 0) bounce = 1.0 - skinBehindInView(world);
     if (SHADE_MODEL == kHairFitted && (SHADE_FLAGS & kFlagUnshadowedLights) != 0 && voxelsOn(uCounts.y > 0 ? 0 : -1))
         firstColumn = hairColumn(0, world).y;
 #ifdef HAIR_LIGHTS
     // HAIR_LIGHTS(F) is F(i, slot, point) for each light, in order
     // (hairShadingDefines): one inlined call per light, with constants.
-#define HAIR_SHADE_ONE(i, s, point) color += shadeLight(i, s, point, world, t, n, v, albedo, firstColumn);
+#define HAIR_SHADE_ONE(i, s, point) color += shadeLight(i, s, point, world, t, n, v, albedo, firstColumn, bounce);
     HAIR_LIGHTS(HAIR_SHADE_ONE)
 #else
     for (int i = 0; i < uCounts.x; ++i)
-        color += shadeLight(i, shadowSlot(i), uLightVec[i].w >= 0.5, world, t, n, v, albedo, firstColumn);
+        color += shadeLight(i, shadowSlot(i), uLightVec[i].w >= 0.5, world, t, n, v, albedo, firstColumn, bounce);
 #endif
     return color;
 }

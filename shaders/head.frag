@@ -11,6 +11,7 @@ layout(location = 1) in vec3 vNormal;
 void main() {}
 #else
 layout(location = 0) out vec4 oColor;
+layout(location = 1) out vec4 oSkin;  // sorted hair: the skin apart, seen through the hair (resolve.frag)
 layout(location = 3) out vec4 oDepth;
 
 void main() {
@@ -36,6 +37,7 @@ void main() {
         if (max(f.r, max(f.g, f.b)) > 0.0) color += f * radiance * hairOnlyVisibility(i, vWorld);
     }
     oColor = vec4(color, 1.0);
+    oSkin = oColor;
     oDepth = vec4(1.0 / gl_FragCoord.w);
 }
 #endif

@@ -1,6 +1,10 @@
 // The small view the renderer tests (test_preview.cpp, test_reference.cpp)
-// draw their strands in.
+// draw their strands in, and the jittered slab of strands the shadow and
+// skin tests (test_preview_shadows.cpp, test_preview_skin.cpp) put in it.
 #pragma once
+
+#include <cstdint>
+#include <vector>
 
 #include "render/reference/hair_fit.h"
 #include "render/view/simple_view.h"
@@ -63,6 +67,33 @@ inline std::vector<View> lightSetups(const View& base) {
     views[3] = views[2];
     for (Light& l : views[3].lights) l.castsShadows = false;
     return views;
+}
+
+/// A slab of straight vertical strands (y from -0.12 to 0.12 m, 8 vertices)
+/// of one radius, jittered on a columns × rows lattice over x0..x1 × z0..z1
+/// by a deterministic generator seeded with `seed`.
+inline StrandFrame strandSlab(int columns, int rows, float x0, float x1, float z0, float z1, float radius, uint32_t seed) {
+    StrandFrame slab;
+    auto random = [&seed] {  // deterministic, in [0, 1)
+        seed = seed * 1664525u + 1013904223u;
+        return float(seed >> 8) / float(1u << 24);
+    };
+    for (int i = 0; i < columns; ++i)
+        for (int k = 0; k < rows; ++k) {
+            const float x = x0 + (x1 - x0) * (float(i) + random()) / float(columns);
+            const float z = z0 + (z1 - z0) * (float(k) + random()) / float(rows);
+            std::vector<Vec3f> p;
+            for (int j = 0; j < 8; ++j) p.push_back(Vec3f(x, -0.12f + 0.24f * float(j) / 7.f, z));
+            const std::vector<float> r(p.size(), radius);
+            slab.addStrand(uint32_t(slab.strandCount()), p.data(), r.data(), p.size());
+        }
+    return slab;
+}
+
+/// Image position of a world point (pixels, y down).
+inline Vec2f project(const View& v, const Vec3f& p) {
+    const Vec4f c = v.camera.projection() * v.camera.view() * p.homogeneous();
+    return Vec2f((c.x() / c.w() * 0.5f + 0.5f) * v.camera.width, (0.5f - c.y() / c.w() * 0.5f) * v.camera.height);
 }
 
 }  // namespace hp::test

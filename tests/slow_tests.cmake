@@ -18,6 +18,8 @@ set(_hp_slow_tests
   test_preview_shadows:PreviewShadows.ShadowingTheFillDarkensTheHair  # five renders under the rig
   test_preview_shadows:PreviewShadows.CapAndOrderOfShadowedLights  # three renderers' programs
   test_preview_shadows:PreviewShadows.EachViewIsShadedWithItsOwnLights  # seventeen renders
+  test_preview_skin:PreviewSkin.SkinThroughTheHairMatchesThePhysicalSlab  # two 64-spp physical renders
+  test_preview_skin:PreviewSkin.ScalpBounceIsTheSkinsLightThroughTheHair  # three renders with shadows
   test_preview_compute:PreviewCompute.ComputeShadedVerticesMatchStageShadedOnes  # twenty-four renders
   test_preview_stage:PreviewStage.ViewerRendersUnderXvfb       # Xvfb start-up
   test_guides:Guides.StableOverTenThousandStepsWithATeleport   # 10^4 solver steps

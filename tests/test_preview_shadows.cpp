@@ -1,10 +1,9 @@
 // The preview shadows every light that casts shadows (up to
 // PreviewShadowSettings::maxLights), each through its own light grid, voxel
 // density and head shadow map: a second light's shadow through a slab of hair
-// is Beer-Lambert's, computed here from the slab's strand density; the skin
-// under a slab of hair lights it as a Lambertian plane's bounce does
-// (analytic); shadowing the rig's fill darkens the hair; the cap and the
-// slot order hold.
+// is Beer-Lambert's, computed here from the slab's strand density (the skin
+// under and behind the hair: test_preview_skin.cpp); shadowing the rig's fill
+// darkens the hair; the cap and the slot order hold.
 //
 // Set HAIRPIPE_TEST_DUMP=<folder> to write the images as EXR there.
 #include "gl_support.h"
@@ -28,34 +27,9 @@ void dump(const std::string& name, const Image& img) {
     if (const char* dir = std::getenv("HAIRPIPE_TEST_DUMP")) writeImage(std::string(dir) + "/" + name + ".exr", img);
 }
 
+using test::project;
 using test::renderOnce;
-
-/// A slab of straight vertical strands (y from -0.12 to 0.12 m, 8 vertices)
-/// of one radius, jittered on a columns × rows lattice over x0..x1 × z0..z1
-/// by a deterministic generator seeded with `seed`.
-StrandFrame strandSlab(int columns, int rows, float x0, float x1, float z0, float z1, float radius, uint32_t seed) {
-    StrandFrame slab;
-    auto random = [&seed] {  // deterministic, in [0, 1)
-        seed = seed * 1664525u + 1013904223u;
-        return float(seed >> 8) / float(1u << 24);
-    };
-    for (int i = 0; i < columns; ++i)
-        for (int k = 0; k < rows; ++k) {
-            const float x = x0 + (x1 - x0) * (float(i) + random()) / float(columns);
-            const float z = z0 + (z1 - z0) * (float(k) + random()) / float(rows);
-            std::vector<Vec3f> p;
-            for (int j = 0; j < 8; ++j) p.push_back(Vec3f(x, -0.12f + 0.24f * float(j) / 7.f, z));
-            const std::vector<float> r(p.size(), radius);
-            slab.addStrand(uint32_t(slab.strandCount()), p.data(), r.data(), p.size());
-        }
-    return slab;
-}
-
-/// Image position of a world point (pixels, y down).
-Vec2f project(const View& v, const Vec3f& p) {
-    const Vec4f c = v.camera.projection() * v.camera.view() * p.homogeneous();
-    return Vec2f((c.x() / c.w() * 0.5f + 0.5f) * v.camera.width, (0.5f - c.y() / c.w() * 0.5f) * v.camera.height);
-}
+using test::strandSlab;
 
 /// Sum of the green channel over the image of the plane rectangle x0..x1 × y0..y1 (z = 0).
 double greenOver(const Image& img, const View& v, float x0, float x1, float y0, float y1) {
@@ -208,80 +182,6 @@ TEST(PreviewShadows, ShadowingTheFillDarkensTheHair) {
                                hairLight(renderOnce(s, fittedOpen, h.strands, &h.head), shadowed);
     EXPECT_LT(fittedRatio, 0.97) << "fitted hair: shadowing fill and rim darkens the hair";
     std::cout << "fitted hair, fill and rim shadowed / unshadowed: " << fittedRatio << "\n";
-}
-
-// The scalp's bounce (shaders/hair_shading.glsl scalpBounce): a slab of
-// straight strands along y (x -0.06..0.06, z 0.02..0.04, C = n 2r L = 1.67
-// crossings through it along z) lies over a Lambertian plane at z = 0 (albedo
-// rho, no sheen, no wrap), lit straight down (l = +z) and seen from above.
-// The skin receives E T_f(C) (T_f(C) = exp(-(1 - a_f) C), the hair's forward
-// transmittance) and returns L_s = rho / pi E T_f(C). A fibre at depth c
-// (crossings above it, seen by the camera with probability e^-c) meets L_s
-// through the C - c crossings below it and sends the viewer a_f of it, times
-// the mean of cos(n_s, l) over the half circle of normals across the fibre
-// facing the viewer (the preview's stand-in for the unknown skin normal),
-// here integrated numerically. Summed over the slab's depth:
-//   a_f L_s int_0^C e^-c T_f(C - c) dc = L_s T_f(C) (1 - e^-(a_f C)).
-// The plane's albedo is the only difference between the two renders, so
-// their difference on the slab's pixels is that bounce plus the skin seen
-// between the strands, (1 - alpha_hair) L_s (alpha_hair from a render
-// without the plane).
-TEST(PreviewShadows, ScalpBounceIsTheSkinsLightThroughTheHair) {
-    HP_REQUIRE_GL();
-    const float radius = 0.0001f;
-    const int columns = 100, rows = 10;
-    const float x0 = -0.06f, x1 = 0.06f, z0 = 0.02f, z1 = 0.04f;
-    const StrandFrame slab = strandSlab(columns, rows, x0, x1, z0, z1, radius, 7u);
-    const double crossings = double(columns * rows) / double((x1 - x0) * (z1 - z0)) * 2.0 * radius * double(z1 - z0);
-    TriangleMesh plane;
-    plane.positions = {Vec3f(-0.2f, -0.2f, 0.f), Vec3f(0.2f, -0.2f, 0.f), Vec3f(0.2f, 0.2f, 0.f), Vec3f(-0.2f, 0.2f, 0.f)};
-    plane.triangles = {Tri{0, 1, 2}, Tri{0, 2, 3}};
-    plane.computeNormals();
-
-    View skin = test::frontView(240, 240, Vec3f(0.f, 0.f, -1.f));
-    skin.lights[0].intensity = 2.f;
-    skin.lights[0].color = Vec3f::Ones();
-    skin.environment = Vec3f::Zero();
-    skin.head.ambient = skin.head.wrap = skin.head.specular = 0.f;
-    skin.head.color = Vec3f(0.6f, 0.42f, 0.33f);
-    fitHairMaterial(HairFiberParams{}, &skin.hair);
-    View black = skin;
-    black.head.color = Vec3f::Zero();
-    PreviewSettings s;
-    s.shadow.resolution = 128;
-    const Image withSkin = renderOnce(s, skin, slab, &plane), withBlack = renderOnce(s, black, slab, &plane);
-    const Image hairAlone = renderOnce(s, skin, slab, nullptr);
-    dump("bounce.skin", withSkin);
-    dump("bounce.black", withBlack);
-
-    // The mean of max(0, cos(psi - gamma)) over psi in (-pi/2, pi/2), over pi
-    // (gamma = 0: the light along the ribbon's normal), by the midpoint rule.
-    double halfCircle = 0.0;
-    const int steps = 1000;
-    for (int i = 0; i < steps; ++i) halfCircle += std::max(0.0, std::cos(-0.5 * M_PI + (i + 0.5) * M_PI / steps));
-    halfCircle *= (M_PI / steps) / M_PI;
-    const double af = double(skin.hair.dual.forward.y()), rho = double(skin.head.color.y()), e = 2.0;
-    const double forwardT = std::exp(-(1.0 - af) * crossings);
-    const double skinRadiance = rho / M_PI * e * forwardT;
-    const double expected = skinRadiance * halfCircle * forwardT * (1.0 - std::exp(-af * crossings));
-    double bounce = 0.0, seen = 0.0;
-    int pixels = 0;
-    const Vec2f a = project(skin, Vec3f(-0.03f, 0.05f, z1)), b = project(skin, Vec3f(0.03f, -0.05f, z1));
-    for (int y = int(std::ceil(a.y())); y < int(b.y()); ++y)
-        for (int x = int(std::ceil(a.x())); x < int(b.x()); ++x) {
-            const double between = (1.0 - double(hairAlone.at(x, y, 3))) * skinRadiance;
-            bounce += double(withSkin.at(x, y, 1)) - double(withBlack.at(x, y, 1)) - between;
-            seen += 1.0 - double(hairAlone.at(x, y, 3));
-            ++pixels;
-        }
-    ASSERT_GT(pixels, 100);
-    bounce /= pixels;
-    seen /= pixels;
-    EXPECT_NEAR(seen / std::exp(-crossings), 1.0, 0.15) << "the skin seen between the strands, against e^-C";
-    EXPECT_NEAR(bounce / expected, 1.0, 0.15) << "the scalp's bounce on the hair (green): preview " << bounce
-                                             << ", slab over a Lambertian plane " << expected;
-    std::cout << "C " << crossings << ", skin seen " << seen << " (e^-C " << std::exp(-crossings) << "); bounce "
-              << bounce << ", analytic " << expected << "\n";
 }
 
 // The preview shadows the first maxLights lights with castsShadows, in order,

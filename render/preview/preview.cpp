@@ -6,16 +6,15 @@
 #include "core/errors.h"
 #include "core/log.h"
 #include "render/preview/gl_program.h"
+#include "render/preview/pass_clock.h"
 #include "render/preview/preview_gpu.h"
 #include "render/preview/voxel_programs.h"
 
 #include <epoxy/gl.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstring>
-#include <ctime>
 
 namespace hp {
 
@@ -27,22 +26,6 @@ using Files = std::vector<std::pair<ShaderStage, std::string>>;
 /// strand rarely straddles another in depth, long enough to keep the
 /// per-patch cost of software rasterizers down.
 constexpr int kSortedPatchSegments = 4;
-
-double cpuMilliseconds() {
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);  // all threads, llvmpipe's rasterizers included
-    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
-}
-
-double threadCpuMilliseconds() {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);  // the calling thread: llvmpipe's vertex pipeline
-    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
-}
-
-double wallMilliseconds() {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 }  // namespace
 
@@ -293,6 +276,18 @@ struct PreviewRenderer::Impl {
 
     void cameraPass(bool voxelsOn, bool mapOn, float lineWidth) {
         glBindBufferBase(GL_UNIFORM_BUFFER, 0, cameraUbo);
+        // Sorted hair: the head's depth from the camera (unit 9), where the camera
+        // sees skin behind the hair (shaders/hair_shading.glsl skinBehindInView).
+        const bool sorted = settings.blend == HairBlend::Sorted;
+        const float far = 1.f;
+        glDepthMask(GL_TRUE);  // the clear obeys it, and the light passes leave it off
+        glClearNamedFramebufferfv(targets.headFbo, GL_DEPTH, 0, &far);
+        glBindFramebuffer(GL_FRAMEBUFFER, sorted ? targets.headFbo : targets.msFbo);
+        glViewport(0, 0, targets.width * targets.supersample, targets.height * targets.supersample);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        if (sorted) { drawHead(headDepth); mark("camera head depth"); }
+        glBindTextureUnit(9, targets.headDepth);
         glBindFramebuffer(GL_FRAMEBUFFER, targets.msFbo);
         glViewport(0, 0, targets.width * targets.supersample, targets.height * targets.supersample);
         const float zero[4] = {0, 0, 0, 0}, one[4] = {1, 1, 1, 1};
@@ -302,10 +297,8 @@ struct PreviewRenderer::Impl {
         glDisable(GL_BLEND);
         glDepthMask(GL_TRUE);
         glClearBufferfv(GL_COLOR, 0, zero);
-        if (settings.blend == HairBlend::Weighted) {  // sorted hair blends into 0 (the resolve reads neither)
-            glClearBufferfv(GL_COLOR, 1, zero);
-            glClearBufferfv(GL_COLOR, 2, one);
-        }
+        glClearBufferfv(GL_COLOR, 1, zero);  // weighted: accumulation; sorted: the skin
+        if (settings.blend == HairBlend::Weighted) glClearBufferfv(GL_COLOR, 2, one);  // sorted hair reads no revealage
         glClearBufferfv(GL_COLOR, 3, inf);
         glClearBufferfv(GL_DEPTH, 0, one);
         mark("camera clear");
@@ -321,8 +314,11 @@ struct PreviewRenderer::Impl {
         glDepthFunc(GL_LESS);
         glEnable(GL_MULTISAMPLE);
 
-        // Opaque head: colour into attachment 0, nearest depth (min) into 3.
-        const GLenum opaque[] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT3};
+        // Opaque head: colour into attachment 0 (sorted hair: into 1, kept apart
+        // and seen through the hair in shaders/resolve.frag), nearest depth into 3.
+        const GLenum none = GL_NONE;
+        const GLenum opaque[] = {sorted ? none : GL_COLOR_ATTACHMENT0, sorted ? GL_COLOR_ATTACHMENT1 : none, none,
+                                 GL_COLOR_ATTACHMENT3};
         glDrawBuffers(4, opaque);
         glEnablei(GL_BLEND, 3);
         glBlendEquationi(3, GL_MIN);
@@ -332,10 +328,11 @@ struct PreviewRenderer::Impl {
 
         // Hair: tested against the head's depth, never writing it; min depth
         // into 3. Sorted: premultiplied colour over attachment 0 (the patches
-        // arrive back to front). Weighted: weighted sums into 1, revealage
-        // products into 2.
+        // arrive back to front; its alpha is the hair's coverage, which the
+        // resolve lets the skin through). Weighted: weighted sums into 1,
+        // revealage products into 2.
         glDepthMask(GL_FALSE);
-        if (settings.blend == HairBlend::Sorted) {
+        if (sorted) {
             const GLenum hair[] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE, GL_COLOR_ATTACHMENT3};
             glDrawBuffers(4, hair);
             glEnablei(GL_BLEND, 0);
@@ -385,6 +382,8 @@ struct PreviewRenderer::Impl {
         // An environment map shows as its mean (render.environment_map).
         const Vec3f env = view.meanEnvironment();
         glProgramUniform3f(p.id(), p.uniform("uEnvironment"), env.x(), env.y(), env.z());
+        const Vec3f af = skinForwardAlbedo(view.hair);  // what a fibre passes of the skin besides its gaps
+        if (sorted) glProgramUniform3f(p.id(), p.uniform("uForward"), af.x(), af.y(), af.z());
         glBindTextureUnit(0, targets.opaque);
         glBindTextureUnit(1, targets.accum);
         glBindTextureUnit(2, targets.reveal);

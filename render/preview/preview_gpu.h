@@ -53,6 +53,10 @@ inline constexpr int kFlagShadowMap = 2;
 inline constexpr int kFlagVoxelFilter = 4;
 /// Some light has no shadow slot: the fitted hair needs slot 0's column for it.
 inline constexpr int kFlagUnshadowedLights = 8;
+/// Sorted hair: the skin is kept apart and seen through the hair's forward
+/// scattering (shaders/resolve.frag), so the shading leaves out the scalp's
+/// bounce where the camera sees skin behind the hair.
+inline constexpr int kFlagSortedHair = 16;
 /// FrameUniforms::counts[3], the hair model (kHair* in shaders/common.glsl).
 inline constexpr int kHairKajiyaKay = 0;
 inline constexpr int kHairKajiyaKayTwoLobes = 1;
@@ -71,6 +75,11 @@ struct UniformInputs {
     const int* resolutions = nullptr;      ///< voxel resolution of each slot
     bool voxels = false, shadowMap = false;
 };
+
+/// What a fibre lets through of the skin behind it besides its gaps, per
+/// channel: the fitted hair's forward albedo a_f (Zinke et al. 2008), none
+/// for Kajiya-Kay hair (shaders/resolve.frag skinThrough).
+Vec3f skinForwardAlbedo(const HairMaterial& hair);
 
 /// The camera pass's uniforms: camera, lights (lightRad[i].w = light i's
 /// shadow slot, -1 none), materials, each slot's grid, counts and flags.
@@ -161,6 +170,9 @@ struct RenderTargets {
     int width = 0, height = 0, samples = 0, supersample = 0;
     unsigned msFbo = 0, opaque = 0, accum = 0, reveal = 0, minDepth = 0, depth = 0;
     unsigned resolvedFbo = 0, resolvedColor = 0, resolvedDepth = 0;
+    /// The head's depth from the camera, one sample a pixel (sorted hair:
+    /// whether the camera sees skin behind a hair point, shaders/hair_shading.glsl).
+    unsigned headFbo = 0, headDepth = 0;
 
     void ensure(int w, int h, int samples, int supersample);
     void destroy();

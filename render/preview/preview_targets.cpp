@@ -76,11 +76,21 @@ void RenderTargets::ensure(int w, int h, int s, int ss) {
     const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     glNamedFramebufferDrawBuffers(resolvedFbo, 2, buffers);
     checkComplete(resolvedFbo, "resolved");
+
+    headDepth = makeTarget(tw, th, 1, GL_DEPTH_COMPONENT32F);
+    glTextureParameteri(headDepth, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(headDepth, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTextureParameteri(headDepth, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(headDepth, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glCreateFramebuffers(1, &headFbo);
+    glNamedFramebufferTexture(headFbo, GL_DEPTH_ATTACHMENT, headDepth, 0);
+    glNamedFramebufferDrawBuffer(headFbo, GL_NONE);
+    checkComplete(headFbo, "camera head depth");
 }
 
 void RenderTargets::destroy() {
-    deleteFramebuffers({&msFbo, &resolvedFbo});
-    deleteTextures({&opaque, &accum, &reveal, &minDepth, &depth, &resolvedColor, &resolvedDepth});
+    deleteFramebuffers({&msFbo, &resolvedFbo, &headFbo});
+    deleteTextures({&opaque, &accum, &reveal, &minDepth, &depth, &resolvedColor, &resolvedDepth, &headDepth});
     width = height = samples = supersample = 0;
 }
 

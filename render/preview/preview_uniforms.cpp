@@ -103,8 +103,14 @@ void fillFrameUniforms(FrameUniforms& u, const UniformInputs& in) {
     u.counts[0] = int(lights);
     u.counts[1] = int(std::min<size_t>(in.slots.size(), kMaxShadowedLights));
     u.counts[2] = (in.voxels ? kFlagVoxels : 0) | (in.shadowMap ? kFlagShadowMap : 0) |
-                  (in.voxels && sh.filter ? kFlagVoxelFilter : 0) | (unshadowed ? kFlagUnshadowedLights : 0);
+                  (in.voxels && sh.filter ? kFlagVoxelFilter : 0) | (unshadowed ? kFlagUnshadowedLights : 0) |
+                  (settings.blend == HairBlend::Sorted ? kFlagSortedHair : 0);
     u.counts[3] = fittedHair ? kHairFitted : h.twoLobes ? kHairKajiyaKayTwoLobes : kHairKajiyaKay;
+}
+
+Vec3f skinForwardAlbedo(const HairMaterial& hair) {
+    if (hair.shading != HairShading::Fitted) return Vec3f::Zero();
+    return hair.dual.forward.cwiseMax(Vec3f::Zero()).cwiseMin(Vec3f::Ones());
 }
 
 std::vector<std::string> hairShadingDefines(const FrameUniforms& u) {
