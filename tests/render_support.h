@@ -4,14 +4,23 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdlib>
+#include <string>
 #include <vector>
 
+#include "render/image/image_io.h"
 #include "render/reference/hair_fit.h"
 #include "render/view/simple_view.h"
 #include "sim/strands/head.h"
 #include "sim/strands/synthetic.h"
 
 namespace hp::test {
+
+/// Writes `img` as <HAIRPIPE_TEST_DUMP>/<name>.exr when that variable names a
+/// folder (to look at a renderer test's images); does nothing otherwise.
+inline void dump(const std::string& name, const Image& img) {
+    if (const char* dir = std::getenv("HAIRPIPE_TEST_DUMP")) writeImage(std::string(dir) + "/" + name + ".exr", img);
+}
 
 /// @brief A camera at (0, 0, 1) looking at the origin with a 40° vertical
 /// field of view, `width` × `height` pixels, and one directional light (View's

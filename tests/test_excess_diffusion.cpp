@@ -53,6 +53,27 @@ double maxError(const std::vector<float>& E, const std::vector<float>& e, double
     return worst;
 }
 
+/// A box of random excess: each node 0 with probability `zero`, else uniform
+/// in [0, scale), and holding hair with probability `hair`.
+struct RandomBox {
+    NodeBox box;
+    std::vector<float> e;
+    std::vector<uint8_t> occupied;
+    RandomBox(int nx, int ny, int nz, unsigned seed, float zero, float scale, float hair) {
+        box.nx = nx;
+        box.ny = ny;
+        box.nz = nz;
+        std::mt19937 rng(seed);
+        std::uniform_real_distribution<float> u(0.f, 1.f);
+        e.resize(box.size());
+        occupied.resize(box.size());
+        for (size_t n = 0; n < e.size(); ++n) {
+            e[n] = u(rng) < zero ? 0.f : scale * u(rng);
+            occupied[n] = u(rng) < hair;
+        }
+    }
+};
+
 }  // namespace
 
 TEST(ExcessDiffusion, SweepsMatchTheNeumannSeriesOnEigenmodes) {
@@ -128,18 +149,10 @@ TEST(ExcessDiffusion, NodesWithoutHairHoldNoExcessAndBlockIt) {
 }
 
 TEST(ExcessDiffusion, SameBitsOnAnyThreadCountAndChunkOrder) {
-    NodeBox box;
-    box.nx = 17;
-    box.ny = 13;
-    box.nz = 29;
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<float> u(0.f, 1.f);
-    std::vector<float> e(box.size());
-    std::vector<uint8_t> occupied(box.size());
-    for (size_t n = 0; n < e.size(); ++n) {
-        e[n] = u(rng) < 0.5f ? 0.f : 3.f * u(rng);
-        occupied[n] = u(rng) < 0.8f;
-    }
+    const RandomBox random(17, 13, 29, 5, 0.5f, 3.f, 0.8f);
+    const NodeBox& box = random.box;
+    const std::vector<float>& e = random.e;
+    const std::vector<uint8_t>& occupied = random.occupied;
     const ParallelFor reversed = [](size_t count, const std::function<void(size_t, size_t)>& f) {
         for (size_t b = count; b > 0; --b) f(b - 1, b);
     };
@@ -168,18 +181,10 @@ TEST(ExcessDiffusion, ListedSweepsMatchWholeBoxSweeps) {
     // is jacobiSweep over the whole box, K times from E⁰ = 0: the same bits,
     // nodes without hair 0, on a box whose faces hold hair (the neighbours
     // outside count 0).
-    NodeBox box;
-    box.nx = 11;
-    box.ny = 7;
-    box.nz = 9;
-    std::mt19937 rng(11);
-    std::uniform_real_distribution<float> u(0.f, 1.f);
-    std::vector<float> e(box.size());
-    std::vector<uint8_t> occupied(box.size());
-    for (size_t n = 0; n < e.size(); ++n) {
-        e[n] = u(rng) < 0.4f ? 0.f : 2.f * u(rng);
-        occupied[n] = u(rng) < 0.35f;
-    }
+    const RandomBox random(11, 7, 9, 11, 0.4f, 2.f, 0.35f);
+    const NodeBox& box = random.box;
+    const std::vector<float>& e = random.e;
+    const std::vector<uint8_t>& occupied = random.occupied;
     for (int sweeps : {1, 2, 3, 4, 7}) {
         std::vector<float> a(box.size(), 0.f), b(box.size());
         for (int s = 0; s < sweeps; ++s) {

@@ -22,15 +22,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <string>
 
 namespace hp {
 namespace {
 
-void dump(const std::string& name, const Image& img) {
-    if (const char* dir = std::getenv("HAIRPIPE_TEST_DUMP")) writeImage(std::string(dir) + "/" + name + ".exr", img);
-}
+using test::dump;
 
 /// Largest |a - b| over the RGB channels, and the largest RGB value of b.
 std::pair<double, double> largestDifference(const Image& a, const Image& b) {

@@ -6,6 +6,7 @@
 //
 // Set HAIRPIPE_TEST_DUMP=<folder> to write the images as EXR there.
 #include "gl_support.h"
+#include "render_support.h"
 #include "test_support.h"
 
 #include "render/compare/compare.h"
@@ -17,15 +18,12 @@
 #include "render/view/simple_view.h"
 #include "sim/strands/synthetic.h"
 
-#include <cstdlib>
 #include <iostream>
 
 namespace hp {
 namespace {
 
-void dump(const std::string& name, const Image& img) {
-    if (const char* dir = std::getenv("HAIRPIPE_TEST_DUMP")) writeImage(std::string(dir) + "/" + name + ".exr", img);
-}
+using test::dump;
 
 /// Mean luminance of the hair pixels' colour (premultiplied colour over
 /// alpha-weighted coverage), over pixels covered in both images.

@@ -17,15 +17,12 @@
 #include "sim/strands/synthetic.h"
 
 #include <cmath>
-#include <cstdlib>
 #include <iostream>
 
 namespace hp {
 namespace {
 
-void dump(const std::string& name, const Image& img) {
-    if (const char* dir = std::getenv("HAIRPIPE_TEST_DUMP")) writeImage(std::string(dir) + "/" + name + ".exr", img);
-}
+using test::dump;
 
 using test::project;
 using test::renderOnce;

@@ -18,19 +18,45 @@
 #include "render/reference/reference.h"
 
 #include <cmath>
-#include <cstdlib>
 #include <iostream>
 
 namespace hp {
 namespace {
 
-void dump(const std::string& name, const Image& img) {
-    if (const char* dir = std::getenv("HAIRPIPE_TEST_DUMP")) writeImage(std::string(dir) + "/" + name + ".exr", img);
-}
+using test::dump;
 
 using test::project;
 using test::renderOnce;
 using test::strandSlab;
+
+/// The default shot's blond fibre (render.hair.melanin 0.3, pheomelanin 0.1).
+HairFiberParams blondFibre() {
+    HairFiberParams blond;
+    blond.sigmaA = hairAbsorptionFromMelanin(0.3f, 0.1f);
+    return blond;
+}
+
+/// A `size` x `size` view from (0, 0, 1) with one white light of `intensity`
+/// travelling along `lightDirection`, a black environment, a matte skin of
+/// the default shot's colour (no ambient, wrap or sheen), and hair fitted to
+/// `fibre`.
+View skinView(int size, const Vec3f& lightDirection, float intensity, const HairFiberParams& fibre) {
+    View v = test::frontView(size, size, lightDirection);
+    v.lights[0].intensity = intensity;
+    v.lights[0].color = Vec3f::Ones();
+    v.environment = Vec3f::Zero();
+    v.head.ambient = v.head.wrap = v.head.specular = 0.f;
+    v.head.color = Vec3f(0.6f, 0.42f, 0.33f);
+    fitHairMaterial(fibre, &v.hair);
+    return v;
+}
+
+/// `v` with a black skin: a render of `v` less a render of this is the
+/// skin's light that reaches the camera.
+View withBlackSkin(View v) {
+    v.head.color = Vec3f::Zero();
+    return v;
+}
 
 /// A plane at z = 0 facing the camera, over x0..x1 × -0.2..0.2.
 TriangleMesh planeMesh(float x0 = -0.2f, float x1 = 0.2f) {
@@ -66,15 +92,8 @@ TEST(PreviewSkin, ScalpBounceIsTheSkinsLightThroughTheHair) {
     const double crossings = double(columns * rows) / double((x1 - x0) * (z1 - z0)) * 2.0 * radius * double(z1 - z0);
     const TriangleMesh plane = planeMesh();
 
-    View skin = test::frontView(240, 240, Vec3f(0.f, 0.f, -1.f));
-    skin.lights[0].intensity = 2.f;
-    skin.lights[0].color = Vec3f::Ones();
-    skin.environment = Vec3f::Zero();
-    skin.head.ambient = skin.head.wrap = skin.head.specular = 0.f;
-    skin.head.color = Vec3f(0.6f, 0.42f, 0.33f);
-    fitHairMaterial(HairFiberParams{}, &skin.hair);
-    View black = skin;
-    black.head.color = Vec3f::Zero();
+    const View skin = skinView(240, Vec3f(0.f, 0.f, -1.f), 2.f, HairFiberParams{});
+    const View black = withBlackSkin(skin);
     // The bounce is the weighted hair's approximation of the skin seen
     // through the hair; sorted hair sees that skin where it is drawn
     // (SkinIsSeenThroughTheFibresForwardScattering below).
@@ -133,15 +152,7 @@ TEST(PreviewSkin, SkinIsSeenThroughTheFibresForwardScattering) {
     const float x0 = -0.06f, x1 = 0.06f, z0 = 0.02f, z1 = 0.04f;
     const StrandFrame slab = strandSlab(100, 10, x0, x1, z0, z1, radius, 7u);
     const TriangleMesh plane = planeMesh();
-    View skin = test::frontView(240, 240, Vec3f(0.f, 0.f, -1.f));
-    skin.lights[0].intensity = 2.f;
-    skin.lights[0].color = Vec3f::Ones();
-    skin.environment = Vec3f::Zero();
-    skin.head.ambient = skin.head.wrap = skin.head.specular = 0.f;
-    skin.head.color = Vec3f(0.6f, 0.42f, 0.33f);
-    HairFiberParams blond;  // the default shot's fibre (render.hair.melanin 0.3, pheomelanin 0.1)
-    blond.sigmaA = hairAbsorptionFromMelanin(0.3f, 0.1f);
-    fitHairMaterial(blond, &skin.hair);
+    const View skin = skinView(240, Vec3f(0.f, 0.f, -1.f), 2.f, blondFibre());
     PreviewSettings s;  // sorted hair, the default
     ASSERT_EQ(s.blend, HairBlend::Sorted);
     s.shadow.voxels = false;
@@ -152,9 +163,8 @@ TEST(PreviewSkin, SkinIsSeenThroughTheFibresForwardScattering) {
     // Mean over the slab's pixels of the skin passed, over rho E / pi, and
     // of (1 - alpha_hair)^(1 - a) per channel.
     auto passed = [&](const View& lit, const Vec3f& forward, Eigen::Vector3d& expected) {
-        View black = lit;
-        black.head.color = Vec3f::Zero();
-        const Image withSkin = renderOnce(s, lit, slab, &plane), withBlack = renderOnce(s, black, slab, &plane);
+        const Image withSkin = renderOnce(s, lit, slab, &plane);
+        const Image withBlack = renderOnce(s, withBlackSkin(lit), slab, &plane);
         const Image hairAlone = renderOnce(s, lit, slab, nullptr);
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         expected = Eigen::Vector3d::Zero();
@@ -206,17 +216,9 @@ TEST(PreviewSkin, SkinThroughTheHairMatchesThePhysicalSlab) {
     const float x0 = -0.06f, x1 = 0.06f, z0 = 0.02f, z1 = 0.04f;
     const StrandFrame slab = strandSlab(100, 10, x0, x1, z0, z1, radius, 7u);
     const TriangleMesh plane = planeMesh();
-    View skin = test::frontView(160, 160, Vec3f(0.f, 0.f, -1.f));
-    skin.lights[0].intensity = 2.f;
-    skin.lights[0].color = Vec3f::Ones();
-    skin.environment = Vec3f::Zero();
-    skin.head.ambient = skin.head.wrap = skin.head.specular = 0.f;
-    skin.head.color = Vec3f(0.6f, 0.42f, 0.33f);
-    HairFiberParams blond;  // the default shot's fibre
-    blond.sigmaA = hairAbsorptionFromMelanin(0.3f, 0.1f);
-    fitHairMaterial(blond, &skin.hair);
-    View black = skin;
-    black.head.color = Vec3f::Zero();
+    const HairFiberParams blond = blondFibre();
+    const View skin = skinView(160, Vec3f(0.f, 0.f, -1.f), 2.f, blond);
+    const View black = withBlackSkin(skin);
     PreviewSettings s;
     s.shadow.resolution = 128;
     ReferenceSettings rs;
@@ -264,17 +266,8 @@ TEST(PreviewSkin, BounceLightsHairBesideTheHead) {
     const float z0 = 0.02f, z1 = 0.04f;
     const StrandFrame slab = strandSlab(50, 10, 0.02f, 0.08f, z0, z1, 0.0001f, 11u);
     const TriangleMesh plane = planeMesh(-0.2f, -0.005f);
-    View skin = test::frontView(200, 200, Vec3f(-3.f, 0.f, -1.f));
-    skin.lights[0].intensity = 4.f;
-    skin.lights[0].color = Vec3f::Ones();
-    skin.environment = Vec3f::Zero();
-    skin.head.ambient = skin.head.wrap = skin.head.specular = 0.f;
-    skin.head.color = Vec3f(0.6f, 0.42f, 0.33f);
-    HairFiberParams blond;
-    blond.sigmaA = hairAbsorptionFromMelanin(0.3f, 0.1f);
-    fitHairMaterial(blond, &skin.hair);
-    View black = skin;
-    black.head.color = Vec3f::Zero();
+    const View skin = skinView(200, Vec3f(-3.f, 0.f, -1.f), 4.f, blondFibre());
+    const View black = withBlackSkin(skin);
     const Vec2f a = project(skin, Vec3f(0.035f, 0.05f, z1)), b = project(skin, Vec3f(0.065f, -0.05f, z1));
     auto bounce = [&](HairBlend blend) {
         PreviewSettings s;

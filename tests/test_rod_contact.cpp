@@ -140,6 +140,16 @@ void report(const std::string& label, const Settled& r) {
                 r.released, r.kineticEnd, r.floor, r.rise);
 }
 
+/// The strand of `shape` settled 5 s on the sphere under case c, printed and
+/// recorded as the test's properties (kinetic energy left, largest rise).
+Settled settledOnSphere(Shape shape, const std::string& label, const Case& c) {
+    const Settled r = onSphere(shape, c.bdf2, c.substeps, true, 5.0);
+    report(label + " " + name(c), r);
+    ::testing::Test::RecordProperty(name(c) + "_kinetic_end_fJ", std::to_string(r.kineticEnd * 1e15));
+    ::testing::Test::RecordProperty(name(c) + "_rise_per_mille", std::to_string(1e3 * r.rise / r.released));
+    return r;
+}
+
 }  // namespace
 
 TEST(RodContact, StraightStrandOnASphereComesToRestAndNeverGainsEnergy) {
@@ -149,10 +159,7 @@ TEST(RodContact, StraightStrandOnASphereComesToRestAndNeverGainsEnergy) {
     // released: the placement lifts a resting vertex by one step's sag h²g
     // before the next step lets it down (measured ≤ 0.19%).
     for (const Case& c : kCases) {
-        const Settled r = onSphere(Shape::Straight, c.bdf2, c.substeps, true, 5.0);
-        report("straight " + name(c), r);
-        RecordProperty(name(c) + "_kinetic_end_fJ", std::to_string(r.kineticEnd * 1e15));
-        RecordProperty(name(c) + "_rise_per_mille", std::to_string(1e3 * r.rise / r.released));
+        const Settled r = settledOnSphere(Shape::Straight, "straight", c);
         EXPECT_GT(r.released, 0.0) << name(c) << ": the strand did not fall onto the sphere";
         EXPECT_LT(r.kineticEnd, restBound(r)) << name(c) << ": the strand on the sphere does not come to rest";
         EXPECT_LT(r.rise, 0.01 * r.released) << name(c) << ": the contact gave the strand energy";
@@ -167,10 +174,7 @@ TEST(RodContact, PlanarCurledStrandOnASphereComesToRest) {
     // contact, and the placement after it changes the bending energy the
     // solve assumed: a candidate, not measured phase by phase).
     for (const Case& c : kCases) {
-        const Settled r = onSphere(Shape::CurledPlanar, c.bdf2, c.substeps, true, 5.0);
-        report("planar curled " + name(c), r);
-        RecordProperty(name(c) + "_kinetic_end_fJ", std::to_string(r.kineticEnd * 1e15));
-        RecordProperty(name(c) + "_rise_per_mille", std::to_string(1e3 * r.rise / r.released));
+        const Settled r = settledOnSphere(Shape::CurledPlanar, "planar curled", c);
         EXPECT_GT(r.released, 0.0) << name(c);
         EXPECT_LT(r.kineticEnd, restBound(r)) << name(c) << ": the strand on the sphere does not come to rest";
     }

@@ -188,8 +188,8 @@ struct GuideSolver::Impl final : solver::StrandModel {
             // only: the step restores the head's clearance.
             forGroups([&](guides::GuideGroup& grp) {
                 for (size_t g = grp.begin(); g < grp.end(); ++g) relax(g, nullptr);
+                grp.displaced(beforePush.data());  // reads and moves only this group's vertices
             });
-            forGroups([&](guides::GuideGroup& grp) { grp.displaced(beforePush.data()); });
         }
         ++set.version;  // the rope's Bullet nodes reload x and v
     }
