@@ -16,6 +16,9 @@
 #include <memory>
 #include <unordered_map>
 
+#include <chrono>
+#include <ctime>
+
 namespace hp {
 
 namespace {
@@ -128,6 +131,35 @@ std::vector<Segment> prepareSegments(const StrandFrame& strands, const GridTrans
     return segments;
 }
 
+/// Fills VoxelizeSettings::phases, if asked: wall and process CPU seconds
+/// since the last lap.
+class PhaseClock {
+public:
+    explicit PhaseClock(VoxelizePhases* phases) : phases_(phases) {
+        if (phases_) *phases_ = VoxelizePhases();
+        wall_ = std::chrono::steady_clock::now();
+        cpu_ = cpuSeconds();
+    }
+    void lap(VoxelizePhases::Phase VoxelizePhases::*phase) {
+        if (!phases_) return;
+        const auto wall = std::chrono::steady_clock::now();
+        const double cpu = cpuSeconds();
+        phases_->*phase = {std::chrono::duration<double>(wall - wall_).count(), cpu - cpu_};
+        wall_ = wall;
+        cpu_ = cpu;
+    }
+
+private:
+    static double cpuSeconds() {
+        timespec ts{};
+        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+        return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+    }
+    VoxelizePhases* phases_;
+    std::chrono::steady_clock::time_point wall_;
+    double cpu_ = 0;
+};
+
 /// Segments grouped by the tiles they may deposit into: tile t (key
 /// keys[t], sorted) owns segments[start[t] .. start[t+1]), in segment order.
 struct TileBins {
@@ -203,7 +235,7 @@ TileBins binSegments(const std::vector<Segment>& segments, VoxelFilter filter, d
 
 template <int C>
 DensityGrid voxelizeTiles(const StrandFrame& strands, const GridTransform& transform,
-                          const VoxelizeSettings& settings) {
+                          const VoxelizeSettings& settings, PhaseClock& clock) {
     std::vector<SegmentVelocity> velocities;
     const std::vector<Segment> segments = prepareSegments(strands, transform, C == 4 ? &velocities : nullptr);
     if (segments.size() > size_t(UINT32_MAX)) throw Error("voxelize: too many segments; use a larger voxel size");
@@ -213,20 +245,23 @@ DensityGrid voxelizeTiles(const StrandFrame& strands, const GridTransform& trans
             throw Error(cat("voxelize: a strand radius of ", rMax, " m is absurd for voxels of ",
                             std::cbrt(transform.voxelVolume()), " m"));
     }
+    clock.lap(&VoxelizePhases::prepare);
     const TileBins bins = binSegments(segments, settings.filter, settings.maxMemoryGiB * double(size_t(1) << 30));
     const size_t tiles = bins.keys.size();
+    clock.lap(&VoxelizePhases::bin);
 
     const size_t limit = size_t(std::max(0.0, settings.maxMemoryGiB) * double(size_t(1) << 30));
     const size_t blockBytes = sizeof(DensityGrid::DensityBlock) + (C == 4 ? sizeof(DensityGrid::VelocityBlock) : 0);
     std::atomic<size_t> bytes{bins.segments.size() * sizeof(uint32_t) + segments.size() * sizeof(Segment) +
                               velocities.size() * sizeof(SegmentVelocity)};
+    const bool avx2 = settings.kernel == VoxelKernel::Auto && hasAvx2();
     std::vector<TileBlocks> results(tiles);
     tbb::enumerable_thread_specific<TileBuffer<C>> buffers;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& range) {
         TileBuffer<C>& tile = buffers.local();
         for (size_t t = range.begin(); t != range.end(); ++t) {
             tile.origin = DensityGrid::blockCoordOfKey(bins.keys[t]) * kTile;
-            fillTile(tile, settings.filter == VoxelFilter::Box, segments.data(), C == 4 ? velocities.data() : nullptr,
+            fillTile(tile, settings.filter == VoxelFilter::Box, avx2, segments.data(), C == 4 ? velocities.data() : nullptr,
                      &bins.segments[bins.start[t]], bins.start[t + 1] - bins.start[t], &results[t]);
             if (bytes.fetch_add(results[t].origins.size() * blockBytes) > limit)
                 throw Error(cat("voxelize: the density grid needs more than ", settings.maxMemoryGiB,
@@ -234,6 +269,7 @@ DensityGrid voxelizeTiles(const StrandFrame& strands, const GridTransform& trans
         }
     });
 
+    clock.lap(&VoxelizePhases::tiles);
     // Concatenate in tile order (sorted keys), independent of scheduling.
     size_t total = 0;
     for (const TileBlocks& r : results) total += r.origins.size();
@@ -249,10 +285,14 @@ DensityGrid voxelizeTiles(const StrandFrame& strands, const GridTransform& trans
         std::move(r.velocity.begin(), r.velocity.end(), std::back_inserter(velocity));
         r = TileBlocks();
     }
-    return DensityGrid(transform, std::move(origins), std::move(density), std::move(velocity));
+    DensityGrid grid(transform, std::move(origins), std::move(density), std::move(velocity));
+    clock.lap(&VoxelizePhases::gather);
+    return grid;
 }
 
 }  // namespace
+
+bool avx2KernelAvailable() { return hasAvx2(); }
 
 double hairVolume(const StrandFrame& strands) {
     double sum = 0;
@@ -266,13 +306,14 @@ double hairVolume(const StrandFrame& strands) {
 }
 
 DensityGrid voxelize(const StrandFrame& strands, const GridTransform& transform, const VoxelizeSettings& settings) {
+    PhaseClock clock(settings.phases);  // the checks count as preparing
     strands.validate();
     const double voxelVolume = transform.voxelVolume();
     if (!(voxelVolume > 0) || !std::isfinite(voxelVolume) || !transform.offset.allFinite())
         throw Error("voxelize: the grid transform is degenerate");
     checkRange(strands, transform);
-    return settings.velocity ? voxelizeTiles<4>(strands, transform, settings)
-                             : voxelizeTiles<1>(strands, transform, settings);
+    return settings.velocity ? voxelizeTiles<4>(strands, transform, settings, clock)
+                             : voxelizeTiles<1>(strands, transform, settings, clock);
 }
 
 }  // namespace hp
