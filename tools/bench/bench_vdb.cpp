@@ -364,7 +364,7 @@ int main(int argc, char** argv) {
         for (int n : threads) {
             tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(n));
             resetPeak();
-            std::vector<double> tv, tw, cv, cw, tf, phase[4];
+            std::vector<double> tv, tw, cv, cw, tf, phase[4], phaseWall[4];
             VoxelizePhases phases;
             VoxelizeSettings timed = vs;
             timed.phases = &phases;
@@ -378,7 +378,7 @@ int main(int argc, char** argv) {
                 tv.push_back(seconds(t));
                 int p = 0;
                 for (const auto* ph : {&phases.prepare, &phases.bin, &phases.tiles, &phases.gather})
-                    phase[p++].push_back(ph->cpu);
+                    phaseWall[p].push_back(ph->wall), phase[p++].push_back(ph->cpu);
                 cv.push_back(bench::processCpuSeconds() - c);
                 activeVoxels = grid.activeVoxelCount();
                 blocks = grid.blockCount();
@@ -408,9 +408,11 @@ int main(int argc, char** argv) {
                         h * 1e3, n, n == 1 ? " " : "s", f.median, f.min, f.max, v.median, v.min, v.max, vc.median,
                         w.median, w.min, w.max, wc.median, double(bytes) / (1 << 20), activeVoxels, blocks, peak,
                         massError, fileMassError);
-            std::printf("  voxelize's phases, cpu s (median): prepare %.3f, bin %.3f, tiles %.3f, gather %.3f\n",
-                        bench::stats(phase[0]).median, bench::stats(phase[1]).median, bench::stats(phase[2]).median,
-                        bench::stats(phase[3]).median);
+            std::printf("  voxelize's phases, cpu s (wall s), medians:");
+            const char* names[4] = {"prepare", "bin", "tiles", "gather"};
+            for (int p = 0; p < 4; ++p)
+                std::printf(" %s %.3f (%.3f)", names[p], bench::stats(phase[p]).median, bench::stats(phaseWall[p]).median);
+            std::printf("\n");
             std::fflush(stdout);
         }
     }
