@@ -373,6 +373,33 @@ TEST(Voxelizer, Avx2KernelGivesTheReferenceGridBitForBit) {
     }
 }
 
+TEST(Voxelizer, FarApartClumpsGiveEachClumpsOwnGrid) {
+    // Two clumps 12 m apart at 1 mm: the box of tiles they reach (375³)
+    // exceeds the dense tile table's 2^24 slots, so binning takes its hash
+    // map path. Each voxel only receives its own clump's segments, in the
+    // same order, so the grid must hold each clump's grid alone, bit for bit:
+    // a tile's segments binned out of order, lost or put in another tile
+    // changes voxels. The clumps alone fit the dense table.
+    const StrandFrame a = randomStrands(300, 5, Vec3f(0.01f, 0.02f, -0.03f));
+    const StrandFrame b = randomStrands(300, 6, Vec3f(12.f, -12.f, 12.f));
+    StrandFrame both = a;
+    for (size_t s = 0; s < b.strandCount(); ++s)
+        both.addStrand(uint32_t(a.strandCount() + s), &b.positions[b.first(s)], &b.radii[b.first(s)], b.vertexCount(s),
+                       &b.velocities[b.first(s)]);
+    const GridTransform grid = GridTransform::uniform(0.001);
+    const DensityGrid together = voxelize(both, grid), alone[2] = {voxelize(a, grid), voxelize(b, grid)};
+    ASSERT_EQ(together.blockCount(), alone[0].blockCount() + alone[1].blockCount());
+    size_t checked = 0;
+    for (const DensityGrid& g : alone)
+        for (size_t i = 0; i < g.blockCount(); ++i)
+            for (int v = 0; v < DensityGrid::kBlockVoxels; ++v) {
+                const Vec3i voxel = g.blockOrigin(i) + Vec3i(v >> 6, (v >> 3) & 7, v & 7);
+                ASSERT_EQ(together.density(voxel), g.density(voxel)) << voxel.transpose();
+                checked += g.density(voxel) > 0;
+            }
+    EXPECT_GT(checked, 10000u);
+}
+
 TEST(Voxelizer, EmptyFrameGivesEmptyGrid) {
     const DensityGrid grid = voxelize(StrandFrame(), GridTransform::uniform(0.001));
     EXPECT_EQ(grid.blockCount(), 0u);
