@@ -145,6 +145,7 @@ void depositTrilinear(TileBuffer<C>& tile, const Segment& s, const SegmentVeloci
 template <int C>
 void extractBlocks(TileBuffer<C>& tile, TileBlocks* out) {
     double* const values = tile.values.data();
+    DensityGrid::DensityBlockPtr spare;
     for (int bx = 0; bx < kBlocksPerTile; ++bx)
         for (int by = 0; by < kBlocksPerTile; ++by)
             for (int bz = 0; bz < kBlocksPerTile; ++bz) {
@@ -153,34 +154,36 @@ void extractBlocks(TileBuffer<C>& tile, TileBlocks* out) {
                 for (int i = 0; i < 8; ++i) touched |= tile.isTouched(bx + (i >> 2), by + ((i >> 1) & 1), bz + (i & 1));
                 if (!touched) continue;
                 const int x0 = bx * kBlock, y0 = by * kBlock, z0 = bz * kBlock;
+                // Converted in one pass; dropped after if it holds no hair
+                // (only zero deposits, e.g. exactly on a voxel plane).
+                if (!spare) spare.reset(new DensityGrid::DensityBlock);  // every voxel written below
+                DensityGrid::DensityBlock& density = *spare;
                 bool any = false;
                 for (int x = 0; x < kBlock; ++x)
                     for (int y = 0; y < kBlock; ++y) {
                         const double* row = values + size_t(TileBuffer<C>::index(x0 + x, y0 + y, z0)) * C;
-                        for (int z = 0; z < kBlock; ++z) any |= row[z * C] > 0;
+                        for (int z = 0; z < kBlock; ++z) {
+                            any |= row[z * C] > 0;
+                            density[size_t(DensityGrid::voxelOffset(x, y, z))] = float(row[z * C]);
+                        }
                     }
-                if (!any) continue;  // only zero deposits (e.g. exactly on a voxel plane): nothing active
+                if (!any) continue;
                 out->origins.push_back(tile.origin + Vec3i(x0, y0, z0));
-                out->density.emplace_back(new DensityGrid::DensityBlock);  // every voxel written below
-                DensityGrid::DensityBlock& density = *out->density.back();
-                DensityGrid::VelocityBlock* velocity = nullptr;
+                out->density.push_back(std::move(spare));
                 if constexpr (C == 4) {
                     out->velocity.emplace_back(new DensityGrid::VelocityBlock);
-                    velocity = out->velocity.back().get();
-                }
-                for (int x = 0; x < kBlock; ++x)
-                    for (int y = 0; y < kBlock; ++y) {
-                        const double* row = values + size_t(TileBuffer<C>::index(x0 + x, y0 + y, z0)) * C;
-                        for (int z = 0; z < kBlock; ++z) {
-                            const int i = DensityGrid::voxelOffset(x, y, z);
-                            density[size_t(i)] = float(row[z * C]);
-                            if constexpr (C == 4) {
+                    DensityGrid::VelocityBlock* velocity = out->velocity.back().get();
+                    for (int x = 0; x < kBlock; ++x)
+                        for (int y = 0; y < kBlock; ++y) {
+                            const double* row = values + size_t(TileBuffer<C>::index(x0 + x, y0 + y, z0)) * C;
+                            for (int z = 0; z < kBlock; ++z) {
+                                const int i = DensityGrid::voxelOffset(x, y, z);
                                 const double* m = row + z * C;
                                 const double w = m[0] > 0 ? 1.0 / m[0] : 0.0;
                                 (*velocity)[size_t(i)] = Vec3f(float(m[1] * w), float(m[2] * w), float(m[3] * w));
                             }
                         }
-                    }
+                }
             }
     // Clear what the deposits reached: cell block b's cells b·8 − 1 .. b·8 + 6
     // write voxels b·8 − 1 .. b·8 + 7, padded b·8 .. b·8 + 8.
