@@ -9,7 +9,10 @@
 // Reports per configuration the median and spread of `runs` runs: seconds to
 // voxelize, seconds to write, file size, active voxels, peak resident memory
 // (reset between configurations through /proc/self/clear_refs), and the
-// relative mass error |Σ density·V − hair volume| / hair volume.
+// relative mass error |Σ density·V − hair volume| / hair volume; then the
+// median CPU and wall seconds of voxelize's phases (VoxelizePhases: preparing
+// the segments, binning them by tile, the tiles' walks and deposits,
+// gathering the blocks).
 //
 // Written as the vdb stage writes by default (vdb.half_float: true,
 // vdb.compression: none); --float and --compression blosc give the full-float,
