@@ -375,7 +375,7 @@ TEST(Voxelizer, Avx2KernelGivesTheReferenceGridBitForBit) {
 
 TEST(Voxelizer, FarApartClumpsGiveEachClumpsOwnGrid) {
     // Two clumps 12 m apart at 1 mm: the box of tiles they reach (375³)
-    // exceeds the dense tile table's 2^24 slots, so binning takes its hash
+    // exceeds the dense tile table's 2^22 slots, so binning takes its hash
     // map path. Each voxel only receives its own clump's segments, in the
     // same order, so the grid must hold each clump's grid alone, bit for bit:
     // a tile's segments binned out of order, lost or put in another tile

@@ -11,16 +11,15 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <ctime>
 #include <functional>
 #include <iterator>
 #include <limits>
 #include <memory>
 #include <unordered_map>
 #include <utility>
-
-#include <chrono>
-#include <ctime>
 
 namespace hp {
 
@@ -207,7 +206,7 @@ BulkVector<Segment> prepareSegments(const StrandFrame& strands, const GridTransf
 /// Fills VoxelizeSettings::phases, if asked: wall and process CPU seconds
 /// since the last lap.
 class PhaseClock {
-public:
+  public:
     explicit PhaseClock(VoxelizePhases* phases) : phases_(phases) {
         if (phases_) *phases_ = VoxelizePhases();
         wall_ = std::chrono::steady_clock::now();
@@ -222,7 +221,7 @@ public:
         cpu_ = cpu;
     }
 
-private:
+  private:
     static double cpuSeconds() {
         timespec ts{};
         clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
@@ -241,10 +240,10 @@ struct TileBins {
     BulkVector<uint32_t> segments;
 };
 
-/// Most slots of the dense tile table (4 bytes each) before binning falls
-/// back to a hash map: hair fills a compact box of tiles (B-vdb's 100k
-/// strands at 1 mm: about 4,000), a scene spread far apart may not.
-constexpr size_t kMaxDenseTiles = size_t(1) << 24;
+/// Most slots of the dense tile table (8 bytes each: 32 MiB at most) before
+/// binning falls back to a hash map: a head of hair fills a compact box of
+/// tiles, strands spread far apart may not.
+constexpr size_t kMaxDenseTiles = size_t(1) << 22;
 
 /// Counting sort of the (tile, segment) pairs by tile, stable (segment order
 /// within a tile), tiles in key order. `count`: pairs in all. Tiles are
@@ -281,7 +280,6 @@ TileBins sortPairs(const BulkVector<TileSpan>& spans, size_t count) {
     const Vec3i extent = box.hi - box.lo + Vec3i::Ones();
     const double dense = double(extent.x()) * double(extent.y()) * double(extent.z());
     std::vector<uint32_t> slotOfPair;  // hash path only
-    std::vector<uint64_t> slotKeys;    // key of each slot (hash path: of each tile met)
     std::vector<size_t> sizes;
     std::unordered_map<uint64_t, uint32_t> slotOfKey;
     auto forEachPair = [&](auto&& visit) {  // visit(segment, slot), in pair order
