@@ -8,6 +8,7 @@
 #include "render/volume/vdb_writer.h"
 #include "render/volume/voxelizer.h"
 #include "sim/strands/synthetic.h"
+#include "batch_support.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -305,6 +306,39 @@ TEST(VdbStage, UnwritableOutputAndMissingStrandsFailTheFrame) {
     EXPECT_NE(report.failures[0].find("has no strands"), std::string::npos) << report.failures[0];
 }
 
+TEST(VdbStage, AWriteBesideTheNextFrameThatFailsFailsItsFrameAndLeavesNoFile) {
+    // With the overlap lane the vdb stage writes frame N's file on a thread
+    // of its own while frame N+1 voxelizes, so a failed write is known only
+    // after run() returned; the stage reports it through collectFailures for
+    // its own frame. Frames 2 and 3 cannot replace the folders in their place
+    // (the rename after the whole temporary file was written fails): frame
+    // 2's failure is collected after frame 3's run, the last frame's only
+    // when the run waits for its write at the end. Frame 1 is written, and no
+    // temporary file is left.
+    test::TempDir dir;
+    for (const char* name : {"hair.0002.vdb", "hair.0003.vdb"}) fs::create_directories(dir / "out/vdb" / name);
+    const Scene scene = Scene::parse("frames: 1-3\nvdb: {enabled: true, voxel_size: 0.004}\n", "s.yaml", dir.path());
+    ShotSettings shot = shotIn(scene, dir / "out");
+    shot.force = true;  // frames 2 and 3 have an "output" (a folder)
+    ASSERT_TRUE(shot.overlap);
+    std::vector<StagePtr> stages = makeStages(scene, shot, {"vdb"});
+    const StrandFrame hair = smallHair(100);
+    HairSource source(&hair);
+    RunReport report;
+    tbb::task_arena(2).execute([&] { report = runFrames(source, stages, shot); });
+    ASSERT_EQ(report.failures.size(), 2u);
+    for (int f : {2, 3}) {
+        const std::string& failure = report.failures[size_t(f - 2)];
+        EXPECT_NE(failure.find(cat("frame ", f, " vdb: ")), std::string::npos) << failure;
+        EXPECT_NE(failure.find("cannot rename"), std::string::npos) << failure;
+        EXPECT_TRUE(fs::is_empty(dir / "out/vdb" / cat("hair.000", f, ".vdb")));
+    }
+    EXPECT_EQ(report.framesDone, 3u);
+    EXPECT_EQ(readDensityVdb(dir / "out/vdb/hair.0001.vdb").grids.size(), 1u);
+    for (const auto& entry : fs::directory_iterator(dir / "out/vdb"))
+        EXPECT_FALSE(isTemporary(entry.path())) << entry.path();
+}
+
 TEST(VdbStage, SceneKeysAreValidated) {
     test::TempDir dir;
     const Scene noToken = Scene::parse("vdb: {enabled: true, output: vdb/hair.vdb}\n", "s.yaml", dir.path());
@@ -329,6 +363,18 @@ TEST(VdbCommand, ExitCodes) {
     const test::ProcessResult r = test::runHairpipe("vdb on.yaml --out out", dir.path());
     EXPECT_EQ(r.exitCode, 2) << r.output;
     EXPECT_NE(r.output.find("frame 2 vdb: the shot has no strands"), std::string::npos) << r.output;
+    // A write that fails while the next frame voxelizes (the stage's write
+    // beside it) still fails the run with exit code 2, naming its frame, and
+    // leaves no temporary file.
+    const fs::path small = test::writeSmallScene(dir.path(), "1-3");
+    fs::create_directories(dir / "blocked/vdb/hair.0002.vdb");
+    const test::ProcessResult blocked = test::runHairpipe(
+        "vdb " + test::q(small) + " --out " + test::q(dir / "blocked") + " --force --set vdb.velocity=false", dir.path());
+    EXPECT_EQ(blocked.exitCode, 2) << blocked.output;
+    EXPECT_NE(blocked.output.find("frame 2 vdb: "), std::string::npos) << blocked.output;
+    for (const char* name : {"hair.0001.vdb", "hair.0003.vdb"}) EXPECT_TRUE(fs::exists(dir / "blocked/vdb" / name)) << name;
+    for (const auto& entry : fs::directory_iterator(dir / "blocked/vdb"))
+        EXPECT_FALSE(isTemporary(entry.path())) << entry.path();
     test::writeFile(dir / "off.yaml", "frames: 1\n");
     const test::ProcessResult off = test::runHairpipe("vdb off.yaml --out out", dir.path());
     EXPECT_EQ(off.exitCode, 1) << off.output;

@@ -100,6 +100,8 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
         } catch (const Error& e) {
             fail(cat("frame ", data.frame, " ", stage.name(), ": ", e.what()));
         }
+        // Earlier frames' work the stage finished since (a file written beside this frame).
+        for (const std::string& failure : stage.collectFailures(false)) fail(failure);
     };
     // One core (--threads 1, or a --jobs child given one) gets no second lane.
     const bool overlap = shot.overlap &&
@@ -166,6 +168,9 @@ RunReport runFrames(FrameSource& source, std::vector<StagePtr>& stages, const Sh
         progress.advance(cat("frame ", frame));
     }
     if (lane) lane->drain();
+    // Work the stages left running (the last frames' files) ends before the run does.
+    for (StagePtr& stage : stages)
+        for (const std::string& failure : stage->collectFailures(true)) fail(failure);
     // Whole-run outputs (reports) once every frame is done.
     if (shot.wholeRunOutputs) finishStages(stages, shot, report);
     return report;

@@ -93,6 +93,13 @@ class FrameStage {
     /// Produces the outputs of one frame, each through writeAtomically.
     /// Throws hp::Error on failure; the scheduler records it and goes on.
     virtual void run(const FrameData& data) = 0;
+    /// Failures of work the stage left running after run() returned (a
+    /// frame's file still being written while the next frame is worked on),
+    /// each as "frame N <stage>: what went wrong"; with `wait`, first waits
+    /// for that work to end. The scheduler calls it after each run(), without
+    /// waiting, and once after the last frame, waiting (before finish()), and
+    /// records each failure like a failed frame (exit code 2).
+    virtual std::vector<std::string> collectFailures(bool wait) { return {}; }
     /// Called once after the last frame of a run (also when frames failed or
     /// were skipped as already done), for outputs that cover the whole run,
     /// such as the compare stage's report. Throws hp::Error on failure; the

@@ -8,7 +8,15 @@
 #include "render/volume/vdb_writer.h"
 #include "render/volume/voxelizer.h"
 
+#include <tbb/global_control.h>
+
 #include <chrono>
+#include <exception>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -40,7 +48,8 @@ class VdbStage final : public FrameStage {
     }
 
     std::string name() const override { return "vdb"; }
-    /// Reads only the strands; voxelizing and writing run beside the next frame's preview.
+    /// Reads only the strands; voxelizing and writing run beside the next
+    /// frame's preview, and the write beside the next frame's voxelizing.
     bool overlaps() const override { return true; }
 
     std::vector<fs::path> outputs(int frame) const override {
@@ -67,21 +76,56 @@ class VdbStage final : public FrameStage {
         info.hairVolume = hairVolume(strands);
         info.filter = voxelize_.filter == VoxelFilter::Box ? "box" : "trilinear";
         const fs::path file = outputs(data.frame).front();
-        const auto t1 = std::chrono::steady_clock::now();
-        // The grid is consumed while written (peak memory of one grid, not two).
-        writeAtomically(file, [&](const fs::path& tmp) { writeDensityVdb(tmp, std::move(grid), info, write_); });
-        logVerbose("frame ", data.frame, " vdb: ", strands.strandCount(), " strands -> ", activeVoxels,
-                   " active voxels (voxelize ", voxelizeSeconds, " s, write ", secondsSince(t1), " s) -> ",
-                   file.string());
+        auto write = [this, file, info, activeVoxels, voxelizeSeconds](DensityGrid& frameGrid) {
+            const auto t1 = std::chrono::steady_clock::now();
+            // The grid is consumed while written (its memory freed as the file's grows).
+            writeAtomically(file, [&](const fs::path& tmp) { writeDensityVdb(tmp, std::move(frameGrid), info, write_); });
+            logVerbose("frame ", info.frame, " vdb: ", info.strandCount, " strands -> ", activeVoxels,
+                       " active voxels (voxelize ", voxelizeSeconds, " s, write ", secondsSince(t1), " s) -> ",
+                       file.string());
+        };
+        // With the overlap lane, the file is written on a thread of its own
+        // while the next frame voxelizes (collectFailures reports a failed
+        // write for its frame); otherwise, and on one thread, in turn.
+        const bool beside = shot_.overlap &&
+                            tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) > 1;
+        waitForWrite();  // at most one file in flight: two grids in memory
+        if (!beside) {
+            write(grid);
+            return;
+        }
+        writer_ = std::thread([this, write, frame = data.frame, owned = std::move(grid)]() mutable {
+            try {
+                write(owned);
+            } catch (const std::exception& e) {  // hp::Error, or std::bad_alloc from a thread nobody else watches
+                const std::lock_guard<std::mutex> lock(mutex_);
+                failures_.push_back(cat("frame ", frame, " vdb: ", e.what()));
+            }
+        });
     }
 
+    std::vector<std::string> collectFailures(bool wait) override {
+        if (wait) waitForWrite();
+        const std::lock_guard<std::mutex> lock(mutex_);
+        return std::exchange(failures_, {});
+    }
+
+    ~VdbStage() override { waitForWrite(); }
+
   private:
+    void waitForWrite() {
+        if (writer_.joinable()) writer_.join();
+    }
+
     ShotSettings shot_;
     double voxelSize_ = 0.001;
     std::string output_;
     std::string sceneName_;
     VoxelizeSettings voxelize_;
     VdbWriteSettings write_;
+    std::thread writer_;  ///< the previous frame's write, while it runs
+    std::mutex mutex_;
+    std::vector<std::string> failures_;  ///< of writes on writer_, not yet collected
 };
 
 }  // namespace

@@ -41,6 +41,7 @@ class FrameSubset final : public FrameStage {
     void run(const FrameData& data) override {
         if (selected(data.frame)) stage_->run(data);
     }
+    std::vector<std::string> collectFailures(bool wait) override { return stage_->collectFailures(wait); }
     void finish(const ShotSettings& shot) override {
         // The whole-run outputs cover the run's frames this stage ran on.
         ShotSettings subset = shot;

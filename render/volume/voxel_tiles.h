@@ -100,8 +100,21 @@ struct TileBlocks {
 /// when C = 4, else null), then moves the tile's non-empty blocks into `out`
 /// as floats and clears the buffer (the border voxels too) for the next
 /// tile. Defined for C = 1 and C = 4.
+/// `avx2`: the trilinear density deposit (C = 1) runs the AVX2 kernel
+/// (same values, bit for bit; only where hasAvx2()).
 template <int C>
-void fillTile(TileBuffer<C>& tile, bool box, const Segment* segments, const SegmentVelocity* velocities,
+void fillTile(TileBuffer<C>& tile, bool box, bool avx2, const Segment* segments, const SegmentVelocity* velocities,
               const uint32_t* ids, size_t count, TileBlocks* out);
+
+/// Whether this CPU runs the AVX2 kernel.
+bool hasAvx2();
+
+/// The trilinear density deposits of segments[ids[0 .. count)] into the
+/// tile, in that order, four pieces at a time in AVX2 lanes
+/// (render/volume/voxel_tiles_avx2.cpp; call only where hasAvx2()).
+void depositTrilinearAvx2(TileBuffer<1>& tile, const Segment* segments, const uint32_t* ids, size_t count);
+
+/// The SSE2 reference of the same deposit, for one segment.
+void depositTrilinearReference(TileBuffer<1>& tile, const Segment& s);
 
 }  // namespace hp::voxel_tiles

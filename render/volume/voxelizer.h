@@ -35,6 +35,27 @@ enum class VoxelFilter {
     Trilinear,
 };
 
+/// The instruction set of the trilinear density deposit, the voxelizer's hot
+/// loop. Both give the same grid, bit for bit.
+enum class VoxelKernel {
+    /// AVX2 where the CPU has it (four pieces of a segment at a time), else SSE2.
+    Auto,
+    /// The SSE2 reference (the x86-64 baseline): one piece at a time.
+    Sse2,
+};
+
+/// Where a voxelize() call's time went (for benchmarks): wall and process CPU
+/// seconds of its phases, in order.
+struct VoxelizePhases {
+    struct Phase {
+        double wall = 0, cpu = 0;
+    };
+    Phase prepare;  ///< segments in index space, strands in Morton order, long ones split
+    Phase bin;      ///< (tile, segment) pairs sorted by tile
+    Phase tiles;    ///< the walks and deposits, one task per tile, and the blocks extracted
+    Phase gather;   ///< the tiles' blocks concatenated into the grid
+};
+
 struct VoxelizeSettings {
     VoxelFilter filter = VoxelFilter::Trilinear;
     /// Also accumulate vertex velocities (linear along each segment) weighted
@@ -44,6 +65,9 @@ struct VoxelizeSettings {
     /// stops with hp::Error rather than exhausting the machine: a voxel size
     /// far too small. (Writing with the consuming writeDensityVdb adds little.)
     double maxMemoryGiB = 8.0;
+    VoxelKernel kernel = VoxelKernel::Auto;
+    /// If set, filled with the time of each phase.
+    VoxelizePhases* phases = nullptr;
 };
 
 /// @brief The density field of `strands` on the grid `transform`.
@@ -55,6 +79,9 @@ struct VoxelizeSettings {
 /// @throws hp::Error on invalid strands, strands beyond the grid's index range,
 ///         or a grid that would exceed the memory limit.
 DensityGrid voxelize(const StrandFrame& strands, const GridTransform& transform, const VoxelizeSettings& settings = {});
+
+/// Whether VoxelKernel::Auto runs the AVX2 kernel on this CPU.
+bool avx2KernelAvailable();
 
 /// The hair volume of `strands` in m³: Σ over segments of the truncated cone
 /// π·L·(r0² + r0·r1 + r1²)/3. voxelize() conserves exactly this quantity.

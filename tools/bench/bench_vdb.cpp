@@ -9,7 +9,10 @@
 // Reports per configuration the median and spread of `runs` runs: seconds to
 // voxelize, seconds to write, file size, active voxels, peak resident memory
 // (reset between configurations through /proc/self/clear_refs), and the
-// relative mass error |Σ density·V − hair volume| / hair volume.
+// relative mass error |Σ density·V − hair volume| / hair volume; then the
+// median CPU and wall seconds of voxelize's phases (VoxelizePhases: preparing
+// the segments, binning them by tile, the tiles' walks and deposits,
+// gathering the blocks).
 //
 // Written as the vdb stage writes by default (vdb.half_float: true,
 // vdb.compression: none); --float and --compression blosc give the full-float,
@@ -23,6 +26,8 @@
 //
 // usage: bench_vdb [--strands N] [--voxel m ...] [--threads n ...] [--runs k]
 //                  [--filter box|trilinear] [--velocity] [--float] [--compression blosc|none] [--limits]
+//                  [--kernel auto|sse2] (the deposit's instruction set: AVX2 where the CPU has it,
+//                                  or the SSE2 reference; same grid)
 //                  [--keep DIR]   (keep the written files there)
 //                  [--compare FILE] (compare the first run's grid with the density of a
 //                                  float VDB written before, e.g. by another build with
@@ -280,6 +285,7 @@ int main(int argc, char** argv) {
         else if (a == "--runs") runs = std::max(1, std::atoi(next().c_str()));
         else if (a == "--filter") vs.filter = next() == "box" ? VoxelFilter::Box : VoxelFilter::Trilinear;
         else if (a == "--velocity") vs.velocity = true;
+        else if (a == "--kernel") vs.kernel = next() == "sse2" ? VoxelKernel::Sse2 : VoxelKernel::Auto;
         else if (a == "--half") ws.halfFloat = true;
         else if (a == "--float") ws.halfFloat = false;
         else if (a == "--limits") limits = true;
@@ -309,8 +315,9 @@ int main(int argc, char** argv) {
     std::printf("B-vdb: %zu synthetic strands x %d vertices (makeSyntheticHair; no simulation yet), "
                 "hair volume %.6g m^3, built in %.2f s\n",
                 frame.strandCount(), hs.vertices, volume, seconds(t0));
-    std::printf("filter %s, velocity %s, %s, %s, %d runs (median [min-max])\n",
+    std::printf("filter %s, velocity %s, kernel %s, %s, %s, %d runs (median [min-max])\n",
                 vs.filter == VoxelFilter::Box ? "box" : "trilinear", vs.velocity ? "on" : "off",
+                vs.kernel == VoxelKernel::Sse2 ? "sse2" : "auto (avx2 where the CPU has it)",
                 ws.halfFloat ? "half float" : "float",
                 ws.compression == VdbCompression::Blosc ? "blosc" : "no compression", runs);
 
@@ -360,15 +367,21 @@ int main(int argc, char** argv) {
         for (int n : threads) {
             tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(n));
             resetPeak();
-            std::vector<double> tv, tw, cv, cw, tf;
+            std::vector<double> tv, tw, cv, cw, tf, phase[4], phaseWall[4];
+            VoxelizePhases phases;
+            VoxelizeSettings timed = vs;
+            timed.phases = &phases;
             size_t activeVoxels = 0, bytes = 0, blocks = 0;
             double massError = 0;
             const fs::path file = dir / ("hair_" + std::to_string(int(h * 1e6)) + "um.vdb");
             for (int r = 0; r < runs; ++r) {
                 auto t = std::chrono::steady_clock::now();
                 double c = bench::processCpuSeconds();
-                DensityGrid grid = voxelize(frame, GridTransform::uniform(h), vs);
+                DensityGrid grid = voxelize(frame, GridTransform::uniform(h), timed);
                 tv.push_back(seconds(t));
+                int p = 0;
+                for (const auto* ph : {&phases.prepare, &phases.bin, &phases.tiles, &phases.gather})
+                    phaseWall[p].push_back(ph->wall), phase[p++].push_back(ph->cpu);
                 cv.push_back(bench::processCpuSeconds() - c);
                 activeVoxels = grid.activeVoxelCount();
                 blocks = grid.blockCount();
@@ -398,6 +411,11 @@ int main(int argc, char** argv) {
                         h * 1e3, n, n == 1 ? " " : "s", f.median, f.min, f.max, v.median, v.min, v.max, vc.median,
                         w.median, w.min, w.max, wc.median, double(bytes) / (1 << 20), activeVoxels, blocks, peak,
                         massError, fileMassError);
+            std::printf("  voxelize's phases, cpu s (wall s), medians:");
+            const char* names[4] = {"prepare", "bin", "tiles", "gather"};
+            for (int p = 0; p < 4; ++p)
+                std::printf(" %s %.3f (%.3f)", names[p], bench::stats(phase[p]).median, bench::stats(phaseWall[p]).median);
+            std::printf("\n");
             std::fflush(stdout);
         }
     }
