@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <xmmintrin.h>
 
 namespace hp {
 
@@ -41,17 +42,22 @@ constexpr double kMaxNodes = 4.0e6;
 /// (both before the guide solver restored the pushed lengths with the push:
 /// 0.7% at 1/2 since, docs/physics.md).
 constexpr float kMaxPush = 0.5f;
-/// Jacobi sweeps of the implicit volume step (excess_diffusion.h): a smooth
-/// excess gets (1 − ρ^K) of the exact implicit push, ρ = 6c/(1 + 6c) = 0.72
-/// at the default c = 0.43, so 0.73 at 4 sweeps. Measured on the ball and
-/// the crossing wisps (BDF2): 1 sweep 338 hairs/cm², 0.5% energy gain;
-/// 4 sweeps 338, 1.5%; 8 sweeps 300, 1.6% (lengths then restored by the step).
-constexpr int kSweeps = 4;
-
+/// One Jacobi sweep of the implicit volume step (excess_diffusion.h) from
+/// E⁰ = 0, E = e/(1 + 6c), read from each node's mass where the push is
+/// gathered. A smooth excess then gets (1 − ρ) of the exact implicit push,
+/// ρ = 6c/(1 + 6c) = 0.72 at the default c = 0.43; the grid-scale modes
+/// still never grow. Measured on tests/test_hair_grid.cpp against 4 sweeps
+/// (the pushed lengths restored with the push, docs/physics.md): the ball
+/// 300 hairs/cm² with BDF2 (338 at 4 sweeps), 300 with implicit Euler (300);
+/// the crossing wisps' energy rise, BDF2, 1/2/4 substeps, 0.4/1.0/2.2% of
+/// what the fall releases (0.7/2.0/3.6%); and the grid's cost at 845 guides
+/// dropped by its sweeps, the box scan and a second pass over the vertices.
 /// Lattices of at most this many nodes per gridded vertex are cleared
 /// with one memset (845 B-sim guides: 20k vertices on 100k-180k nodes; the
 /// memset took half the time of clearing each vertex's eight nodes).
 constexpr size_t kClearByFill = 32;
+/// Chunks of the counting sort by node row (any number gives the same order).
+constexpr size_t kSortChunks = 8;
 /// Vertices below which apply() runs on the calling thread.
 constexpr size_t kParallelVertices = 8192;
 
@@ -157,33 +163,54 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     constexpr uint32_t kNone = ~0u;
     vertexCells_.resize(n);
     rowOf_.resize(n);
-    run(n, [&](size_t b, size_t e) {
-        for (size_t i = b; i < e; ++i) {
-            const Vec3f p = toLocal * in.x[i];
-            if (!valid(i, p)) {
-                rowOf_[i] = kNone;
-                continue;
+    // The counting sort in chunks of vertices: each chunk counts its rows,
+    // the offsets interleave the chunks row by row, then each chunk writes
+    // its vertices' cells and (m, v) straight to their places. A stable
+    // sort's result is unique, so the chunks change nothing but the time.
+    const size_t chunks = serial ? 1 : kSortChunks;
+    auto chunkBegin = [&](size_t ch) { return n * ch / chunks; };
+    rowCount_.assign(chunks * rows, 0u);  // chunk-major: chunks on two threads share no cache line
+    run(chunks, [&](size_t cb, size_t ce) {
+        for (size_t ch = cb; ch < ce; ++ch) {
+            uint32_t* count = rowCount_.data() + ch * rows;
+            for (size_t i = chunkBegin(ch), end = chunkBegin(ch + 1); i < end; ++i) {
+                const Vec3f p = toLocal * in.x[i];
+                if (!valid(i, p)) {
+                    rowOf_[i] = kNone;
+                    continue;
+                }
+                Cell& c = vertexCells_[i];
+                cellOf(i, p, c);
+                const uint32_t r = uint32_t(size_t(c.k) * size_t(ny) + size_t(c.j));
+                rowOf_[i] = r;
+                ++count[r];
             }
-            Cell& c = vertexCells_[i];
-            cellOf(i, p, c);
-            rowOf_[i] = uint32_t(size_t(c.k) * size_t(ny) + size_t(c.j));
         }
     });
-    rowStart_.assign(rows + 1, 0u);
-    for (size_t i = 0; i < n; ++i)
-        if (rowOf_[i] != kNone) ++rowStart_[rowOf_[i] + 1];
-    for (size_t r = 0; r < rows; ++r) rowStart_[r + 1] += rowStart_[r];
-    const size_t gridded = rowStart_[rows];
-    fill_.assign(rowStart_.begin(), rowStart_.end() - 1);
+    rowStart_.resize(rows + 1);
+    uint32_t total = 0;
+    for (size_t r = 0; r < rows; ++r) {
+        rowStart_[r] = total;
+        for (size_t ch = 0; ch < chunks; ++ch) {
+            uint32_t& at = rowCount_[ch * rows + r];
+            const uint32_t count = at;
+            at = total;  // now chunk ch's next place in row r
+            total += count;
+        }
+    }
+    rowStart_[rows] = total;
+    const size_t gridded = total;
     cells_.resize(gridded);
-    for (size_t i = 0; i < n; ++i)
-        if (rowOf_[i] != kNone) cells_[fill_[rowOf_[i]]++].vertex = uint32_t(i);
     massVel_.resize(gridded);
-    run(gridded, [&](size_t b, size_t e) {
-        for (size_t o = b; o < e; ++o) {
-            const size_t i = cells_[o].vertex;
-            cells_[o] = vertexCells_[i];
-            massVel_[o] = Eigen::Vector4f(in.mass[i], in.v[i].x(), in.v[i].y(), in.v[i].z());
+    run(chunks, [&](size_t cb, size_t ce) {
+        for (size_t ch = cb; ch < ce; ++ch) {
+            uint32_t* at = rowCount_.data() + ch * rows;
+            for (size_t i = chunkBegin(ch), end = chunkBegin(ch + 1); i < end; ++i) {
+                if (rowOf_[i] == kNone) continue;
+                const uint32_t o = at[rowOf_[i]]++;
+                cells_[o] = vertexCells_[i];
+                massVel_[o] = Eigen::Vector4f(in.mass[i], in.v[i].x(), in.v[i].y(), in.v[i].z());
+            }
         }
     });
     auto slabStart = [&](size_t k) { return rowStart_[k * size_t(ny)]; };
@@ -224,142 +251,95 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     // r = M·lengthPerMass/(Δ³·λ₀), λ₀ from hairs per cm² to per m².
     const float toRatio = in.lengthPerMass / (d * d * d * s_.targetDensity * 1e4f);
     const float s = blendFraction(in.h), cPush = pushFraction(in.h), push = cPush * d * d;
+    // The volume step's relaxed excess at a node, E = e/(1 + 6c): one
+    // Jacobi sweep of (I − c·L)·E = e from E⁰ = 0 (excess_diffusion.h), so
+    // it is read straight from the node's mass in the same pass.
+    const float inv = 1.f / (1.f + 6.f * cPush);
+    const Eigen::Matrix3f R = in.head.linear();
 
-    // Friction, and the density each vertex reads: the densest node a
-    // vertex reads and the box of nodes above the target (minima and
-    // maxima: the same whatever the order), in one pass over the nodes.
+    // One pass over the sorted vertices reads each vertex's eight nodes
+    // once for friction, the density it reads and the volume push.
     std::atomic<float> maxR{0.f};
-    std::atomic<int> boxLo[3] = {nx, ny, nz}, boxHi[3] = {-1, -1, -1};
-    auto lower = [](std::atomic<int>& a, int v) {
-        for (int m = a.load(); v < m && !a.compare_exchange_weak(m, v);) {
-        }
-    };
-    auto raise = [](std::atomic<int>& a, int v) {
-        for (int m = a.load(); v > m && !a.compare_exchange_weak(m, v);) {
-        }
-    };
-    ratio_.resize(gridded);
-    run(gridded, [&, N, C, sx, plane, toRatio, s](size_t b, size_t e) {
+    std::atomic<size_t> pushed{0};
+    run(gridded, [&, N, C, sx, plane, toRatio, s, push, inv, invD](size_t b, size_t e) {
         float localMax = 0.f;
-        int lo3[3] = {nx, ny, nz}, hi3[3] = {-1, -1, -1};
+        size_t moved = 0;
         for (size_t o = b; o < e; ++o) {
             const Cell& c = C[o];
-            const float wx[2] = {1.f - c.tx, c.tx}, wy[2] = {1.f - c.ty, c.ty}, wz[2] = {1.f - c.tz, c.tz};
-            Eigen::Vector4f V = Eigen::Vector4f::Zero();  // (Σ w, V̄): lane 0 unused
-            float r = 0.f, cornerMax = 0.f;
+            // The eight nodes in the order di + 2·dj + 4·dk, four at a time
+            // (SSE): their masses in lanes, w = (wx·wy)·wz and w/M lane by
+            // lane, then V = V + (w/M)·(M, P) node by node in that order,
+            // the sums r = Σ w·ratio in that order too: the same operations
+            // one by one as a scalar loop (SSE rounds each lane as the
+            // scalar operation does), so the same bits.
+            const __m128 wx = _mm_setr_ps(1.f - c.tx, c.tx, 1.f - c.tx, c.tx);
+            const __m128 wy = _mm_setr_ps(1.f - c.ty, 1.f - c.ty, c.ty, c.ty);
+            const __m128 wxy = _mm_mul_ps(wx, wy);
+            const __m128 w[2] = {_mm_mul_ps(wxy, _mm_set1_ps(1.f - c.tz)), _mm_mul_ps(wxy, _mm_set1_ps(c.tz))};
+            __m128 V = _mm_setzero_ps();  // (Σ w, V̄): lane 0 unused
+            __m128 cornerMax = _mm_setzero_ps(), ratio[2];
+            float r = 0.f;
             unsigned above = 0;  // bit di + 2·dj + 4·dk: that node is above the target
-            for (int dk = 0; dk < 2; ++dk)
-                for (int dj = 0; dj < 2; ++dj) {
-                    const Eigen::Vector4f* row = N + c.node + size_t(dk) * plane + size_t(dj) * sx;
-                    for (int di = 0; di < 2; ++di) {
-                        const Eigen::Vector4f& nd = row[di];
-                        const float w = wx[di] * wy[dj] * wz[dk];
-                        if (nd[0] > 0.f) V += (w / nd[0]) * nd;
-                        const float ratio = nd[0] * toRatio;
-                        r += w * ratio;
-                        cornerMax = std::max(cornerMax, ratio);
-                        above |= unsigned(ratio > 1.f) << (di + 2 * dj + 4 * dk);
-                    }
-                }
-            const Vec3f v = massVel_[o].tail<3>();
-            in.v[c.vertex] = v + s * (V.tail<3>() - v);
-            ratio_[o] = r;
-            localMax = std::max(localMax, cornerMax);
-            if (above) {
-                // Per axis: the low face holds an above-target node if any
-                // node with offset 0 does, the high face if any with 1 does.
-                constexpr unsigned low[3] = {0x55, 0x33, 0x0f};
-                const int at[3] = {c.i, c.j, c.k};
-                for (int a = 0; a < 3; ++a) {
-                    lo3[a] = std::min(lo3[a], (above & low[a]) ? at[a] : at[a] + 1);
-                    hi3[a] = std::max(hi3[a], (above & ~low[a] & 0xff) ? at[a] + 1 : at[a]);
-                }
+            for (int dk = 0; dk < 2; ++dk) {
+                const float* base = N[c.node + size_t(dk) * plane].data();
+                const __m128 nd[4] = {_mm_load_ps(base), _mm_load_ps(base + 4), _mm_load_ps(base + 4 * sx),
+                                     _mm_load_ps(base + 4 * sx + 4)};
+                const __m128 M = _mm_movelh_ps(_mm_unpacklo_ps(nd[0], nd[1]), _mm_unpacklo_ps(nd[2], nd[3]));
+                const __m128 q = _mm_div_ps(w[dk], M);
+                const __m128 has = _mm_cmpgt_ps(M, _mm_setzero_ps());
+                ratio[dk] = _mm_mul_ps(M, _mm_set1_ps(toRatio));
+                const __m128 wr = _mm_mul_ps(w[dk], ratio[dk]);
+                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0x00), _mm_mul_ps(_mm_shuffle_ps(q, q, 0x00), nd[0])));
+                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0x55), _mm_mul_ps(_mm_shuffle_ps(q, q, 0x55), nd[1])));
+                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0xaa), _mm_mul_ps(_mm_shuffle_ps(q, q, 0xaa), nd[2])));
+                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0xff), _mm_mul_ps(_mm_shuffle_ps(q, q, 0xff), nd[3])));
+                r += _mm_cvtss_f32(wr);
+                r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0x55));
+                r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0xaa));
+                r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0xff));
+                cornerMax = _mm_max_ps(cornerMax, ratio[dk]);
+                above |= unsigned(_mm_movemask_ps(_mm_cmpgt_ps(ratio[dk], _mm_set1_ps(1.f)))) << (4 * dk);
             }
-        }
-        for (int a = 0; a < 3; ++a) {
-            lower(boxLo[a], lo3[a]);
-            raise(boxHi[a], hi3[a]);
+            cornerMax = _mm_max_ps(cornerMax, _mm_shuffle_ps(cornerMax, cornerMax, 0x4e));
+            cornerMax = _mm_max_ps(cornerMax, _mm_shuffle_ps(cornerMax, cornerMax, 0xb1));
+            localMax = std::max(localMax, _mm_cvtss_f32(cornerMax));
+            alignas(16) float Vs[4];
+            _mm_store_ps(Vs, V);
+            const Vec3f v = massVel_[o].tail<3>();
+            in.v[c.vertex] = v + s * (Vec3f(Vs[1], Vs[2], Vs[3]) - v);
+            // The volume push, where a node is above the target (elsewhere
+            // E = 0): x ← x − c·Δ²·∇E/max(1, r̄), ∇E = Σ E_n·∇w_n with
+            // ∇w_n = (w'x·wy·wz, wx·w'y·wz, wx·wy·w'z), w' = ∓1/Δ, the
+            // terms summed node by node, the three axes in SSE lanes.
+            if (!above || !(push > 0.f)) continue;
+            const float dw[2] = {-invD, invD};
+            const float wxs[2] = {1.f - c.tx, c.tx}, wys[2] = {1.f - c.ty, c.ty}, wzs[2] = {1.f - c.tz, c.tz};
+            __m128 grad = _mm_setzero_ps();
+            for (int dk = 0; dk < 2; ++dk) {
+                alignas(16) float E[4];
+                _mm_store_ps(E, _mm_mul_ps(_mm_max_ps(_mm_sub_ps(ratio[dk], _mm_set1_ps(1.f)), _mm_setzero_ps()),
+                                           _mm_set1_ps(inv)));
+                for (int dj = 0; dj < 2; ++dj)
+                    for (int di = 0; di < 2; ++di) {
+                        const __m128 g = _mm_mul_ps(
+                            _mm_mul_ps(_mm_setr_ps(dw[di], wxs[di], wxs[di], 0.f), _mm_setr_ps(wys[dj], dw[dj], wys[dj], 0.f)),
+                            _mm_setr_ps(wzs[dk], wzs[dk], dw[dk], 0.f));
+                        grad = _mm_add_ps(grad, _mm_mul_ps(_mm_set1_ps(E[di + 2 * dj]), g));
+                    }
+            }
+            alignas(16) float G[4];
+            _mm_store_ps(G, grad);
+            const Vec3f gv(G[0], G[1], G[2]);
+            if (gv.squaredNorm() > 0.f) {
+                in.x[c.vertex] -= (push / std::max(1.f, r)) * (R * gv);
+                ++moved;
+            }
         }
         for (float m = maxR.load(); localMax > m && !maxR.compare_exchange_weak(m, localMax);) {
         }
+        pushed += moved;
     });
     st.maxDensity = maxR.load() * s_.targetDensity;
-
-    // The volume step's excess, relaxed implicitly on the box of nodes
-    // above the target grown by the sweeps' reach, kept in relaxed_ for the
-    // gather. K sweeps from E⁰ = 0 reach K − 1 nodes beyond the excess (E¹
-    // is nonzero only on it, each sweep one node further), so beyond that
-    // margin E is 0, and a node at the margin reads 0 from outside it
-    // either way: the same E as on the whole lattice.
-    NodeBox eBox;  // empty: no excess anywhere
-    int eLo[3] = {0, 0, 0};
-    if (push > 0.f && boxHi[0].load() >= 0) {
-        const int sweeps = kSweeps, reach = kSweeps - 1;
-        int hi3[3];
-        const int top[3] = {nx - 1, ny - 1, nz - 1};
-        for (int a = 0; a < 3; ++a) {
-            eLo[a] = std::max(0, boxLo[a].load() - reach);
-            hi3[a] = std::min(top[a], boxHi[a].load() + reach);
-        }
-        eBox.nx = hi3[0] - eLo[0] + 1;
-        eBox.ny = hi3[1] - eLo[1] + 1;
-        eBox.nz = hi3[2] - eLo[2] + 1;
-        // The box's nodes with hair and their excess, listed plane by plane.
-        occupied_.reset(eBox);
-        relaxed_.resize(eBox.size());
-        run(size_t(eBox.nz), [&, N, toRatio](size_t b, size_t e) {
-            for (size_t k = b; k < e; ++k)
-                for (int j = 0; j < eBox.ny; ++j)
-                    occupied_.addRow(j, int(k), N[index(eLo[0], eLo[1] + j, eLo[2] + int(k))].data(), 4, toRatio);
-        });
-        relaxListed(occupied_, cPush, sweeps, relaxed_.data(), run);
-    }
-    const float* const E = relaxed_.data();
-    const int ebx = eBox.nx, eby = eBox.ny, ebz = eBox.nz, elx = eLo[0], ely = eLo[1], elz = eLo[2];
-    // E at a node: relaxed_ inside the box (0 on nodes without hair), 0 outside.
-    auto excessAt = [=](int i, int j, int k) {
-        const unsigned bi = unsigned(i - elx), bj = unsigned(j - ely), bk = unsigned(k - elz);
-        if (bi >= unsigned(ebx) || bj >= unsigned(eby) || bk >= unsigned(ebz)) return 0.f;
-        return E[(size_t(bk) * size_t(eby) + size_t(bj)) * size_t(ebx) + size_t(bi)];
-    };
-
-    // The volume push (reads only the grid): down the gradient of the
-    // relaxed excess, divided by the density the vertex reads.
-    std::atomic<size_t> pushed{0};
-    if (eBox.size() > 0) {
-        const Eigen::Matrix3f R = in.head.linear();
-        const size_t ex = size_t(ebx), exy = size_t(ebx) * size_t(eby);
-        run(gridded, [&, C, push, invD, ex, exy](size_t b, size_t e) {
-            size_t moved = 0;
-            for (size_t o = b; o < e; ++o) {
-                const Cell& c = C[o];
-                const float wx[2] = {1.f - c.tx, c.tx}, wy[2] = {1.f - c.ty, c.ty}, wz[2] = {1.f - c.tz, c.tz};
-                const float dw[2] = {-invD, invD};
-                // The eight nodes' E: straight from the box when the cell
-                // lies inside it (most do: the box reaches kSweeps − 1 beyond
-                // the excess), else node by node (0 outside).
-                float Ec[8];
-                const unsigned bi = unsigned(c.i - elx), bj = unsigned(c.j - ely), bk = unsigned(c.k - elz);
-                if (bi < unsigned(ebx - 1) && bj < unsigned(eby - 1) && bk < unsigned(ebz - 1)) {
-                    const float* base = E + size_t(bk) * exy + size_t(bj) * ex + bi;
-                    for (int q = 0; q < 8; ++q) Ec[q] = base[size_t(q >> 2) * exy + size_t((q >> 1) & 1) * ex + size_t(q & 1)];
-                } else {
-                    for (int q = 0; q < 8; ++q) Ec[q] = excessAt(c.i + (q & 1), c.j + ((q >> 1) & 1), c.k + (q >> 2));
-                }
-                Vec3f grad = Vec3f::Zero();
-                for (int dk = 0; dk < 2; ++dk)
-                    for (int dj = 0; dj < 2; ++dj)
-                        for (int di = 0; di < 2; ++di)
-                            grad += Ec[di + 2 * dj + 4 * dk] *
-                                    Vec3f(dw[di] * wy[dj] * wz[dk], wx[di] * dw[dj] * wz[dk], wx[di] * wy[dj] * dw[dk]);
-                if (grad.squaredNorm() > 0.f) {
-                    in.x[c.vertex] -= (push / std::max(1.f, ratio_[o])) * (R * grad);
-                    ++moved;
-                }
-            }
-            pushed += moved;
-        });
-    }
     st.pushed = pushed;
 
     // Leave the array all zeros for the next call. A lattice of at most

@@ -119,19 +119,17 @@ class HairGrid {
     VolumeSettings s_;
     std::vector<Cell> vertexCells_;  ///< per vertex
     std::vector<uint32_t> rowOf_;    ///< node row (j, k) of each vertex's base node; ~0: not gridded
-    std::vector<unsigned> rowStart_, fill_;
+    std::vector<uint32_t> rowStart_;  ///< first sorted vertex of each node row
+    std::vector<uint32_t> rowCount_;  ///< the sort's counts, then places, per chunk and row
     /// Gridded vertices sorted by node row (hair_grid.cpp): their cells and
     /// (m, v), copied in that order so that every pass reads them in a stream.
     std::vector<Cell> cells_;
     std::vector<Eigen::Vector4f> massVel_;
-    std::vector<float> ratio_;       ///< r̄ = λ̄/λ₀ each sorted vertex reads
     /// Per node (m, P): mass and momentum, one SSE packet, so the splat
     /// adds w·(m, m·v) in one operation; zero between calls. The hair
     /// length is M·lengthPerMass (the same for every vertex), not stored:
     /// the passes wait on the lattice's memory, not on arithmetic.
     std::vector<Eigen::Vector4f> nodes_;
-    OccupiedNodes occupied_;         ///< the volume step's nodes with hair
-    std::vector<float> relaxed_;     ///< its E on the box of nodes
 };
 
 }  // namespace hp::volume
