@@ -8,7 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
-#include <xmmintrin.h>
+#include <emmintrin.h>
 
 namespace hp {
 
@@ -81,10 +81,22 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
         if (serial) f(0, count);
         else parallel(count, f);
     };
-    // Head-local positions are computed where they are read (twice: cheaper
-    // than storing and loading them).
-    const Eigen::Isometry3f toLocal = in.head.inverse();
-    auto valid = [&](size_t i, const Vec3f& p) { return in.mass[i] > 0.f && p.allFinite(); };
+    // Head-local positions are computed where they are read (three times:
+    // cheaper than storing and loading them), in SSE from the inverse's
+    // columns, p = ((c0·x + c1·y) + c2·z) + c3: the order Eigen's
+    // Isometry3f product adds in, so the same bits.
+    const Eigen::Matrix4f toLocal = in.head.inverse().matrix();
+    const __m128 col[4] = {_mm_loadu_ps(toLocal.data()), _mm_loadu_ps(toLocal.data() + 4),
+                           _mm_loadu_ps(toLocal.data() + 8), _mm_loadu_ps(toLocal.data() + 12)};
+    auto local = [&col](const Vec3f& x) {
+        return _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(col[0], _mm_set1_ps(x.x())), _mm_mul_ps(col[1], _mm_set1_ps(x.y()))),
+                                     _mm_mul_ps(col[2], _mm_set1_ps(x.z()))),
+                          col[3]);
+    };
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f);
+    auto valid = [&](size_t i, __m128 p) {  // a mass, and x, y, z finite (p − p is 0, not NaN)
+        return in.mass[i] > 0.f && (_mm_movemask_ps(_mm_cmpord_ps(_mm_sub_ps(p, p), zero)) & 7) == 7;
+    };
 
     // Head-local positions and their bounds (min and max do not depend on
     // the order or the chunks).
@@ -94,14 +106,17 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
         bound[3 + a] = -INFINITY;
     }
     run(n, [&](size_t b, size_t e) {
-        Vec3f lo = Vec3f::Constant(INFINITY), hi = Vec3f::Constant(-INFINITY);
+        __m128 lo4 = _mm_set1_ps(INFINITY), hi4 = _mm_set1_ps(-INFINITY);
         for (size_t i = b; i < e; ++i) {
-            const Vec3f p = toLocal * in.x[i];
+            const __m128 p = local(in.x[i]);
             if (valid(i, p)) {
-                lo = lo.cwiseMin(p);
-                hi = hi.cwiseMax(p);
+                lo4 = _mm_min_ps(lo4, p);
+                hi4 = _mm_max_ps(hi4, p);
             }
         }
+        alignas(16) float lo[4], hi[4];
+        _mm_store_ps(lo, lo4);
+        _mm_store_ps(hi, hi4);
         for (int a = 0; a < 3; ++a) {
             for (float m = bound[a].load(); lo[a] < m && !bound[a].compare_exchange_weak(m, lo[a]);) {
             }
@@ -128,23 +143,20 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     st.cellSize = d;
     st.nodes = nodes;
     const float invD = 1.f / d;
-    auto index = [nx, ny](int i, int j, int k) {
-        return (size_t(k) * size_t(ny) + size_t(j)) * size_t(nx) + size_t(i);
+    // A vertex's base node (i, j, k) and trilinear fractions t: f = (p −
+    // origin)/Δ, base min(max(f, 0), n − 2) truncated (f in (−1, 0), from
+    // rounding below the origin, gives 0 like a clamped int(f)), t =
+    // clamp(f − base, 0, 1); lane by lane, so the same bits as scalar code.
+    const __m128 origin4 = _mm_setr_ps(origin.x(), origin.y(), origin.z(), 0.f);
+    const __m128 top = _mm_setr_ps(float(nx - 2), float(ny - 2), float(nz - 2), 0.f);
+    auto locate = [=](__m128 p, __m128& t) {
+        const __m128 f = _mm_mul_ps(_mm_sub_ps(p, origin4), _mm_set1_ps(invD));
+        const __m128i base = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(f, zero), top));
+        t = _mm_min_ps(_mm_max_ps(_mm_sub_ps(f, _mm_cvtepi32_ps(base)), zero), one);
+        return base;
     };
-    // Written field by field into the array: a Cell built on the stack and
-    // copied whole stalled on store forwarding (perf: 70% of this pass).
-    auto cellOf = [&](size_t i, const Vec3f& p, Cell& c) {
-        const Vec3f f = (p - origin) * invD;
-        // int() truncates: floor for f ≥ 0, and f > −1 (rounding below the
-        // origin) gives 0 either way after the clamp, with t clamped to 0.
-        c.i = std::clamp(int(f.x()), 0, nx - 2);
-        c.j = std::clamp(int(f.y()), 0, ny - 2);
-        c.k = std::clamp(int(f.z()), 0, nz - 2);
-        c.tx = std::clamp(f.x() - float(c.i), 0.f, 1.f);
-        c.ty = std::clamp(f.y() - float(c.j), 0.f, 1.f);
-        c.tz = std::clamp(f.z() - float(c.k), 0.f, 1.f);
-        c.node = uint32_t(index(c.i, c.j, c.k));
-        c.vertex = uint32_t(i);
+    auto laneOf = [](__m128i v, int lane) {
+        return _mm_cvtsi128_si32(lane == 0 ? v : lane == 1 ? _mm_shuffle_epi32(v, 0x55) : _mm_shuffle_epi32(v, 0xaa));
     };
 
     // The node array is all zeros between calls (apply() clears the nodes it
@@ -152,7 +164,7 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     if (nodes_.size() < nodes) nodes_.resize(nodes, Eigen::Vector4f::Zero());
 
     // Vertices by the node row (j, k) of their base node, in vertex order
-    // within a row (a stable counting sort), their cells and (m, v) copied
+    // within a row (a stable counting sort), their cells and (m, v) written
     // in that order. Every pass walks it: neighbouring entries read and
     // write the same few rows of nodes and read their own data in a stream
     // (in vertex order the guides cross the lattice, and every vertex's
@@ -161,12 +173,12 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     // slab is a contiguous range.
     const size_t rows = size_t(ny) * size_t(nz);
     constexpr uint32_t kNone = ~0u;
-    vertexCells_.resize(n);
     rowOf_.resize(n);
     // The counting sort in chunks of vertices: each chunk counts its rows,
     // the offsets interleave the chunks row by row, then each chunk writes
-    // its vertices' cells and (m, v) straight to their places. A stable
-    // sort's result is unique, so the chunks change nothing but the time.
+    // its vertices' entries straight to their places (the cell found again:
+    // cheaper than storing it). A stable sort's result is unique, so the
+    // chunks change nothing but the time.
     const size_t chunks = serial ? 1 : kSortChunks;
     auto chunkBegin = [&](size_t ch) { return n * ch / chunks; };
     rowCount_.assign(chunks * rows, 0u);  // chunk-major: chunks on two threads share no cache line
@@ -174,14 +186,14 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
         for (size_t ch = cb; ch < ce; ++ch) {
             uint32_t* count = rowCount_.data() + ch * rows;
             for (size_t i = chunkBegin(ch), end = chunkBegin(ch + 1); i < end; ++i) {
-                const Vec3f p = toLocal * in.x[i];
+                const __m128 p = local(in.x[i]);
                 if (!valid(i, p)) {
                     rowOf_[i] = kNone;
                     continue;
                 }
-                Cell& c = vertexCells_[i];
-                cellOf(i, p, c);
-                const uint32_t r = uint32_t(size_t(c.k) * size_t(ny) + size_t(c.j));
+                __m128 t;
+                const __m128i base = locate(p, t);
+                const uint32_t r = uint32_t(size_t(laneOf(base, 2)) * size_t(ny) + size_t(laneOf(base, 1)));
                 rowOf_[i] = r;
                 ++count[r];
             }
@@ -200,16 +212,24 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     }
     rowStart_[rows] = total;
     const size_t gridded = total;
-    cells_.resize(gridded);
-    massVel_.resize(gridded);
+    entries_.resize(gridded);
+    order_.resize(gridded);
     run(chunks, [&](size_t cb, size_t ce) {
         for (size_t ch = cb; ch < ce; ++ch) {
             uint32_t* at = rowCount_.data() + ch * rows;
             for (size_t i = chunkBegin(ch), end = chunkBegin(ch + 1); i < end; ++i) {
                 if (rowOf_[i] == kNone) continue;
                 const uint32_t o = at[rowOf_[i]]++;
-                cells_[o] = vertexCells_[i];
-                massVel_[o] = Eigen::Vector4f(in.mass[i], in.v[i].x(), in.v[i].y(), in.v[i].z());
+                __m128 t;
+                const __m128i base = locate(local(in.x[i]), t);
+                Entry& en = entries_[o];
+                // t and the node in one 16-byte store's place (__m128 may
+                // alias): lane 3 is overwritten by the node next.
+                _mm_store_ps(reinterpret_cast<float*>(&en), t);
+                en.node = uint32_t((size_t(laneOf(base, 2)) * size_t(ny) + size_t(laneOf(base, 1))) * size_t(nx) +
+                                   size_t(laneOf(base, 0)));
+                en.mv = Eigen::Vector4f(in.mass[i], in.v[i].x(), in.v[i].y(), in.v[i].z());
+                order_[o] = uint32_t(i);
             }
         }
     });
@@ -228,22 +248,30 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
         }
     };
     Eigen::Vector4f* const N = nodes_.data();
-    const Cell* const C = cells_.data();
+    const Entry* const C = entries_.data();
+    const uint32_t* const vertexOf = order_.data();
     const size_t sx = size_t(nx);
 
     // Splat: w·(m, m·v) on the eight nodes.
     bySlab([&, N, C, sx, plane](size_t first, size_t end) {
         for (size_t o = first; o < end; ++o) {
-            const Cell& c = C[o];
-            const float m = massVel_[o][0];
-            const Eigen::Vector4f mp(m, m * massVel_[o][1], m * massVel_[o][2], m * massVel_[o][3]);
-            const float wx[2] = {1.f - c.tx, c.tx}, wy[2] = {1.f - c.ty, c.ty}, wz[2] = {1.f - c.tz, c.tz};
-            for (int dk = 0; dk < 2; ++dk)
-                for (int dj = 0; dj < 2; ++dj) {
-                    Eigen::Vector4f* row = N + c.node + size_t(dk) * plane + size_t(dj) * sx;
-                    const float wyz = wy[dj] * wz[dk];
-                    for (int di = 0; di < 2; ++di) row[di] += (wx[di] * wyz) * mp;
-                }
+            const Entry& c = C[o];
+            // mp = (m, m·v) and w = wx·(wy·wz) for the four nodes of a
+            // plane (lane di + 2·dj), lane by lane as scalar code would.
+            const float m = c.mv[0];
+            const __m128 mp = _mm_mul_ps(_mm_load_ps(c.mv.data()), _mm_setr_ps(1.f, m, m, m));
+            const __m128 wx = _mm_setr_ps(1.f - c.t[0], c.t[0], 1.f - c.t[0], c.t[0]);
+            const __m128 wy = _mm_setr_ps(1.f - c.t[1], 1.f - c.t[1], c.t[1], c.t[1]);
+            const float wz[2] = {1.f - c.t[2], c.t[2]};
+            for (int dk = 0; dk < 2; ++dk) {
+                const __m128 w = _mm_mul_ps(wx, _mm_mul_ps(wy, _mm_set1_ps(wz[dk])));
+                float* base = N[c.node + size_t(dk) * plane].data();
+                float* at[4] = {base, base + 4, base + 4 * sx, base + 4 * sx + 4};
+                _mm_store_ps(at[0], _mm_add_ps(_mm_load_ps(at[0]), _mm_mul_ps(_mm_shuffle_ps(w, w, 0x00), mp)));
+                _mm_store_ps(at[1], _mm_add_ps(_mm_load_ps(at[1]), _mm_mul_ps(_mm_shuffle_ps(w, w, 0x55), mp)));
+                _mm_store_ps(at[2], _mm_add_ps(_mm_load_ps(at[2]), _mm_mul_ps(_mm_shuffle_ps(w, w, 0xaa), mp)));
+                _mm_store_ps(at[3], _mm_add_ps(_mm_load_ps(at[3]), _mm_mul_ps(_mm_shuffle_ps(w, w, 0xff), mp)));
+            }
         }
     });
 
@@ -261,21 +289,21 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     // once for friction, the density it reads and the volume push.
     std::atomic<float> maxR{0.f};
     std::atomic<size_t> pushed{0};
-    run(gridded, [&, N, C, sx, plane, toRatio, s, push, inv, invD](size_t b, size_t e) {
+    run(gridded, [&, N, C, vertexOf, sx, plane, toRatio, s, push, inv, invD](size_t b, size_t e) {
         float localMax = 0.f;
         size_t moved = 0;
         for (size_t o = b; o < e; ++o) {
-            const Cell& c = C[o];
+            const Entry& c = C[o];
             // The eight nodes in the order di + 2·dj + 4·dk, four at a time
             // (SSE): their masses in lanes, w = (wx·wy)·wz and w/M lane by
             // lane, then V = V + (w/M)·(M, P) node by node in that order,
             // the sums r = Σ w·ratio in that order too: the same operations
             // one by one as a scalar loop (SSE rounds each lane as the
             // scalar operation does), so the same bits.
-            const __m128 wx = _mm_setr_ps(1.f - c.tx, c.tx, 1.f - c.tx, c.tx);
-            const __m128 wy = _mm_setr_ps(1.f - c.ty, 1.f - c.ty, c.ty, c.ty);
+            const __m128 wx = _mm_setr_ps(1.f - c.t[0], c.t[0], 1.f - c.t[0], c.t[0]);
+            const __m128 wy = _mm_setr_ps(1.f - c.t[1], 1.f - c.t[1], c.t[1], c.t[1]);
             const __m128 wxy = _mm_mul_ps(wx, wy);
-            const __m128 w[2] = {_mm_mul_ps(wxy, _mm_set1_ps(1.f - c.tz)), _mm_mul_ps(wxy, _mm_set1_ps(c.tz))};
+            const __m128 w[2] = {_mm_mul_ps(wxy, _mm_set1_ps(1.f - c.t[2])), _mm_mul_ps(wxy, _mm_set1_ps(c.t[2]))};
             __m128 V = _mm_setzero_ps();  // (Σ w, V̄): lane 0 unused
             __m128 cornerMax = _mm_setzero_ps(), ratio[2];
             float r = 0.f;
@@ -305,33 +333,34 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
             localMax = std::max(localMax, _mm_cvtss_f32(cornerMax));
             alignas(16) float Vs[4];
             _mm_store_ps(Vs, V);
-            const Vec3f v = massVel_[o].tail<3>();
-            in.v[c.vertex] = v + s * (Vec3f(Vs[1], Vs[2], Vs[3]) - v);
+            const Vec3f v = c.mv.tail<3>();
+            in.v[vertexOf[o]] = v + s * (Vec3f(Vs[1], Vs[2], Vs[3]) - v);
             // The volume push, where a node is above the target (elsewhere
             // E = 0): x ← x − c·Δ²·∇E/max(1, r̄), ∇E = Σ E_n·∇w_n with
             // ∇w_n = (w'x·wy·wz, wx·w'y·wz, wx·wy·w'z), w' = ∓1/Δ, the
             // terms summed node by node, the three axes in SSE lanes.
             if (!above || !(push > 0.f)) continue;
-            const float dw[2] = {-invD, invD};
-            const float wxs[2] = {1.f - c.tx, c.tx}, wys[2] = {1.f - c.ty, c.ty}, wzs[2] = {1.f - c.tz, c.tz};
+            // ∇w_n = (A_di·B_dj)·C_dk lane by lane, A = (w'x, wx, wx),
+            // B = (wy, w'y, wy), C = (wz, wz, w'z); lane 3 unused.
+            const float tx = c.t[0], ty = c.t[1], tz = c.t[2];
+            const __m128 A[2] = {_mm_setr_ps(-invD, 1.f - tx, 1.f - tx, 0.f), _mm_setr_ps(invD, tx, tx, 0.f)};
+            const __m128 B[2] = {_mm_setr_ps(1.f - ty, -invD, 1.f - ty, 0.f), _mm_setr_ps(ty, invD, ty, 0.f)};
+            const __m128 Cz[2] = {_mm_setr_ps(1.f - tz, 1.f - tz, -invD, 0.f), _mm_setr_ps(tz, tz, invD, 0.f)};
+            const __m128 AB[4] = {_mm_mul_ps(A[0], B[0]), _mm_mul_ps(A[1], B[0]), _mm_mul_ps(A[0], B[1]),
+                                  _mm_mul_ps(A[1], B[1])};  // index di + 2·dj
             __m128 grad = _mm_setzero_ps();
             for (int dk = 0; dk < 2; ++dk) {
-                alignas(16) float E[4];
-                _mm_store_ps(E, _mm_mul_ps(_mm_max_ps(_mm_sub_ps(ratio[dk], _mm_set1_ps(1.f)), _mm_setzero_ps()),
-                                           _mm_set1_ps(inv)));
-                for (int dj = 0; dj < 2; ++dj)
-                    for (int di = 0; di < 2; ++di) {
-                        const __m128 g = _mm_mul_ps(
-                            _mm_mul_ps(_mm_setr_ps(dw[di], wxs[di], wxs[di], 0.f), _mm_setr_ps(wys[dj], dw[dj], wys[dj], 0.f)),
-                            _mm_setr_ps(wzs[dk], wzs[dk], dw[dk], 0.f));
-                        grad = _mm_add_ps(grad, _mm_mul_ps(_mm_set1_ps(E[di + 2 * dj]), g));
-                    }
+                const __m128 E = _mm_mul_ps(_mm_max_ps(_mm_sub_ps(ratio[dk], one), zero), _mm_set1_ps(inv));
+                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(E, E, 0x00), _mm_mul_ps(AB[0], Cz[dk])));
+                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(E, E, 0x55), _mm_mul_ps(AB[1], Cz[dk])));
+                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(E, E, 0xaa), _mm_mul_ps(AB[2], Cz[dk])));
+                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(E, E, 0xff), _mm_mul_ps(AB[3], Cz[dk])));
             }
             alignas(16) float G[4];
             _mm_store_ps(G, grad);
             const Vec3f gv(G[0], G[1], G[2]);
             if (gv.squaredNorm() > 0.f) {
-                in.x[c.vertex] -= (push / std::max(1.f, r)) * (R * gv);
+                in.x[vertexOf[o]] -= (push / std::max(1.f, r)) * (R * gv);
                 ++moved;
             }
         }

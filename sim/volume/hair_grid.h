@@ -108,23 +108,22 @@ class HairGrid {
     float pushFraction(float h) const;
 
   private:
-    /// A gridded vertex in the passes' order: base node (i, j, k), its
-    /// index in the lattice, trilinear fractions.
-    struct Cell {
-        int i, j, k;
+    /// A gridded vertex in the passes' order: trilinear fractions t, the
+    /// index of its base node (i, j, k) in the lattice, (m, v); 32 bytes.
+    struct Entry {
+        alignas(16) float t[3];
         uint32_t node;
-        float tx, ty, tz;
-        uint32_t vertex;  ///< index into GridInput
+        Eigen::Vector4f mv;
     };
     VolumeSettings s_;
-    std::vector<Cell> vertexCells_;  ///< per vertex
     std::vector<uint32_t> rowOf_;    ///< node row (j, k) of each vertex's base node; ~0: not gridded
     std::vector<uint32_t> rowStart_;  ///< first sorted vertex of each node row
     std::vector<uint32_t> rowCount_;  ///< the sort's counts, then places, per chunk and row
-    /// Gridded vertices sorted by node row (hair_grid.cpp): their cells and
-    /// (m, v), copied in that order so that every pass reads them in a stream.
-    std::vector<Cell> cells_;
-    std::vector<Eigen::Vector4f> massVel_;
+    /// Gridded vertices sorted by node row (hair_grid.cpp): their entries,
+    /// written in that order so that every pass reads them in a stream, and
+    /// their indices into GridInput.
+    std::vector<Entry> entries_;
+    std::vector<uint32_t> order_;
     /// Per node (m, P): mass and momentum, one SSE packet, so the splat
     /// adds w·(m, m·v) in one operation; zero between calls. The hair
     /// length is M·lengthPerMass (the same for every vertex), not stored:
