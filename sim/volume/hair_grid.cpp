@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <emmintrin.h>
 
 namespace hp {
@@ -52,10 +53,6 @@ constexpr float kMaxPush = 0.5f;
 /// the crossing wisps' energy rise, BDF2, 1/2/4 substeps, 0.4/1.0/2.2% of
 /// what the fall releases (0.7/2.0/3.6%); and the grid's cost at 845 guides
 /// dropped by its sweeps, the box scan and a second pass over the vertices.
-/// Lattices of at most this many nodes per gridded vertex are cleared
-/// with one memset (845 B-sim guides: 20k vertices on 100k-180k nodes; the
-/// memset took half the time of clearing each vertex's eight nodes).
-constexpr size_t kClearByFill = 32;
 /// Chunks of the counting sort by node row (any number gives the same order).
 constexpr size_t kSortChunks = 8;
 /// Vertices below which apply() runs on the calling thread.
@@ -159,10 +156,6 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
         return _mm_cvtsi128_si32(lane == 0 ? v : lane == 1 ? _mm_shuffle_epi32(v, 0x55) : _mm_shuffle_epi32(v, 0xaa));
     };
 
-    // The node array is all zeros between calls (apply() clears the nodes it
-    // touched before returning), so only growth costs a fill.
-    if (nodes_.size() < nodes) nodes_.resize(nodes, Eigen::Vector4f::Zero());
-
     // Vertices by the node row (j, k) of their base node, in vertex order
     // within a row (a stable counting sort), their cells and (m, v) written
     // in that order. Every pass walks it: neighbouring entries read and
@@ -223,26 +216,66 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
                 __m128 t;
                 const __m128i base = locate(local(in.x[i]), t);
                 Entry& en = entries_[o];
-                // t and the node in one 16-byte store's place (__m128 may
-                // alias): lane 3 is overwritten by the node next.
+                // t and i in one 16-byte store's place (__m128 may alias):
+                // lane 3 is overwritten by i next.
                 _mm_store_ps(reinterpret_cast<float*>(&en), t);
-                en.node = uint32_t((size_t(laneOf(base, 2)) * size_t(ny) + size_t(laneOf(base, 1))) * size_t(nx) +
-                                   size_t(laneOf(base, 0)));
+                en.i = laneOf(base, 0);
                 en.mv = Eigen::Vector4f(in.mass[i], in.v[i].x(), in.v[i].y(), in.v[i].z());
                 order_[o] = uint32_t(i);
             }
         }
     });
-    auto slabStart = [&](size_t k) { return rowStart_[k * size_t(ny)]; };
 
-    // Even slabs, then odd slabs: each writes node planes k and k+1 only.
-    auto bySlab = [&](auto&& body) {  // body(first, end) over a slab's range of the order
+    // The nodes the vertices can touch, stored row by row: node row (j, k)
+    // holds the x span its four base rows (j − 1..j, k − 1..k) reach, i_min
+    // to i_max + 1, so a node is N[rowBase[row] + i]. On B-sim's 845 guides
+    // this holds a third of the bounding box's nodes (the rope's hair
+    // standing out from the sphere: a ninth); the splat, the gathers and
+    // the clear then touch less memory. The sums are the same, term by
+    // term, as on the whole box.
+    spanLo_.assign(rows, std::numeric_limits<int>::max());
+    spanHi_.assign(rows, -1);
+    run(rows, [&](size_t b, size_t e) {
+        for (size_t r = b; r < e; ++r) {
+            int ilo = std::numeric_limits<int>::max(), ihi = -1;
+            for (size_t o = rowStart_[r]; o < rowStart_[r + 1]; ++o) {
+                ilo = std::min(ilo, entries_[o].i);
+                ihi = std::max(ihi, entries_[o].i);
+            }
+            spanLo_[r] = ilo;
+            spanHi_[r] = ihi;
+        }
+    });
+    rowBase_.resize(rows);
+    size_t stored = 0;
+    for (size_t r = 0; r < rows; ++r) {
+        const size_t j = r % size_t(ny), k = r / size_t(ny);
+        int ilo = spanLo_[r], ihi = spanHi_[r];  // base rows (j, k), (j − 1, k), (j, k − 1), (j − 1, k − 1)
+        if (j > 0) ilo = std::min(ilo, spanLo_[r - 1]), ihi = std::max(ihi, spanHi_[r - 1]);
+        if (k > 0) ilo = std::min(ilo, spanLo_[r - size_t(ny)]), ihi = std::max(ihi, spanHi_[r - size_t(ny)]);
+        if (j > 0 && k > 0) ilo = std::min(ilo, spanLo_[r - size_t(ny) - 1]), ihi = std::max(ihi, spanHi_[r - size_t(ny) - 1]);
+        if (ihi < 0) {
+            rowBase_[r] = 0;  // no vertex reaches this row
+            continue;
+        }
+        rowBase_[r] = ptrdiff_t(stored) - ilo;
+        stored += size_t(ihi + 2 - ilo);  // i_min .. i_max + 1
+    }
+    // The node array is all zeros between calls (apply() clears the nodes it
+    // used before returning), so only growth costs a fill.
+    if (nodes_.size() < stored) nodes_.resize(stored, Eigen::Vector4f::Zero());
+    st.nodes = stored;
+
+    // Even slabs, then odd slabs: each writes node planes k and k+1 only
+    // (their rows lie in that order in the node array, so apart from other
+    // slabs of its parity).
+    auto bySlab = [&](auto&& body) {  // body(first row, end row) of a slab's base rows
         for (int parity = 0; parity < 2; ++parity) {
             const size_t slabs = size_t(std::max(0, (nz - parity) / 2));
             run(slabs, [&](size_t b, size_t e) {
                 for (size_t sl = b; sl < e; ++sl) {
                     const size_t k = 2 * sl + size_t(parity);
-                    body(size_t(slabStart(k)), size_t(slabStart(k + 1)));
+                    body(k * size_t(ny), (k + 1) * size_t(ny));
                 }
             });
         }
@@ -250,11 +283,14 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     Eigen::Vector4f* const N = nodes_.data();
     const Entry* const C = entries_.data();
     const uint32_t* const vertexOf = order_.data();
-    const size_t sx = size_t(nx);
+    const ptrdiff_t* const RB = rowBase_.data();
+    const uint32_t* const RS = rowStart_.data();
+    const size_t sy = size_t(ny);
 
     // Splat: w·(m, m·v) on the eight nodes.
-    bySlab([&, N, C, sx, plane](size_t first, size_t end) {
-        for (size_t o = first; o < end; ++o) {
+    bySlab([&, N, C, RB, RS, sy](size_t firstRow, size_t endRow) {
+        for (size_t r = firstRow; r < endRow; ++r)
+        for (size_t o = RS[r]; o < RS[r + 1]; ++o) {
             const Entry& c = C[o];
             // mp = (m, m·v) and w = wx·(wy·wz) for the four nodes of a
             // plane (lane di + 2·dj), lane by lane as scalar code would.
@@ -265,8 +301,9 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
             const float wz[2] = {1.f - c.t[2], c.t[2]};
             for (int dk = 0; dk < 2; ++dk) {
                 const __m128 w = _mm_mul_ps(wx, _mm_mul_ps(wy, _mm_set1_ps(wz[dk])));
-                float* base = N[c.node + size_t(dk) * plane].data();
-                float* at[4] = {base, base + 4, base + 4 * sx, base + 4 * sx + 4};
+                float* row0 = N[RB[r + size_t(dk) * sy] + c.i].data();
+                float* row1 = N[RB[r + size_t(dk) * sy + 1] + c.i].data();
+                float* at[4] = {row0, row0 + 4, row1, row1 + 4};
                 _mm_store_ps(at[0], _mm_add_ps(_mm_load_ps(at[0]), _mm_mul_ps(_mm_shuffle_ps(w, w, 0x00), mp)));
                 _mm_store_ps(at[1], _mm_add_ps(_mm_load_ps(at[1]), _mm_mul_ps(_mm_shuffle_ps(w, w, 0x55), mp)));
                 _mm_store_ps(at[2], _mm_add_ps(_mm_load_ps(at[2]), _mm_mul_ps(_mm_shuffle_ps(w, w, 0xaa), mp)));
@@ -289,10 +326,12 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     // once for friction, the density it reads and the volume push.
     std::atomic<float> maxR{0.f};
     std::atomic<size_t> pushed{0};
-    run(gridded, [&, N, C, vertexOf, sx, plane, toRatio, s, push, inv, invD](size_t b, size_t e) {
+    run(gridded, [&, N, C, vertexOf, RB, RS, sy, toRatio, s, push, inv, invD](size_t b, size_t e) {
         float localMax = 0.f;
         size_t moved = 0;
+        size_t row = size_t(std::upper_bound(RS, RS + rows + 1, uint32_t(b)) - RS) - 1;  // the row of entry b
         for (size_t o = b; o < e; ++o) {
+            while (o >= RS[row + 1]) ++row;
             const Entry& c = C[o];
             // The eight nodes in the order di + 2·dj + 4·dk, four at a time
             // (SSE): their masses in lanes, w = (wx·wy)·wz and w/M lane by
@@ -309,9 +348,10 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
             float r = 0.f;
             unsigned above = 0;  // bit di + 2·dj + 4·dk: that node is above the target
             for (int dk = 0; dk < 2; ++dk) {
-                const float* base = N[c.node + size_t(dk) * plane].data();
-                const __m128 nd[4] = {_mm_load_ps(base), _mm_load_ps(base + 4), _mm_load_ps(base + 4 * sx),
-                                     _mm_load_ps(base + 4 * sx + 4)};
+                const float* row0 = N[RB[row + size_t(dk) * sy] + c.i].data();
+                const float* row1 = N[RB[row + size_t(dk) * sy + 1] + c.i].data();
+                const __m128 nd[4] = {_mm_load_ps(row0), _mm_load_ps(row0 + 4), _mm_load_ps(row1),
+                                      _mm_load_ps(row1 + 4)};
                 const __m128 M = _mm_movelh_ps(_mm_unpacklo_ps(nd[0], nd[1]), _mm_unpacklo_ps(nd[2], nd[3]));
                 const __m128 q = _mm_div_ps(w[dk], M);
                 const __m128 has = _mm_cmpgt_ps(M, _mm_setzero_ps());
@@ -371,21 +411,9 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     st.maxDensity = maxR.load() * s_.targetDensity;
     st.pushed = pushed;
 
-    // Leave the array all zeros for the next call. A lattice of at most
-    // kClearByFill nodes a vertex is cleared whole (a memset streams at
-    // memory speed), a sparser one node by node where the splat wrote.
-    if (nodes <= kClearByFill * gridded) {
-        std::memset(static_cast<void*>(N), 0, nodes * sizeof(Eigen::Vector4f));
-        return st;
-    }
-    bySlab([&, N, C, sx, plane](size_t first, size_t end) {
-        for (size_t o = first; o < end; ++o)
-            for (int dk = 0; dk < 2; ++dk)
-                for (int dj = 0; dj < 2; ++dj) {
-                    Eigen::Vector4f* row = N + C[o].node + size_t(dk) * plane + size_t(dj) * sx;
-                    row[0] = row[1] = Eigen::Vector4f::Zero();
-                }
-    });
+    // Leave the array all zeros for the next call (one memset: the rows
+    // hold little beyond what the splat wrote).
+    std::memset(static_cast<void*>(N), 0, stored * sizeof(Eigen::Vector4f));
     return st;
 }
 

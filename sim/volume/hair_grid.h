@@ -108,11 +108,12 @@ class HairGrid {
     float pushFraction(float h) const;
 
   private:
-    /// A gridded vertex in the passes' order: trilinear fractions t, the
-    /// index of its base node (i, j, k) in the lattice, (m, v); 32 bytes.
+    /// A gridded vertex in the passes' order: trilinear fractions t, the x
+    /// index i of its base node (i, j, k) (its row (j, k) is where it is
+    /// sorted), (m, v); 32 bytes.
     struct Entry {
         alignas(16) float t[3];
-        uint32_t node;
+        int32_t i;
         Eigen::Vector4f mv;
     };
     VolumeSettings s_;
@@ -124,6 +125,8 @@ class HairGrid {
     /// their indices into GridInput.
     std::vector<Entry> entries_;
     std::vector<uint32_t> order_;
+    std::vector<int> spanLo_, spanHi_;  ///< per base row: the least and largest i of its vertices
+    std::vector<ptrdiff_t> rowBase_;   ///< per node row: node (i, j, k) is nodes_[rowBase_[row] + i]
     /// Per node (m, P): mass and momentum, one SSE packet, so the splat
     /// adds w·(m, m·v) in one operation; zero between calls. The hair
     /// length is M·lengthPerMass (the same for every vertex), not stored:
