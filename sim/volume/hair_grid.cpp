@@ -43,16 +43,18 @@ constexpr double kMaxNodes = 4.0e6;
 /// (both before the guide solver restored the pushed lengths with the push:
 /// 0.7% at 1/2 since, docs/physics.md).
 constexpr float kMaxPush = 0.5f;
-/// One Jacobi sweep of the implicit volume step (excess_diffusion.h) from
-/// E⁰ = 0, E = e/(1 + 6c), read from each node's mass where the push is
-/// gathered. A smooth excess then gets (1 − ρ) of the exact implicit push,
-/// ρ = 6c/(1 + 6c) = 0.72 at the default c = 0.43; the grid-scale modes
-/// still never grow. Measured on tests/test_hair_grid.cpp against 4 sweeps
-/// (the pushed lengths restored with the push, docs/physics.md): the ball
-/// 300 hairs/cm² with BDF2 (338 at 4 sweeps), 300 with implicit Euler (300);
-/// the crossing wisps' energy rise, BDF2, 1/2/4 substeps, 0.4/1.0/2.2% of
-/// what the fall releases (0.7/2.0/3.6%); and the grid's cost at 845 guides
-/// dropped by its sweeps, the box scan and a second pass over the vertices.
+/// Jacobi sweeps of the implicit volume step (excess_diffusion.h): a smooth
+/// excess gets (1 − ρ^K) of the exact implicit push, ρ = 6c/(1 + 6c) = 0.72
+/// at the default c = 0.43, so 0.73 at 4 sweeps. Measured on the ball and
+/// the crossing wisps (BDF2): 1 sweep 338 hairs/cm², 0.5% energy gain;
+/// 4 sweeps 338, 1.5%; 8 sweeps 300, 1.6% (lengths then restored by the step).
+/// With the lengths restored with the push, one sweep (E = e/(1 + 6c), read
+/// straight from the nodes) left the ball at 300 and the energy lower, but
+/// the default shot's hair did not come to rest after the head stopped
+/// (ShotSimulation.HairHangsUnderGravityAndSwingsWithTheHead: 10.5 m/s at
+/// frame 120; 2 sweeps 0.30, 3 sweeps 1.19, 4 sweeps 0.016 m/s), so 4 stay.
+constexpr int kSweeps = 4;
+
 /// Chunks of the counting sort by node row (any number gives the same order).
 constexpr size_t kSortChunks = 8;
 /// Vertices below which apply() runs on the calling thread.
@@ -247,20 +249,28 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
         }
     });
     rowBase_.resize(rows);
+    rowLo_.resize(rows);
+    rowEnd_.resize(rows);
+    planeStart_.resize(size_t(nz) + 1);
     size_t stored = 0;
     for (size_t r = 0; r < rows; ++r) {
         const size_t j = r % size_t(ny), k = r / size_t(ny);
+        if (j == 0) planeStart_[k] = uint32_t(stored);
         int ilo = spanLo_[r], ihi = spanHi_[r];  // base rows (j, k), (j − 1, k), (j, k − 1), (j − 1, k − 1)
         if (j > 0) ilo = std::min(ilo, spanLo_[r - 1]), ihi = std::max(ihi, spanHi_[r - 1]);
         if (k > 0) ilo = std::min(ilo, spanLo_[r - size_t(ny)]), ihi = std::max(ihi, spanHi_[r - size_t(ny)]);
         if (j > 0 && k > 0) ilo = std::min(ilo, spanLo_[r - size_t(ny) - 1]), ihi = std::max(ihi, spanHi_[r - size_t(ny) - 1]);
         if (ihi < 0) {
             rowBase_[r] = 0;  // no vertex reaches this row
+            rowLo_[r] = rowEnd_[r] = 0;
             continue;
         }
         rowBase_[r] = ptrdiff_t(stored) - ilo;
-        stored += size_t(ihi + 2 - ilo);  // i_min .. i_max + 1
+        rowLo_[r] = ilo;
+        rowEnd_[r] = ihi + 2;  // i_min .. i_max + 1
+        stored += size_t(ihi + 2 - ilo);
     }
+    planeStart_[size_t(nz)] = uint32_t(stored);
     // The node array is all zeros between calls (apply() clears the nodes it
     // used before returning), so only growth costs a fill.
     if (nodes_.size() < stored) nodes_.resize(stored, Eigen::Vector4f::Zero());
@@ -316,18 +326,98 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     // r = M·lengthPerMass/(Δ³·λ₀), λ₀ from hairs per cm² to per m².
     const float toRatio = in.lengthPerMass / (d * d * d * s_.targetDensity * 1e4f);
     const float s = blendFraction(in.h), cPush = pushFraction(in.h), push = cPush * d * d;
-    // The volume step's relaxed excess at a node, E = e/(1 + 6c): one
-    // Jacobi sweep of (I − c·L)·E = e from E⁰ = 0 (excess_diffusion.h), so
-    // it is read straight from the node's mass in the same pass.
-    const float inv = 1.f / (1.f + 6.f * cPush);
     const Eigen::Matrix3f R = in.head.linear();
+    const int* const RL = rowLo_.data();
+    const int* const RE = rowEnd_.data();
+
+    // The densest node and the box of nodes above the target (minima and
+    // maxima: the same whatever the order), plane by plane over the stored
+    // nodes: every node with hair is a node some vertex reads.
+    std::atomic<float> maxR{0.f};
+    std::atomic<int> boxLo[3] = {nx, ny, nz}, boxHi[3] = {-1, -1, -1};
+    auto lower = [](std::atomic<int>& a, int v) {
+        for (int m = a.load(); v < m && !a.compare_exchange_weak(m, v);) {
+        }
+    };
+    auto raise = [](std::atomic<int>& a, int v) {
+        for (int m = a.load(); v > m && !a.compare_exchange_weak(m, v);) {
+        }
+    };
+    run(size_t(nz), [&, N, RB, RL, RE, toRatio](size_t b, size_t e) {
+        float localMax = 0.f;
+        int lo3[3] = {nx, ny, nz}, hi3[3] = {-1, -1, -1};
+        for (size_t k = b; k < e; ++k)
+            for (int j = 0; j < ny; ++j) {
+                const size_t r = k * size_t(ny) + size_t(j);
+                for (int i = RL[r]; i < RE[r]; ++i) {
+                    const float ratio = N[RB[r] + i][0] * toRatio;
+                    localMax = std::max(localMax, ratio);
+                    if (!(ratio > 1.f)) continue;
+                    const int at[3] = {i, j, int(k)};
+                    for (int a = 0; a < 3; ++a) {
+                        lo3[a] = std::min(lo3[a], at[a]);
+                        hi3[a] = std::max(hi3[a], at[a]);
+                    }
+                }
+            }
+        for (int a = 0; a < 3; ++a) {
+            lower(boxLo[a], lo3[a]);
+            raise(boxHi[a], hi3[a]);
+        }
+        for (float m = maxR.load(); localMax > m && !maxR.compare_exchange_weak(m, localMax);) {
+        }
+    });
+    st.maxDensity = maxR.load() * s_.targetDensity;
+
+    // The volume step's excess, relaxed implicitly (excess_diffusion.h) on
+    // the nodes with hair in the box of nodes above the target grown by the
+    // sweeps' reach, kept in relaxed_ (stored node order, then a zero slot)
+    // for the gather. K sweeps from E⁰ = 0 reach K − 1 nodes beyond the
+    // excess (E¹ is nonzero only on it, each sweep one node further), so
+    // beyond that margin E is 0, and a node at the margin reads 0 from
+    // outside it either way: the same E as on the whole lattice.
+    const bool relaxed = push > 0.f && boxHi[0].load() >= 0;
+    if (relaxed) {
+        const int reach = kSweeps - 1, last[3] = {nx - 1, ny - 1, nz - 1};
+        int bl[3], bh[3];
+        for (int a = 0; a < 3; ++a) {
+            bl[a] = std::max(0, boxLo[a].load() - reach);
+            bh[a] = std::min(last[a], boxHi[a].load() + reach);
+        }
+        const uint32_t none = uint32_t(stored);
+        occupied_.reset(size_t(nz), planeStart_.data(), stored + 1, none);
+        // Node (i, j', k') of a stored row, or the none slot.
+        auto slot = [&, RB, RL, RE](size_t r, int i) {
+            return i >= RL[r] && i < RE[r] ? uint32_t(RB[r] + i) : none;
+        };
+        run(size_t(bh[2] - bl[2] + 1), [&, N, RB, RL, RE, toRatio](size_t b, size_t e) {
+            for (size_t kk = b; kk < e; ++kk) {
+                const int k = bl[2] + int(kk);
+                for (int j = bl[1]; j <= bh[1]; ++j) {
+                    const size_t r = size_t(k) * size_t(ny) + size_t(j);
+                    for (int i = std::max(bl[0], RL[r]), end = std::min(bh[0] + 1, RE[r]); i < end; ++i) {
+                        const uint32_t q = uint32_t(RB[r] + i);
+                        const float m = N[q][0];
+                        if (!(m > 0.f)) continue;
+                        occupied_.add(size_t(k), q,
+                                      {i - 1 >= RL[r] ? q - 1 : none, i + 1 < RE[r] ? q + 1 : none,
+                                       j > 0 ? slot(r - 1, i) : none, j + 1 < ny ? slot(r + 1, i) : none,
+                                       k > 0 ? slot(r - size_t(ny), i) : none,
+                                       k + 1 < nz ? slot(r + size_t(ny), i) : none},
+                                      std::max(0.f, m * toRatio - 1.f));
+                    }
+                }
+            }
+        });
+        relaxed_.resize(stored + 1);
+        relaxListed(occupied_, cPush, kSweeps, relaxed_.data(), run);
+    }
+    const float* const E = relaxed_.data();
 
     // One pass over the sorted vertices reads each vertex's eight nodes
     // once for friction, the density it reads and the volume push.
-    std::atomic<float> maxR{0.f};
     std::atomic<size_t> pushed{0};
-    run(gridded, [&, N, C, vertexOf, RB, RS, sy, toRatio, s, push, inv, invD](size_t b, size_t e) {
-        float localMax = 0.f;
+    run(gridded, [&, N, E, C, vertexOf, RB, RS, sy, toRatio, s, push, invD](size_t b, size_t e) {
         size_t moved = 0;
         size_t row = size_t(std::upper_bound(RS, RS + rows + 1, uint32_t(b)) - RS) - 1;  // the row of entry b
         for (size_t o = b; o < e; ++o) {
@@ -344,9 +434,7 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
             const __m128 wxy = _mm_mul_ps(wx, wy);
             const __m128 w[2] = {_mm_mul_ps(wxy, _mm_set1_ps(1.f - c.t[2])), _mm_mul_ps(wxy, _mm_set1_ps(c.t[2]))};
             __m128 V = _mm_setzero_ps();  // (Σ w, V̄): lane 0 unused
-            __m128 cornerMax = _mm_setzero_ps(), ratio[2];
             float r = 0.f;
-            unsigned above = 0;  // bit di + 2·dj + 4·dk: that node is above the target
             for (int dk = 0; dk < 2; ++dk) {
                 const float* row0 = N[RB[row + size_t(dk) * sy] + c.i].data();
                 const float* row1 = N[RB[row + size_t(dk) * sy + 1] + c.i].data();
@@ -355,8 +443,7 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
                 const __m128 M = _mm_movelh_ps(_mm_unpacklo_ps(nd[0], nd[1]), _mm_unpacklo_ps(nd[2], nd[3]));
                 const __m128 q = _mm_div_ps(w[dk], M);
                 const __m128 has = _mm_cmpgt_ps(M, _mm_setzero_ps());
-                ratio[dk] = _mm_mul_ps(M, _mm_set1_ps(toRatio));
-                const __m128 wr = _mm_mul_ps(w[dk], ratio[dk]);
+                const __m128 wr = _mm_mul_ps(w[dk], _mm_mul_ps(M, _mm_set1_ps(toRatio)));
                 V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0x00), _mm_mul_ps(_mm_shuffle_ps(q, q, 0x00), nd[0])));
                 V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0x55), _mm_mul_ps(_mm_shuffle_ps(q, q, 0x55), nd[1])));
                 V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0xaa), _mm_mul_ps(_mm_shuffle_ps(q, q, 0xaa), nd[2])));
@@ -365,21 +452,21 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
                 r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0x55));
                 r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0xaa));
                 r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0xff));
-                cornerMax = _mm_max_ps(cornerMax, ratio[dk]);
-                above |= unsigned(_mm_movemask_ps(_mm_cmpgt_ps(ratio[dk], _mm_set1_ps(1.f)))) << (4 * dk);
             }
-            cornerMax = _mm_max_ps(cornerMax, _mm_shuffle_ps(cornerMax, cornerMax, 0x4e));
-            cornerMax = _mm_max_ps(cornerMax, _mm_shuffle_ps(cornerMax, cornerMax, 0xb1));
-            localMax = std::max(localMax, _mm_cvtss_f32(cornerMax));
             alignas(16) float Vs[4];
             _mm_store_ps(Vs, V);
             const Vec3f v = c.mv.tail<3>();
             in.v[vertexOf[o]] = v + s * (Vec3f(Vs[1], Vs[2], Vs[3]) - v);
-            // The volume push, where a node is above the target (elsewhere
-            // E = 0): x ← x − c·Δ²·∇E/max(1, r̄), ∇E = Σ E_n·∇w_n with
-            // ∇w_n = (w'x·wy·wz, wx·w'y·wz, wx·wy·w'z), w' = ∓1/Δ, the
+            // The volume push where a node the vertex reads holds excess
+            // (elsewhere ∇E = 0): x ← x − c·Δ²·∇E/max(1, r̄), ∇E = Σ E_n·∇w_n
+            // with ∇w_n = (w'x·wy·wz, wx·w'y·wz, wx·wy·w'z), w' = ∓1/Δ, the
             // terms summed node by node, the three axes in SSE lanes.
-            if (!above || !(push > 0.f)) continue;
+            if (!relaxed) continue;
+            __m128 En[2];  // E of the nodes di + 2·dj of planes dk = 0, 1
+            for (int dk = 0; dk < 2; ++dk)
+                En[dk] = _mm_loadh_pi(_mm_loadl_pi(zero, reinterpret_cast<const __m64*>(E + RB[row + size_t(dk) * sy] + c.i)),
+                                      reinterpret_cast<const __m64*>(E + RB[row + size_t(dk) * sy + 1] + c.i));
+            if (_mm_movemask_ps(_mm_or_ps(_mm_cmpneq_ps(En[0], zero), _mm_cmpneq_ps(En[1], zero))) == 0) continue;
             // ∇w_n = (A_di·B_dj)·C_dk lane by lane, A = (w'x, wx, wx),
             // B = (wy, w'y, wy), C = (wz, wz, w'z); lane 3 unused.
             const float tx = c.t[0], ty = c.t[1], tz = c.t[2];
@@ -390,11 +477,11 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
                                   _mm_mul_ps(A[1], B[1])};  // index di + 2·dj
             __m128 grad = _mm_setzero_ps();
             for (int dk = 0; dk < 2; ++dk) {
-                const __m128 E = _mm_mul_ps(_mm_max_ps(_mm_sub_ps(ratio[dk], one), zero), _mm_set1_ps(inv));
-                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(E, E, 0x00), _mm_mul_ps(AB[0], Cz[dk])));
-                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(E, E, 0x55), _mm_mul_ps(AB[1], Cz[dk])));
-                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(E, E, 0xaa), _mm_mul_ps(AB[2], Cz[dk])));
-                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(E, E, 0xff), _mm_mul_ps(AB[3], Cz[dk])));
+                const __m128 Ek = En[dk];
+                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0x00), _mm_mul_ps(AB[0], Cz[dk])));
+                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0x55), _mm_mul_ps(AB[1], Cz[dk])));
+                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0xaa), _mm_mul_ps(AB[2], Cz[dk])));
+                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0xff), _mm_mul_ps(AB[3], Cz[dk])));
             }
             alignas(16) float G[4];
             _mm_store_ps(G, grad);
@@ -404,11 +491,8 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
                 ++moved;
             }
         }
-        for (float m = maxR.load(); localMax > m && !maxR.compare_exchange_weak(m, localMax);) {
-        }
         pushed += moved;
     });
-    st.maxDensity = maxR.load() * s_.targetDensity;
     st.pushed = pushed;
 
     // Leave the array all zeros for the next call (one memset: the rows

@@ -127,6 +127,10 @@ class HairGrid {
     std::vector<uint32_t> order_;
     std::vector<int> spanLo_, spanHi_;  ///< per base row: the least and largest i of its vertices
     std::vector<ptrdiff_t> rowBase_;   ///< per node row: node (i, j, k) is nodes_[rowBase_[row] + i]
+    std::vector<int> rowLo_, rowEnd_;  ///< per node row: the stored i span [lo, end)
+    std::vector<uint32_t> planeStart_; ///< first stored node of each plane (and the count at the end)
+    OccupiedNodes occupied_;           ///< the volume step's nodes with hair
+    std::vector<float> relaxed_;       ///< its E per stored node, then a zero slot
     /// Per node (m, P): mass and momentum, one SSE packet, so the splat
     /// adds w·(m, m·v) in one operation; zero between calls. The hair
     /// length is M·lengthPerMass (the same for every vertex), not stored:
