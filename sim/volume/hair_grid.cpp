@@ -5,6 +5,7 @@
 #include "sim/volume/excess_diffusion.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -386,27 +387,42 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
         }
         const uint32_t none = uint32_t(stored);
         occupied_.reset(size_t(nz), planeStart_.data(), stored + 1, none);
-        // Node (i, j', k') of a stored row, or the none slot.
-        auto slot = [&, RB, RL, RE](size_t r, int i) {
-            return i >= RL[r] && i < RE[r] ? uint32_t(RB[r] + i) : none;
-        };
+        // Plane by plane (each plane from one thread), row by row, with
+        // the four neighbouring rows' bases and spans read once a row.
         run(size_t(bh[2] - bl[2] + 1), [&, N, RB, RL, RE, toRatio](size_t b, size_t e) {
+            uint32_t* const nodeOut = occupied_.node.data();
+            std::array<uint32_t, 6>* const aroundOut = occupied_.neighbour.data();
+            float* const excessOut = occupied_.excess.data();
             for (size_t kk = b; kk < e; ++kk) {
                 const int k = bl[2] + int(kk);
+                const size_t t0 = occupied_.first[size_t(k)];
+                size_t t = t0;
                 for (int j = bl[1]; j <= bh[1]; ++j) {
                     const size_t r = size_t(k) * size_t(ny) + size_t(j);
-                    for (int i = std::max(bl[0], RL[r]), end = std::min(bh[0] + 1, RE[r]); i < end; ++i) {
-                        const uint32_t q = uint32_t(RB[r] + i);
+                    // Rows y−, y+, z−, z+; one outside the lattice spans nothing.
+                    const size_t near[4] = {r - 1, r + 1, r - size_t(ny), r + size_t(ny)};
+                    const bool has[4] = {j > 0, j + 1 < ny, k > 0, k + 1 < nz};
+                    ptrdiff_t nb[4];
+                    int nlo[4], nend[4];
+                    for (int a = 0; a < 4; ++a) {
+                        nb[a] = has[a] ? RB[near[a]] : 0;
+                        nlo[a] = has[a] ? RL[near[a]] : 0;
+                        nend[a] = has[a] ? RE[near[a]] : 0;
+                    }
+                    const ptrdiff_t base = RB[r];
+                    const int rowLo = RL[r], rowEnd = RE[r];
+                    for (int i = std::max(bl[0], rowLo), end = std::min(bh[0] + 1, rowEnd); i < end; ++i) {
+                        const uint32_t q = uint32_t(base + i);
                         const float m = N[q][0];
                         if (!(m > 0.f)) continue;
-                        occupied_.add(size_t(k), q,
-                                      {i - 1 >= RL[r] ? q - 1 : none, i + 1 < RE[r] ? q + 1 : none,
-                                       j > 0 ? slot(r - 1, i) : none, j + 1 < ny ? slot(r + 1, i) : none,
-                                       k > 0 ? slot(r - size_t(ny), i) : none,
-                                       k + 1 < nz ? slot(r + size_t(ny), i) : none},
-                                      std::max(0.f, m * toRatio - 1.f));
+                        auto at = [&](int a) { return i >= nlo[a] && i < nend[a] ? uint32_t(nb[a] + i) : none; };
+                        nodeOut[t] = q;
+                        aroundOut[t] = {i > rowLo ? q - 1 : none, i + 1 < rowEnd ? q + 1 : none, at(0), at(1), at(2), at(3)};
+                        excessOut[t] = std::max(0.f, m * toRatio - 1.f);
+                        ++t;
                     }
                 }
+                occupied_.count[size_t(k)] = uint32_t(t - t0);
             }
         });
         relaxed_.resize(stored + 1);
