@@ -179,7 +179,10 @@ struct GuideSolver::Impl final : solver::StrandModel {
     /// clearance and computes velocities from positions, so the volume push
     /// adds no velocity.
     void couple(const solver::Substep& sub) {
-        beforePush = set.x;
+        beforePush.resize(set.x.size());
+        skeleton.parallel(set.x.size(), std::max<size_t>(1024, set.x.size() / 8), [&](size_t b, size_t e) {
+            std::copy(set.x.begin() + std::ptrdiff_t(b), set.x.begin() + std::ptrdiff_t(e), beforePush.begin() + std::ptrdiff_t(b));
+        });
         volume::GridInput in;
         in.x = set.x.data();
         in.v = set.v.data();

@@ -54,8 +54,12 @@ void relaxListed(OccupiedNodes& list, float c, int sweeps, float* out, const Par
     // out; both start at 0, and slots not listed are never written again.
     list.scratch.resize(n);
     float* buf[2] = {out, list.scratch.data()};
-    std::memset(out, 0, n * sizeof(float));
-    if (sweeps > 1) std::memset(buf[1], 0, n * sizeof(float));
+    if (planes == 0) std::memset(out, 0, n * sizeof(float));  // the zero slot alone
+    parallel(planes, [&](size_t b, size_t end) {  // cleared in chunks on the threads
+        const size_t from = n * b / planes, to = n * end / planes;
+        std::memset(out + from, 0, (to - from) * sizeof(float));
+        if (sweeps > 1) std::memset(buf[1] + from, 0, (to - from) * sizeof(float));
+    });
     int cur = (sweeps % 2 == 1) ? 0 : 1;  // the buffer holding E^1
     const uint32_t* node = list.node.data();
     const std::array<uint32_t, 6>* around = list.neighbour.data();
