@@ -162,13 +162,21 @@ struct GuideSolver::Impl final : solver::StrandModel {
     /// guide is a chain of dependent square roots and divisions, and
     /// independent guides between them keep the divider busy.
     void restoreLengths(size_t b, size_t e) {
+        // strand::followTheLeader's move, inline here so that the four
+        // guides' square roots and divisions overlap (the same operations,
+        // so the same bits).
+        auto place = [](const Vec3f& parent, const Vec3f& child, float length) {
+            const Vec3f d = child - parent;
+            const float len = d.norm();
+            return len > 1e-12f ? Vec3f(parent + d * (length / len)) : Vec3f(parent + Vec3f::UnitY() * length);
+        };
         constexpr size_t kInterleave = 4;
         for (size_t g0 = b; g0 < e; g0 += kInterleave) {
             const size_t lanes = std::min(kInterleave, e - g0);
             for (int j = 0; j < set.segments; ++j)
                 for (size_t l = 0; l < lanes; ++l) {
                     Vec3f* x = &set.x[set.vertex(g0 + l, 0)];
-                    x[j + 1] = strand::followTheLeader(x[j], x[j + 1], set.restLength[set.segment(g0 + l, j)]);
+                    x[j + 1] = place(x[j], x[j + 1], set.restLength[set.segment(g0 + l, j)]);
                 }
         }
     }
