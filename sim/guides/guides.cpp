@@ -187,10 +187,19 @@ struct GuideSolver::Impl final : solver::StrandModel {
     /// clearance and computes velocities from positions, so the volume push
     /// adds no velocity.
     void couple(const solver::Substep& sub) {
+        // Copied in chunks on the threads where there is enough to copy
+        // (a serial copy costs both threads its time; a parallel one of a
+        // few thousand vertices costs more in waking the other thread).
+        constexpr size_t kParallelCopy = 8192;
         beforePush.resize(set.x.size());
-        skeleton.parallel(set.x.size(), std::max<size_t>(1024, set.x.size() / 8), [&](size_t b, size_t e) {
-            std::copy(set.x.begin() + std::ptrdiff_t(b), set.x.begin() + std::ptrdiff_t(e), beforePush.begin() + std::ptrdiff_t(b));
-        });
+        if (set.x.size() < kParallelCopy) {
+            std::copy(set.x.begin(), set.x.end(), beforePush.begin());
+        } else {
+            skeleton.parallel(set.x.size(), set.x.size() / 8, [&](size_t b, size_t e) {
+                std::copy(set.x.begin() + std::ptrdiff_t(b), set.x.begin() + std::ptrdiff_t(e),
+                          beforePush.begin() + std::ptrdiff_t(b));
+            });
+        }
         volume::GridInput in;
         in.x = set.x.data();
         in.v = set.v.data();

@@ -275,7 +275,7 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     // The node array is all zeros between calls (apply() clears the nodes it
     // used before returning), so only growth costs a fill.
     if (nodes_.size() < stored) nodes_.resize(stored, Eigen::Vector4f::Zero());
-    st.nodes = stored;
+    st.storedNodes = stored;
 
     // Even slabs, then odd slabs: each writes node planes k and k+1 only
     // (their rows lie in that order in the node array, so apart from other

@@ -52,11 +52,18 @@
 // cells every step.
 //
 // Cost: every pass walks the sorted order, with each vertex's cell and
-// (m, v) copied into it, so the nodes a pass touches stay in the cache and
-// its own data streams; a node holds (M, P) only (λ_c = M_c·ℓ/m/Δ³: every
-// vertex carries the same hair length per mass); friction and the density
-// scan share one pass; the volume step sweeps a list of the nodes with
-// hair. Measured in docs/benchmarks.md ("B-sim with the hair-hair grid").
+// (m, v) written into it by the sort, so the nodes a pass touches stay in
+// the cache and its own data streams; the sort counts and scatters in
+// chunks on the threads (a stable sort's result is unique). A node holds
+// (M, P) only (λ_c = M_c·ℓ/m/Δ³: every vertex carries the same hair length
+// per mass), and only the nodes the vertices reach are stored, row by row
+// over each row's x span. After the splat one scan of the stored nodes
+// finds the densest node and the box above the target, the volume step
+// sweeps the nodes with hair in that box from a list holding each one's
+// neighbours, and one pass over the vertices reads each vertex's eight
+// nodes once for friction, the density it reads and the push (SSE lanes
+// doing the scalar operations in the scalar order: the same bits).
+// Measured in docs/benchmarks.md ("B-sim with the hair-hair grid").
 #pragma once
 
 #include "sim/volume/excess_diffusion.h"
@@ -89,7 +96,8 @@ struct GridInput {
 /// What one apply() did (diagnostics and tests).
 struct GridStats {
     float cellSize = 0.f;           ///< Δ used, m (coarser than the setting when the hair spreads too far)
-    size_t nodes = 0;
+    size_t nodes = 0;               ///< nodes of the box round the hair
+    size_t storedNodes = 0;         ///< of those, the nodes stored: those the vertices reach (hair_grid.cpp)
     float maxDensity = 0.f;         ///< largest density of a node a vertex reads, hairs per cm²
     size_t pushed = 0;              ///< vertices the volume step moved
 };
