@@ -65,9 +65,10 @@ void jacobiSweep(const NodeBox& box, const float* e, const uint8_t* occupied, fl
 /// The occupied nodes the sweeps visit and their excess e, listed plane by
 /// plane (plane k's at [first[k], first[k] + count[k])), each with the
 /// indices of its six neighbours (x−, x+, y−, y+, z−, z+) in the value
-/// arrays. A neighbour outside the grid (or the box) is the `zero` slot,
-/// which stays 0: adding it to the sum adds nothing, not even a sign (the
-/// sum starts at +0 and every E is ≥ 0). Reused call after call.
+/// arrays. A neighbour that does not exist (outside the grid) is the
+/// `zero` slot, and one not listed holds 0 too: adding either to the sum
+/// adds nothing, not even a sign (the sum starts at +0 and every E is ≥ 0),
+/// so the values are those of skipping it. Reused call after call.
 struct OccupiedNodes {
     std::vector<uint32_t> node;                      ///< value index of the listed node
     std::vector<std::array<uint32_t, 6>> neighbour;  ///< value indices of its neighbours
@@ -97,7 +98,9 @@ struct OccupiedNodes {
 /// nodes are the listed ones.
 void relaxListed(OccupiedNodes& list, float c, int sweeps, float* out, const ParallelFor& parallel);
 
-/// relaxListed on the nodes with occupied[n] != 0 and excess e[n].
+/// relaxListed on the nodes with occupied[n] != 0 and excess e[n] of a
+/// box (value slots: the box's nodes, then the zero slot); `out` receives
+/// box.size() values.
 void relaxExcess(const NodeBox& box, const float* e, const uint8_t* occupied, float c, int sweeps, float* out,
                  OccupiedNodes& scratch, const ParallelFor& parallel);
 
