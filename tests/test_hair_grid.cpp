@@ -136,6 +136,29 @@ TEST(HairGrid, MeasuresHairLengthPerVolume) {
     EXPECT_NEAR(st.maxDensity, expected, 1e-4 * expected);
 }
 
+TEST(HairGrid, MeasuresTheNodeTheWeightsFavour) {
+    // N vertices at one point: the grid's lattice starts at the cell
+    // holding it (origin ⌊p/Δ⌋·Δ), so its trilinear fractions are
+    // t = p/Δ − ⌊p/Δ⌋ and the densest node is the corner of largest weight,
+    // here (i + 1, j, k + 1) with w = tx·(1 − ty)·tz, holding N·m·w of
+    // mass: density N·m·(ℓ/m)·w/Δ³. That corner lies at the far x end of
+    // its row, where the grid stores one node beyond the vertices' cells.
+    const float d = 0.01f, mass = 1e-6f, lengthPerMass = 2e4f;
+    const Vec3f t(0.9f, 0.2f, 0.7f), p = d * (Vec3f(12.f, 5.f, 23.f) + t);
+    const size_t n = 100;
+    std::vector<Vec3f> x(n, p), v(n, Vec3f::Zero());
+    std::vector<float> m(n, mass);
+    GridInput in = gridInput(x, v, m, lengthPerMass, 0.01f);
+    VolumeSettings s = frictionOnly(0.f);
+    s.cellSize = d;
+    HairGrid grid(s);
+    const volume::GridStats st = grid.apply(in, reversedFor);
+    const Eigen::Vector3d f = (p.cast<double>() / double(d)).array() - (p.cast<double>() / double(d)).array().floor();
+    const double w = f.x() * (1.0 - f.y()) * f.z();
+    const double expected = double(n) * mass * lengthPerMass * w / (double(d) * d * d) * 1e-4;  // hairs per cm²
+    EXPECT_NEAR(st.maxDensity, expected, 1e-4 * expected);
+}
+
 TEST(HairGrid, VolumeStepSpreadsADenseBlobAndLeavesThinHairAlone) {
     Cloud c(3000);
     for (Vec3f& p : c.x) p *= 0.5f;  // a 3 cm blob

@@ -157,13 +157,49 @@ struct GuideSolver::Impl final : solver::StrandModel {
                                  set.settings.collisionRadius);
     }
 
+    /// relax(g, nullptr) on guides [b, e): lengths restored root to tip
+    /// (follow the leader), the same moves, four guides interleaved: each
+    /// guide is a chain of dependent square roots and divisions, and
+    /// independent guides between them keep the divider busy.
+    void restoreLengths(size_t b, size_t e) {
+        // strand::followTheLeader's move, inline here so that the four
+        // guides' square roots and divisions overlap (the same operations,
+        // so the same bits).
+        auto place = [](const Vec3f& parent, const Vec3f& child, float length) {
+            const Vec3f d = child - parent;
+            const float len = d.norm();
+            return len > 1e-12f ? Vec3f(parent + d * (length / len)) : Vec3f(parent + Vec3f::UnitY() * length);
+        };
+        constexpr size_t kInterleave = 4;
+        for (size_t g0 = b; g0 < e; g0 += kInterleave) {
+            const size_t lanes = std::min(kInterleave, e - g0);
+            for (int j = 0; j < set.segments; ++j)
+                for (size_t l = 0; l < lanes; ++l) {
+                    Vec3f* x = &set.x[set.vertex(g0 + l, 0)];
+                    x[j + 1] = place(x[j], x[j + 1], set.restLength[set.segment(g0 + l, j)]);
+                }
+        }
+    }
+
     /// Hair against hair: the grid's friction and volume on the state the
     /// substep starts from (sim/volume/hair_grid.h), the pushed guides'
     /// lengths restored at once; the formulation's step then restores
     /// clearance and computes velocities from positions, so the volume push
     /// adds no velocity.
     void couple(const solver::Substep& sub) {
-        beforePush = set.x;
+        // Copied in chunks on the threads where there is enough to copy
+        // (a serial copy costs both threads its time; a parallel one of a
+        // few thousand vertices costs more in waking the other thread).
+        constexpr size_t kParallelCopy = 8192;
+        beforePush.resize(set.x.size());
+        if (set.x.size() < kParallelCopy) {
+            std::copy(set.x.begin(), set.x.end(), beforePush.begin());
+        } else {
+            skeleton.parallel(set.x.size(), set.x.size() / 8, [&](size_t b, size_t e) {
+                std::copy(set.x.begin() + std::ptrdiff_t(b), set.x.begin() + std::ptrdiff_t(e),
+                          beforePush.begin() + std::ptrdiff_t(b));
+            });
+        }
         volume::GridInput in;
         in.x = set.x.data();
         in.v = set.v.data();
@@ -187,7 +223,7 @@ struct GuideSolver::Impl final : solver::StrandModel {
             // substeps, 2% / 4% with it (tests/test_hair_grid.cpp). Lengths
             // only: the step restores the head's clearance.
             forGroups([&](guides::GuideGroup& grp) {
-                for (size_t g = grp.begin(); g < grp.end(); ++g) relax(g, nullptr);
+                restoreLengths(grp.begin(), grp.end());
                 grp.displaced(beforePush.data());  // reads and moves only this group's vertices
             });
         }

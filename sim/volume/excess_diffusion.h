@@ -37,6 +37,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -61,61 +62,45 @@ struct NodeBox {
 void jacobiSweep(const NodeBox& box, const float* e, const uint8_t* occupied, float c, const float* in, float* out,
                  int k0, int k1);
 
-/// The occupied nodes of a box and their excess e, listed plane by plane
-/// (plane k's at [k·plane, k·plane + count[k]), ascending): what the sweeps
-/// visit. Reused call after call.
+/// The occupied nodes the sweeps visit and their excess e, listed plane by
+/// plane (plane k's at [first[k], first[k] + count[k])), each with the
+/// indices of its six neighbours (x−, x+, y−, y+, z−, z+) in the value
+/// arrays. A neighbour that does not exist (outside the grid) is the
+/// `zero` slot, and one not listed holds 0 too: adding either to the sum
+/// adds nothing, not even a sign (the sum starts at +0 and every E is ≥ 0),
+/// so the values are those of skipping it. Reused call after call.
 struct OccupiedNodes {
-    NodeBox box;
-    std::vector<uint32_t> node;     ///< box index
-    std::vector<uint8_t> inside;    ///< its neighbours in the box (bits −x, +x, −y, +y, −z, +z)
-    std::vector<float> excess;      ///< e there
-    std::vector<uint32_t> count;    ///< per plane
-    std::vector<float> values;      ///< the sweeps' second buffer
+    std::vector<uint32_t> node;                      ///< value index of the listed node
+    std::vector<std::array<uint32_t, 6>> neighbour;  ///< value indices of its neighbours
+    std::vector<float> excess;                       ///< e there
+    std::vector<uint32_t> first, count;              ///< per plane
+    size_t values = 0;                               ///< entries of a value array, the zero slot included
+    uint32_t zero = 0;                               ///< the slot that stays 0
+    std::vector<float> scratch;                      ///< the sweeps' second buffer
 
-    /// Sizes the lists for `b` (counts 0).
-    void reset(const NodeBox& b);
-    /// Lists node (i, j, k) of the box, excess e; within a plane in
-    /// ascending order, any plane from one thread at a time.
-    void add(int i, int j, int k, float e) {
-        const size_t plane = size_t(box.nx) * size_t(box.ny);
-        const size_t t = size_t(k) * plane + count[size_t(k)]++;
-        node[t] = uint32_t(size_t(k) * plane + size_t(j) * size_t(box.nx) + size_t(i));
-        inside[t] = uint8_t(unsigned(i > 0) | unsigned(i + 1 < box.nx) << 1 | unsigned(j > 0) << 2 |
-                            unsigned(j + 1 < box.ny) << 3 | unsigned(k > 0) << 4 | unsigned(k + 1 < box.nz) << 5);
+    /// Sizes the lists: `planes` planes, plane k's room from start[k] to
+    /// start[k + 1] (start has planes + 1 entries), counts 0; value arrays
+    /// of `valueCount` entries with slot `zeroSlot` kept 0.
+    void reset(size_t planes, const uint32_t* start, size_t valueCount, uint32_t zeroSlot);
+    /// Lists a node of plane k (any plane from one thread at a time).
+    void add(size_t k, uint32_t at, const std::array<uint32_t, 6>& around, float e) {
+        const size_t t = first[k] + count[k]++;
+        node[t] = at;
+        neighbour[t] = around;
         excess[t] = e;
-    }
-    /// Lists the nodes with m > 0 of row (j, k) of the box, excess
-    /// max(0, m·toRatio − 1), from x-row `m` (box.nx values, stride
-    /// `stride` floats); rows of a plane in ascending order, any plane from
-    /// one thread at a time.
-    void addRow(int j, int k, const float* m, size_t stride, float toRatio) {
-        const size_t plane = size_t(box.nx) * size_t(box.ny), first = size_t(k) * plane;
-        size_t t = first + count[size_t(k)];
-        uint32_t* nd = node.data();
-        uint8_t* in = inside.data();
-        float* ex = excess.data();
-        const unsigned jk = unsigned(j > 0) << 2 | unsigned(j + 1 < box.ny) << 3 | unsigned(k > 0) << 4 |
-                            unsigned(k + 1 < box.nz) << 5;
-        const uint32_t row = uint32_t(first + size_t(j) * size_t(box.nx));
-        for (int i = 0; i < box.nx; ++i) {
-            const float mi = m[size_t(i) * stride];
-            if (!(mi > 0.f)) continue;
-            nd[t] = row + uint32_t(i);
-            in[t] = uint8_t(jk | unsigned(i > 0) | unsigned(i + 1 < box.nx) << 1);
-            ex[t++] = std::max(0.f, mi * toRatio - 1.f);
-        }
-        count[size_t(k)] = uint32_t(t - first);
     }
 };
 
 /// E after `sweeps` Jacobi sweeps from E⁰ = 0 (the file comment) on the
-/// listed nodes, 0 on the others; the planes of each sweep run through
-/// `parallel`; `out` receives E (box.size() values). The same values, term
-/// by term, as jacobiSweep over the whole box with the nodes listed as the
-/// occupied ones.
+/// listed nodes, 0 in every other slot; the planes of each sweep run
+/// through `parallel`; `out` receives E (list.values entries). The same
+/// values, term by term, as jacobiSweep over a whole box whose occupied
+/// nodes are the listed ones.
 void relaxListed(OccupiedNodes& list, float c, int sweeps, float* out, const ParallelFor& parallel);
 
-/// relaxListed on the nodes with occupied[n] != 0 and excess e[n].
+/// relaxListed on the nodes with occupied[n] != 0 and excess e[n] of a
+/// box (value slots: the box's nodes, then the zero slot); `out` receives
+/// box.size() values.
 void relaxExcess(const NodeBox& box, const float* e, const uint8_t* occupied, float c, int sweeps, float* out,
                  OccupiedNodes& scratch, const ParallelFor& parallel);
 

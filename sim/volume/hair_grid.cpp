@@ -5,9 +5,12 @@
 #include "sim/volume/excess_diffusion.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <emmintrin.h>
 
 namespace hp {
 
@@ -46,12 +49,15 @@ constexpr float kMaxPush = 0.5f;
 /// at the default c = 0.43, so 0.73 at 4 sweeps. Measured on the ball and
 /// the crossing wisps (BDF2): 1 sweep 338 hairs/cm², 0.5% energy gain;
 /// 4 sweeps 338, 1.5%; 8 sweeps 300, 1.6% (lengths then restored by the step).
+/// With the lengths restored with the push, one sweep (E = e/(1 + 6c), read
+/// straight from the nodes) left the ball at 300 and the energy lower, but
+/// the default shot's hair did not come to rest after the head stopped
+/// (ShotSimulation.HairHangsUnderGravityAndSwingsWithTheHead: 10.5 m/s at
+/// frame 120; 2 sweeps 0.30, 3 sweeps 1.19, 4 sweeps 0.016 m/s), so 4 stay.
 constexpr int kSweeps = 4;
 
-/// Lattices of at most this many nodes per gridded vertex are cleared
-/// with one memset (845 B-sim guides: 20k vertices on 100k-180k nodes; the
-/// memset took half the time of clearing each vertex's eight nodes).
-constexpr size_t kClearByFill = 32;
+/// Chunks of the counting sort by node row (any number gives the same order).
+constexpr size_t kSortChunks = 8;
 /// Vertices below which apply() runs on the calling thread.
 constexpr size_t kParallelVertices = 8192;
 
@@ -75,10 +81,22 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
         if (serial) f(0, count);
         else parallel(count, f);
     };
-    // Head-local positions are computed where they are read (twice: cheaper
-    // than storing and loading them).
-    const Eigen::Isometry3f toLocal = in.head.inverse();
-    auto valid = [&](size_t i, const Vec3f& p) { return in.mass[i] > 0.f && p.allFinite(); };
+    // Head-local positions are computed where they are read (three times:
+    // cheaper than storing and loading them), in SSE from the inverse's
+    // columns, p = ((c0·x + c1·y) + c2·z) + c3: the order Eigen's
+    // Isometry3f product adds in, so the same bits.
+    const Eigen::Matrix4f toLocal = in.head.inverse().matrix();
+    const __m128 col[4] = {_mm_loadu_ps(toLocal.data()), _mm_loadu_ps(toLocal.data() + 4),
+                           _mm_loadu_ps(toLocal.data() + 8), _mm_loadu_ps(toLocal.data() + 12)};
+    auto local = [&col](const Vec3f& x) {
+        return _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(col[0], _mm_set1_ps(x.x())), _mm_mul_ps(col[1], _mm_set1_ps(x.y()))),
+                                     _mm_mul_ps(col[2], _mm_set1_ps(x.z()))),
+                          col[3]);
+    };
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f);
+    auto valid = [&](size_t i, __m128 p) {  // a mass, and x, y, z finite (p − p is 0, not NaN)
+        return in.mass[i] > 0.f && (_mm_movemask_ps(_mm_cmpord_ps(_mm_sub_ps(p, p), zero)) & 7) == 7;
+    };
 
     // Head-local positions and their bounds (min and max do not depend on
     // the order or the chunks).
@@ -88,14 +106,17 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
         bound[3 + a] = -INFINITY;
     }
     run(n, [&](size_t b, size_t e) {
-        Vec3f lo = Vec3f::Constant(INFINITY), hi = Vec3f::Constant(-INFINITY);
+        __m128 lo4 = _mm_set1_ps(INFINITY), hi4 = _mm_set1_ps(-INFINITY);
         for (size_t i = b; i < e; ++i) {
-            const Vec3f p = toLocal * in.x[i];
+            const __m128 p = local(in.x[i]);
             if (valid(i, p)) {
-                lo = lo.cwiseMin(p);
-                hi = hi.cwiseMax(p);
+                lo4 = _mm_min_ps(lo4, p);
+                hi4 = _mm_max_ps(hi4, p);
             }
         }
+        alignas(16) float lo[4], hi[4];
+        _mm_store_ps(lo, lo4);
+        _mm_store_ps(hi, hi4);
         for (int a = 0; a < 3; ++a) {
             for (float m = bound[a].load(); lo[a] < m && !bound[a].compare_exchange_weak(m, lo[a]);) {
             }
@@ -122,31 +143,24 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     st.cellSize = d;
     st.nodes = nodes;
     const float invD = 1.f / d;
-    auto index = [nx, ny](int i, int j, int k) {
-        return (size_t(k) * size_t(ny) + size_t(j)) * size_t(nx) + size_t(i);
+    // A vertex's base node (i, j, k) and trilinear fractions t: f = (p −
+    // origin)/Δ, base min(max(f, 0), n − 2) truncated (f in (−1, 0), from
+    // rounding below the origin, gives 0 like a clamped int(f)), t =
+    // clamp(f − base, 0, 1); lane by lane, so the same bits as scalar code.
+    const __m128 origin4 = _mm_setr_ps(origin.x(), origin.y(), origin.z(), 0.f);
+    const __m128 top = _mm_setr_ps(float(nx - 2), float(ny - 2), float(nz - 2), 0.f);
+    auto locate = [=](__m128 p, __m128& t) {
+        const __m128 f = _mm_mul_ps(_mm_sub_ps(p, origin4), _mm_set1_ps(invD));
+        const __m128i base = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(f, zero), top));
+        t = _mm_min_ps(_mm_max_ps(_mm_sub_ps(f, _mm_cvtepi32_ps(base)), zero), one);
+        return base;
     };
-    // Written field by field into the array: a Cell built on the stack and
-    // copied whole stalled on store forwarding (perf: 70% of this pass).
-    auto cellOf = [&](size_t i, const Vec3f& p, Cell& c) {
-        const Vec3f f = (p - origin) * invD;
-        // int() truncates: floor for f ≥ 0, and f > −1 (rounding below the
-        // origin) gives 0 either way after the clamp, with t clamped to 0.
-        c.i = std::clamp(int(f.x()), 0, nx - 2);
-        c.j = std::clamp(int(f.y()), 0, ny - 2);
-        c.k = std::clamp(int(f.z()), 0, nz - 2);
-        c.tx = std::clamp(f.x() - float(c.i), 0.f, 1.f);
-        c.ty = std::clamp(f.y() - float(c.j), 0.f, 1.f);
-        c.tz = std::clamp(f.z() - float(c.k), 0.f, 1.f);
-        c.node = uint32_t(index(c.i, c.j, c.k));
-        c.vertex = uint32_t(i);
+    auto laneOf = [](__m128i v, int lane) {
+        return _mm_cvtsi128_si32(lane == 0 ? v : lane == 1 ? _mm_shuffle_epi32(v, 0x55) : _mm_shuffle_epi32(v, 0xaa));
     };
-
-    // The node array is all zeros between calls (apply() clears the nodes it
-    // touched before returning), so only growth costs a fill.
-    if (nodes_.size() < nodes) nodes_.resize(nodes, Eigen::Vector4f::Zero());
 
     // Vertices by the node row (j, k) of their base node, in vertex order
-    // within a row (a stable counting sort), their cells and (m, v) copied
+    // within a row (a stable counting sort), their cells and (m, v) written
     // in that order. Every pass walks it: neighbouring entries read and
     // write the same few rows of nodes and read their own data in a stream
     // (in vertex order the guides cross the lattice, and every vertex's
@@ -155,68 +169,157 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     // slab is a contiguous range.
     const size_t rows = size_t(ny) * size_t(nz);
     constexpr uint32_t kNone = ~0u;
-    vertexCells_.resize(n);
     rowOf_.resize(n);
-    run(n, [&](size_t b, size_t e) {
-        for (size_t i = b; i < e; ++i) {
-            const Vec3f p = toLocal * in.x[i];
-            if (!valid(i, p)) {
-                rowOf_[i] = kNone;
-                continue;
+    // The counting sort in chunks of vertices: each chunk counts its rows,
+    // the offsets interleave the chunks row by row, then each chunk writes
+    // its vertices' entries straight to their places (the cell found again:
+    // cheaper than storing it). A stable sort's result is unique, so the
+    // chunks change nothing but the time.
+    const size_t chunks = serial ? 1 : kSortChunks;
+    auto chunkBegin = [&](size_t ch) { return n * ch / chunks; };
+    rowCount_.assign(chunks * rows, 0u);  // chunk-major: chunks on two threads share no cache line
+    run(chunks, [&](size_t cb, size_t ce) {
+        for (size_t ch = cb; ch < ce; ++ch) {
+            uint32_t* count = rowCount_.data() + ch * rows;
+            for (size_t i = chunkBegin(ch), end = chunkBegin(ch + 1); i < end; ++i) {
+                const __m128 p = local(in.x[i]);
+                if (!valid(i, p)) {
+                    rowOf_[i] = kNone;
+                    continue;
+                }
+                __m128 t;
+                const __m128i base = locate(p, t);
+                const uint32_t r = uint32_t(size_t(laneOf(base, 2)) * size_t(ny) + size_t(laneOf(base, 1)));
+                rowOf_[i] = r;
+                ++count[r];
             }
-            Cell& c = vertexCells_[i];
-            cellOf(i, p, c);
-            rowOf_[i] = uint32_t(size_t(c.k) * size_t(ny) + size_t(c.j));
         }
     });
-    rowStart_.assign(rows + 1, 0u);
-    for (size_t i = 0; i < n; ++i)
-        if (rowOf_[i] != kNone) ++rowStart_[rowOf_[i] + 1];
-    for (size_t r = 0; r < rows; ++r) rowStart_[r + 1] += rowStart_[r];
-    const size_t gridded = rowStart_[rows];
-    fill_.assign(rowStart_.begin(), rowStart_.end() - 1);
-    cells_.resize(gridded);
-    for (size_t i = 0; i < n; ++i)
-        if (rowOf_[i] != kNone) cells_[fill_[rowOf_[i]]++].vertex = uint32_t(i);
-    massVel_.resize(gridded);
-    run(gridded, [&](size_t b, size_t e) {
-        for (size_t o = b; o < e; ++o) {
-            const size_t i = cells_[o].vertex;
-            cells_[o] = vertexCells_[i];
-            massVel_[o] = Eigen::Vector4f(in.mass[i], in.v[i].x(), in.v[i].y(), in.v[i].z());
+    rowStart_.resize(rows + 1);
+    uint32_t total = 0;
+    for (size_t r = 0; r < rows; ++r) {
+        rowStart_[r] = total;
+        for (size_t ch = 0; ch < chunks; ++ch) {
+            uint32_t& at = rowCount_[ch * rows + r];
+            const uint32_t count = at;
+            at = total;  // now chunk ch's next place in row r
+            total += count;
+        }
+    }
+    rowStart_[rows] = total;
+    const size_t gridded = total;
+    entries_.resize(gridded);
+    order_.resize(gridded);
+    run(chunks, [&](size_t cb, size_t ce) {
+        for (size_t ch = cb; ch < ce; ++ch) {
+            uint32_t* at = rowCount_.data() + ch * rows;
+            for (size_t i = chunkBegin(ch), end = chunkBegin(ch + 1); i < end; ++i) {
+                if (rowOf_[i] == kNone) continue;
+                const uint32_t o = at[rowOf_[i]]++;
+                __m128 t;
+                const __m128i base = locate(local(in.x[i]), t);
+                Entry& en = entries_[o];
+                // t and i in one 16-byte store's place (__m128 may alias):
+                // lane 3 is overwritten by i next.
+                _mm_store_ps(reinterpret_cast<float*>(&en), t);
+                en.i = laneOf(base, 0);
+                en.mv = Eigen::Vector4f(in.mass[i], in.v[i].x(), in.v[i].y(), in.v[i].z());
+                order_[o] = uint32_t(i);
+            }
         }
     });
-    auto slabStart = [&](size_t k) { return rowStart_[k * size_t(ny)]; };
 
-    // Even slabs, then odd slabs: each writes node planes k and k+1 only.
-    auto bySlab = [&](auto&& body) {  // body(first, end) over a slab's range of the order
+    // The nodes the vertices can touch, stored row by row: node row (j, k)
+    // holds the x span its four base rows (j − 1..j, k − 1..k) reach, i_min
+    // to i_max + 1, so a node is N[rowBase[row] + i]. On B-sim's 845 guides
+    // this stores 42% of the box's nodes (rod: 30,300 of 72,813; rope,
+    // its hair standing out from the sphere: 51% of 181,476); the splat,
+    // the gathers and the clear then touch less memory. The sums are the
+    // same, term by term, as on the whole box.
+    spanLo_.assign(rows, std::numeric_limits<int>::max());
+    spanHi_.assign(rows, -1);
+    run(rows, [&](size_t b, size_t e) {
+        for (size_t r = b; r < e; ++r) {
+            int ilo = std::numeric_limits<int>::max(), ihi = -1;
+            for (size_t o = rowStart_[r]; o < rowStart_[r + 1]; ++o) {
+                ilo = std::min(ilo, entries_[o].i);
+                ihi = std::max(ihi, entries_[o].i);
+            }
+            spanLo_[r] = ilo;
+            spanHi_[r] = ihi;
+        }
+    });
+    rowBase_.resize(rows);
+    rowLo_.resize(rows);
+    rowEnd_.resize(rows);
+    planeStart_.resize(size_t(nz) + 1);
+    size_t stored = 0;
+    for (size_t r = 0; r < rows; ++r) {
+        const size_t j = r % size_t(ny), k = r / size_t(ny);
+        if (j == 0) planeStart_[k] = uint32_t(stored);
+        int ilo = spanLo_[r], ihi = spanHi_[r];  // base rows (j, k), (j − 1, k), (j, k − 1), (j − 1, k − 1)
+        if (j > 0) ilo = std::min(ilo, spanLo_[r - 1]), ihi = std::max(ihi, spanHi_[r - 1]);
+        if (k > 0) ilo = std::min(ilo, spanLo_[r - size_t(ny)]), ihi = std::max(ihi, spanHi_[r - size_t(ny)]);
+        if (j > 0 && k > 0) ilo = std::min(ilo, spanLo_[r - size_t(ny) - 1]), ihi = std::max(ihi, spanHi_[r - size_t(ny) - 1]);
+        if (ihi < 0) {
+            rowBase_[r] = 0;  // no vertex reaches this row
+            rowLo_[r] = rowEnd_[r] = 0;
+            continue;
+        }
+        rowBase_[r] = ptrdiff_t(stored) - ilo;
+        rowLo_[r] = ilo;
+        rowEnd_[r] = ihi + 2;  // i_min .. i_max + 1
+        stored += size_t(ihi + 2 - ilo);
+    }
+    planeStart_[size_t(nz)] = uint32_t(stored);
+    // The node array is all zeros between calls (apply() clears the nodes it
+    // used before returning), so only growth costs a fill.
+    if (nodes_.size() < stored) nodes_.resize(stored, Eigen::Vector4f::Zero());
+    st.storedNodes = stored;
+
+    // Even slabs, then odd slabs: each writes node planes k and k+1 only
+    // (their rows lie in that order in the node array, so apart from other
+    // slabs of its parity).
+    auto bySlab = [&](auto&& body) {  // body(first row, end row) of a slab's base rows
         for (int parity = 0; parity < 2; ++parity) {
             const size_t slabs = size_t(std::max(0, (nz - parity) / 2));
             run(slabs, [&](size_t b, size_t e) {
                 for (size_t sl = b; sl < e; ++sl) {
                     const size_t k = 2 * sl + size_t(parity);
-                    body(size_t(slabStart(k)), size_t(slabStart(k + 1)));
+                    body(k * size_t(ny), (k + 1) * size_t(ny));
                 }
             });
         }
     };
     Eigen::Vector4f* const N = nodes_.data();
-    const Cell* const C = cells_.data();
-    const size_t sx = size_t(nx);
+    const Entry* const C = entries_.data();
+    const uint32_t* const vertexOf = order_.data();
+    const ptrdiff_t* const RB = rowBase_.data();
+    const uint32_t* const RS = rowStart_.data();
+    const size_t sy = size_t(ny);
 
     // Splat: w·(m, m·v) on the eight nodes.
-    bySlab([&, N, C, sx, plane](size_t first, size_t end) {
-        for (size_t o = first; o < end; ++o) {
-            const Cell& c = C[o];
-            const float m = massVel_[o][0];
-            const Eigen::Vector4f mp(m, m * massVel_[o][1], m * massVel_[o][2], m * massVel_[o][3]);
-            const float wx[2] = {1.f - c.tx, c.tx}, wy[2] = {1.f - c.ty, c.ty}, wz[2] = {1.f - c.tz, c.tz};
-            for (int dk = 0; dk < 2; ++dk)
-                for (int dj = 0; dj < 2; ++dj) {
-                    Eigen::Vector4f* row = N + c.node + size_t(dk) * plane + size_t(dj) * sx;
-                    const float wyz = wy[dj] * wz[dk];
-                    for (int di = 0; di < 2; ++di) row[di] += (wx[di] * wyz) * mp;
-                }
+    bySlab([&, N, C, RB, RS, sy](size_t firstRow, size_t endRow) {
+        for (size_t r = firstRow; r < endRow; ++r)
+        for (size_t o = RS[r]; o < RS[r + 1]; ++o) {
+            const Entry& c = C[o];
+            // mp = (m, m·v) and w = wx·(wy·wz) for the four nodes of a
+            // plane (lane di + 2·dj), lane by lane as scalar code would.
+            const float m = c.mv[0];
+            const __m128 mp = _mm_mul_ps(_mm_load_ps(c.mv.data()), _mm_setr_ps(1.f, m, m, m));
+            const __m128 wx = _mm_setr_ps(1.f - c.t[0], c.t[0], 1.f - c.t[0], c.t[0]);
+            const __m128 wy = _mm_setr_ps(1.f - c.t[1], 1.f - c.t[1], c.t[1], c.t[1]);
+            const float wz[2] = {1.f - c.t[2], c.t[2]};
+            for (int dk = 0; dk < 2; ++dk) {
+                const __m128 w = _mm_mul_ps(wx, _mm_mul_ps(wy, _mm_set1_ps(wz[dk])));
+                float* row0 = N[RB[r + size_t(dk) * sy] + c.i].data();
+                float* row1 = N[RB[r + size_t(dk) * sy + 1] + c.i].data();
+                float* at[4] = {row0, row0 + 4, row1, row1 + 4};
+                _mm_store_ps(at[0], _mm_add_ps(_mm_load_ps(at[0]), _mm_mul_ps(_mm_shuffle_ps(w, w, 0x00), mp)));
+                _mm_store_ps(at[1], _mm_add_ps(_mm_load_ps(at[1]), _mm_mul_ps(_mm_shuffle_ps(w, w, 0x55), mp)));
+                _mm_store_ps(at[2], _mm_add_ps(_mm_load_ps(at[2]), _mm_mul_ps(_mm_shuffle_ps(w, w, 0xaa), mp)));
+                _mm_store_ps(at[3], _mm_add_ps(_mm_load_ps(at[3]), _mm_mul_ps(_mm_shuffle_ps(w, w, 0xff), mp)));
+            }
         }
     });
 
@@ -224,10 +327,13 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     // r = M·lengthPerMass/(Δ³·λ₀), λ₀ from hairs per cm² to per m².
     const float toRatio = in.lengthPerMass / (d * d * d * s_.targetDensity * 1e4f);
     const float s = blendFraction(in.h), cPush = pushFraction(in.h), push = cPush * d * d;
+    const Eigen::Matrix3f R = in.head.linear();
+    const int* const RL = rowLo_.data();
+    const int* const RE = rowEnd_.data();
 
-    // Friction, and the density each vertex reads: the densest node a
-    // vertex reads and the box of nodes above the target (minima and
-    // maxima: the same whatever the order), in one pass over the nodes.
+    // The densest node and the box of nodes above the target (minima and
+    // maxima: the same whatever the order), plane by plane over the stored
+    // nodes: every node with hair is a node some vertex reads.
     std::atomic<float> maxR{0.f};
     std::atomic<int> boxLo[3] = {nx, ny, nz}, boxHi[3] = {-1, -1, -1};
     auto lower = [](std::atomic<int>& a, int v) {
@@ -238,44 +344,23 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
         for (int m = a.load(); v > m && !a.compare_exchange_weak(m, v);) {
         }
     };
-    ratio_.resize(gridded);
-    run(gridded, [&, N, C, sx, plane, toRatio, s](size_t b, size_t e) {
+    run(size_t(nz), [&, N, RB, RL, RE, toRatio](size_t b, size_t e) {
         float localMax = 0.f;
         int lo3[3] = {nx, ny, nz}, hi3[3] = {-1, -1, -1};
-        for (size_t o = b; o < e; ++o) {
-            const Cell& c = C[o];
-            const float wx[2] = {1.f - c.tx, c.tx}, wy[2] = {1.f - c.ty, c.ty}, wz[2] = {1.f - c.tz, c.tz};
-            Eigen::Vector4f V = Eigen::Vector4f::Zero();  // (Σ w, V̄): lane 0 unused
-            float r = 0.f, cornerMax = 0.f;
-            unsigned above = 0;  // bit di + 2·dj + 4·dk: that node is above the target
-            for (int dk = 0; dk < 2; ++dk)
-                for (int dj = 0; dj < 2; ++dj) {
-                    const Eigen::Vector4f* row = N + c.node + size_t(dk) * plane + size_t(dj) * sx;
-                    for (int di = 0; di < 2; ++di) {
-                        const Eigen::Vector4f& nd = row[di];
-                        const float w = wx[di] * wy[dj] * wz[dk];
-                        if (nd[0] > 0.f) V += (w / nd[0]) * nd;
-                        const float ratio = nd[0] * toRatio;
-                        r += w * ratio;
-                        cornerMax = std::max(cornerMax, ratio);
-                        above |= unsigned(ratio > 1.f) << (di + 2 * dj + 4 * dk);
+        for (size_t k = b; k < e; ++k)
+            for (int j = 0; j < ny; ++j) {
+                const size_t r = k * size_t(ny) + size_t(j);
+                for (int i = RL[r]; i < RE[r]; ++i) {
+                    const float ratio = N[RB[r] + i][0] * toRatio;
+                    localMax = std::max(localMax, ratio);
+                    if (!(ratio > 1.f)) continue;
+                    const int at[3] = {i, j, int(k)};
+                    for (int a = 0; a < 3; ++a) {
+                        lo3[a] = std::min(lo3[a], at[a]);
+                        hi3[a] = std::max(hi3[a], at[a]);
                     }
                 }
-            const Vec3f v = massVel_[o].tail<3>();
-            in.v[c.vertex] = v + s * (V.tail<3>() - v);
-            ratio_[o] = r;
-            localMax = std::max(localMax, cornerMax);
-            if (above) {
-                // Per axis: the low face holds an above-target node if any
-                // node with offset 0 does, the high face if any with 1 does.
-                constexpr unsigned low[3] = {0x55, 0x33, 0x0f};
-                const int at[3] = {c.i, c.j, c.k};
-                for (int a = 0; a < 3; ++a) {
-                    lo3[a] = std::min(lo3[a], (above & low[a]) ? at[a] : at[a] + 1);
-                    hi3[a] = std::max(hi3[a], (above & ~low[a] & 0xff) ? at[a] + 1 : at[a]);
-                }
             }
-        }
         for (int a = 0; a < 3; ++a) {
             lower(boxLo[a], lo3[a]);
             raise(boxHi[a], hi3[a]);
@@ -285,97 +370,153 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     });
     st.maxDensity = maxR.load() * s_.targetDensity;
 
-    // The volume step's excess, relaxed implicitly on the box of nodes
-    // above the target grown by the sweeps' reach, kept in relaxed_ for the
-    // gather. K sweeps from E⁰ = 0 reach K − 1 nodes beyond the excess (E¹
-    // is nonzero only on it, each sweep one node further), so beyond that
-    // margin E is 0, and a node at the margin reads 0 from outside it
-    // either way: the same E as on the whole lattice.
-    NodeBox eBox;  // empty: no excess anywhere
-    int eLo[3] = {0, 0, 0};
-    if (push > 0.f && boxHi[0].load() >= 0) {
-        const int sweeps = kSweeps, reach = kSweeps - 1;
-        int hi3[3];
-        const int top[3] = {nx - 1, ny - 1, nz - 1};
+    // The volume step's excess, relaxed implicitly (excess_diffusion.h) on
+    // the nodes with hair in the box of nodes above the target grown by the
+    // sweeps' reach, kept in relaxed_ (stored node order, then a zero slot)
+    // for the gather. K sweeps from E⁰ = 0 reach K − 1 nodes beyond the
+    // excess (E¹ is nonzero only on it, each sweep one node further), so
+    // beyond that margin E is 0, and a node at the margin reads 0 from
+    // outside it either way: the same E as on the whole lattice.
+    const bool relaxed = push > 0.f && boxHi[0].load() >= 0;
+    if (relaxed) {
+        const int reach = kSweeps - 1, last[3] = {nx - 1, ny - 1, nz - 1};
+        int bl[3], bh[3];
         for (int a = 0; a < 3; ++a) {
-            eLo[a] = std::max(0, boxLo[a].load() - reach);
-            hi3[a] = std::min(top[a], boxHi[a].load() + reach);
+            bl[a] = std::max(0, boxLo[a].load() - reach);
+            bh[a] = std::min(last[a], boxHi[a].load() + reach);
         }
-        eBox.nx = hi3[0] - eLo[0] + 1;
-        eBox.ny = hi3[1] - eLo[1] + 1;
-        eBox.nz = hi3[2] - eLo[2] + 1;
-        // The box's nodes with hair and their excess, listed plane by plane.
-        occupied_.reset(eBox);
-        relaxed_.resize(eBox.size());
-        run(size_t(eBox.nz), [&, N, toRatio](size_t b, size_t e) {
-            for (size_t k = b; k < e; ++k)
-                for (int j = 0; j < eBox.ny; ++j)
-                    occupied_.addRow(j, int(k), N[index(eLo[0], eLo[1] + j, eLo[2] + int(k))].data(), 4, toRatio);
+        const uint32_t none = uint32_t(stored);
+        occupied_.reset(size_t(nz), planeStart_.data(), stored + 1, none);
+        // Plane by plane (each plane from one thread), row by row, with
+        // the four neighbouring rows' bases and spans read once a row.
+        run(size_t(bh[2] - bl[2] + 1), [&, N, RB, RL, RE, toRatio](size_t b, size_t e) {
+            uint32_t* const nodeOut = occupied_.node.data();
+            std::array<uint32_t, 6>* const aroundOut = occupied_.neighbour.data();
+            float* const excessOut = occupied_.excess.data();
+            for (size_t kk = b; kk < e; ++kk) {
+                const int k = bl[2] + int(kk);
+                const size_t t0 = occupied_.first[size_t(k)];
+                size_t t = t0;
+                for (int j = bl[1]; j <= bh[1]; ++j) {
+                    const size_t r = size_t(k) * size_t(ny) + size_t(j);
+                    // Rows y−, y+, z−, z+; one outside the lattice spans nothing.
+                    const size_t near[4] = {r - 1, r + 1, r - size_t(ny), r + size_t(ny)};
+                    const bool has[4] = {j > 0, j + 1 < ny, k > 0, k + 1 < nz};
+                    ptrdiff_t nb[4];
+                    int nlo[4], nend[4];
+                    for (int a = 0; a < 4; ++a) {
+                        nb[a] = has[a] ? RB[near[a]] : 0;
+                        nlo[a] = has[a] ? RL[near[a]] : 0;
+                        nend[a] = has[a] ? RE[near[a]] : 0;
+                    }
+                    const ptrdiff_t base = RB[r];
+                    const int rowLo = RL[r], rowEnd = RE[r];
+                    for (int i = std::max(bl[0], rowLo), end = std::min(bh[0] + 1, rowEnd); i < end; ++i) {
+                        const uint32_t q = uint32_t(base + i);
+                        const float m = N[q][0];
+                        if (!(m > 0.f)) continue;
+                        auto at = [&](int a) { return i >= nlo[a] && i < nend[a] ? uint32_t(nb[a] + i) : none; };
+                        nodeOut[t] = q;
+                        aroundOut[t] = {i > rowLo ? q - 1 : none, i + 1 < rowEnd ? q + 1 : none, at(0), at(1), at(2), at(3)};
+                        excessOut[t] = std::max(0.f, m * toRatio - 1.f);
+                        ++t;
+                    }
+                }
+                occupied_.count[size_t(k)] = uint32_t(t - t0);
+            }
         });
-        relaxListed(occupied_, cPush, sweeps, relaxed_.data(), run);
+        relaxed_.resize(stored + 1);
+        relaxListed(occupied_, cPush, kSweeps, relaxed_.data(), run);
     }
     const float* const E = relaxed_.data();
-    const int ebx = eBox.nx, eby = eBox.ny, ebz = eBox.nz, elx = eLo[0], ely = eLo[1], elz = eLo[2];
-    // E at a node: relaxed_ inside the box (0 on nodes without hair), 0 outside.
-    auto excessAt = [=](int i, int j, int k) {
-        const unsigned bi = unsigned(i - elx), bj = unsigned(j - ely), bk = unsigned(k - elz);
-        if (bi >= unsigned(ebx) || bj >= unsigned(eby) || bk >= unsigned(ebz)) return 0.f;
-        return E[(size_t(bk) * size_t(eby) + size_t(bj)) * size_t(ebx) + size_t(bi)];
-    };
 
-    // The volume push (reads only the grid): down the gradient of the
-    // relaxed excess, divided by the density the vertex reads.
+    // One pass over the sorted vertices reads each vertex's eight nodes
+    // once for friction, the density it reads and the volume push.
     std::atomic<size_t> pushed{0};
-    if (eBox.size() > 0) {
-        const Eigen::Matrix3f R = in.head.linear();
-        const size_t ex = size_t(ebx), exy = size_t(ebx) * size_t(eby);
-        run(gridded, [&, C, push, invD, ex, exy](size_t b, size_t e) {
-            size_t moved = 0;
-            for (size_t o = b; o < e; ++o) {
-                const Cell& c = C[o];
-                const float wx[2] = {1.f - c.tx, c.tx}, wy[2] = {1.f - c.ty, c.ty}, wz[2] = {1.f - c.tz, c.tz};
-                const float dw[2] = {-invD, invD};
-                // The eight nodes' E: straight from the box when the cell
-                // lies inside it (most do: the box reaches kSweeps − 1 beyond
-                // the excess), else node by node (0 outside).
-                float Ec[8];
-                const unsigned bi = unsigned(c.i - elx), bj = unsigned(c.j - ely), bk = unsigned(c.k - elz);
-                if (bi < unsigned(ebx - 1) && bj < unsigned(eby - 1) && bk < unsigned(ebz - 1)) {
-                    const float* base = E + size_t(bk) * exy + size_t(bj) * ex + bi;
-                    for (int q = 0; q < 8; ++q) Ec[q] = base[size_t(q >> 2) * exy + size_t((q >> 1) & 1) * ex + size_t(q & 1)];
-                } else {
-                    for (int q = 0; q < 8; ++q) Ec[q] = excessAt(c.i + (q & 1), c.j + ((q >> 1) & 1), c.k + (q >> 2));
-                }
-                Vec3f grad = Vec3f::Zero();
-                for (int dk = 0; dk < 2; ++dk)
-                    for (int dj = 0; dj < 2; ++dj)
-                        for (int di = 0; di < 2; ++di)
-                            grad += Ec[di + 2 * dj + 4 * dk] *
-                                    Vec3f(dw[di] * wy[dj] * wz[dk], wx[di] * dw[dj] * wz[dk], wx[di] * wy[dj] * dw[dk]);
-                if (grad.squaredNorm() > 0.f) {
-                    in.x[c.vertex] -= (push / std::max(1.f, ratio_[o])) * (R * grad);
-                    ++moved;
-                }
+    run(gridded, [&, N, E, C, vertexOf, RB, RS, sy, toRatio, s, push, invD](size_t b, size_t e) {
+        size_t moved = 0;
+        size_t row = size_t(std::upper_bound(RS, RS + rows + 1, uint32_t(b)) - RS) - 1;  // the row of entry b
+        for (size_t o = b; o < e; ++o) {
+            while (o >= RS[row + 1]) ++row;
+            const Entry& c = C[o];
+            // The eight nodes in the order di + 2·dj + 4·dk, four at a time
+            // (SSE): their masses in lanes, w = (wx·wy)·wz and w/M lane by
+            // lane, then V = V + (w/M)·(M, P) node by node in that order,
+            // the sums r = Σ w·ratio in that order too: the same operations
+            // one by one as a scalar loop (SSE rounds each lane as the
+            // scalar operation does), so the same bits.
+            const __m128 wx = _mm_setr_ps(1.f - c.t[0], c.t[0], 1.f - c.t[0], c.t[0]);
+            const __m128 wy = _mm_setr_ps(1.f - c.t[1], 1.f - c.t[1], c.t[1], c.t[1]);
+            const __m128 wxy = _mm_mul_ps(wx, wy);
+            const __m128 w[2] = {_mm_mul_ps(wxy, _mm_set1_ps(1.f - c.t[2])), _mm_mul_ps(wxy, _mm_set1_ps(c.t[2]))};
+            __m128 V = _mm_setzero_ps();  // (Σ w, V̄): lane 0 unused
+            float r = 0.f;
+            for (int dk = 0; dk < 2; ++dk) {
+                const float* row0 = N[RB[row + size_t(dk) * sy] + c.i].data();
+                const float* row1 = N[RB[row + size_t(dk) * sy + 1] + c.i].data();
+                const __m128 nd[4] = {_mm_load_ps(row0), _mm_load_ps(row0 + 4), _mm_load_ps(row1),
+                                      _mm_load_ps(row1 + 4)};
+                const __m128 M = _mm_movelh_ps(_mm_unpacklo_ps(nd[0], nd[1]), _mm_unpacklo_ps(nd[2], nd[3]));
+                const __m128 q = _mm_div_ps(w[dk], M);
+                const __m128 has = _mm_cmpgt_ps(M, _mm_setzero_ps());
+                const __m128 wr = _mm_mul_ps(w[dk], _mm_mul_ps(M, _mm_set1_ps(toRatio)));
+                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0x00), _mm_mul_ps(_mm_shuffle_ps(q, q, 0x00), nd[0])));
+                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0x55), _mm_mul_ps(_mm_shuffle_ps(q, q, 0x55), nd[1])));
+                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0xaa), _mm_mul_ps(_mm_shuffle_ps(q, q, 0xaa), nd[2])));
+                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0xff), _mm_mul_ps(_mm_shuffle_ps(q, q, 0xff), nd[3])));
+                r += _mm_cvtss_f32(wr);
+                r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0x55));
+                r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0xaa));
+                r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0xff));
             }
-            pushed += moved;
-        });
-    }
+            alignas(16) float Vs[4];
+            _mm_store_ps(Vs, V);
+            const Vec3f v = c.mv.tail<3>();
+            in.v[vertexOf[o]] = v + s * (Vec3f(Vs[1], Vs[2], Vs[3]) - v);
+            // The volume push where a node the vertex reads holds excess
+            // (elsewhere ∇E = 0): x ← x − c·Δ²·∇E/max(1, r̄), ∇E = Σ E_n·∇w_n
+            // with ∇w_n = (w'x·wy·wz, wx·w'y·wz, wx·wy·w'z), w' = ∓1/Δ, the
+            // terms summed node by node, the three axes in SSE lanes.
+            if (!relaxed) continue;
+            __m128 En[2];  // E of the nodes di + 2·dj of planes dk = 0, 1
+            for (int dk = 0; dk < 2; ++dk)
+                En[dk] = _mm_loadh_pi(_mm_loadl_pi(zero, reinterpret_cast<const __m64*>(E + RB[row + size_t(dk) * sy] + c.i)),
+                                      reinterpret_cast<const __m64*>(E + RB[row + size_t(dk) * sy + 1] + c.i));
+            if (_mm_movemask_ps(_mm_or_ps(_mm_cmpneq_ps(En[0], zero), _mm_cmpneq_ps(En[1], zero))) == 0) continue;
+            // ∇w_n = (A_di·B_dj)·C_dk lane by lane, A = (w'x, wx, wx),
+            // B = (wy, w'y, wy), C = (wz, wz, w'z); lane 3 unused.
+            const float tx = c.t[0], ty = c.t[1], tz = c.t[2];
+            const __m128 A[2] = {_mm_setr_ps(-invD, 1.f - tx, 1.f - tx, 0.f), _mm_setr_ps(invD, tx, tx, 0.f)};
+            const __m128 B[2] = {_mm_setr_ps(1.f - ty, -invD, 1.f - ty, 0.f), _mm_setr_ps(ty, invD, ty, 0.f)};
+            const __m128 Cz[2] = {_mm_setr_ps(1.f - tz, 1.f - tz, -invD, 0.f), _mm_setr_ps(tz, tz, invD, 0.f)};
+            const __m128 AB[4] = {_mm_mul_ps(A[0], B[0]), _mm_mul_ps(A[1], B[0]), _mm_mul_ps(A[0], B[1]),
+                                  _mm_mul_ps(A[1], B[1])};  // index di + 2·dj
+            __m128 grad = _mm_setzero_ps();
+            for (int dk = 0; dk < 2; ++dk) {
+                const __m128 Ek = En[dk];
+                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0x00), _mm_mul_ps(AB[0], Cz[dk])));
+                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0x55), _mm_mul_ps(AB[1], Cz[dk])));
+                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0xaa), _mm_mul_ps(AB[2], Cz[dk])));
+                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0xff), _mm_mul_ps(AB[3], Cz[dk])));
+            }
+            alignas(16) float G[4];
+            _mm_store_ps(G, grad);
+            const Vec3f gv(G[0], G[1], G[2]);
+            if (gv.squaredNorm() > 0.f) {
+                in.x[vertexOf[o]] -= (push / std::max(1.f, r)) * (R * gv);
+                ++moved;
+            }
+        }
+        pushed += moved;
+    });
     st.pushed = pushed;
 
-    // Leave the array all zeros for the next call. A lattice of at most
-    // kClearByFill nodes a vertex is cleared whole (a memset streams at
-    // memory speed), a sparser one node by node where the splat wrote.
-    if (nodes <= kClearByFill * gridded) {
-        std::memset(static_cast<void*>(N), 0, nodes * sizeof(Eigen::Vector4f));
-        return st;
-    }
-    bySlab([&, N, C, sx, plane](size_t first, size_t end) {
-        for (size_t o = first; o < end; ++o)
-            for (int dk = 0; dk < 2; ++dk)
-                for (int dj = 0; dj < 2; ++dj) {
-                    Eigen::Vector4f* row = N + C[o].node + size_t(dk) * plane + size_t(dj) * sx;
-                    row[0] = row[1] = Eigen::Vector4f::Zero();
-                }
+    // Leave the array all zeros for the next call: the stored rows hold
+    // little beyond what the splat wrote, so they are cleared whole, in
+    // chunks on the threads (a serial pass costs both threads its time).
+    run(kSortChunks, [&, N](size_t b, size_t e) {
+        const size_t from = stored * b / kSortChunks, to = stored * e / kSortChunks;
+        std::memset(static_cast<void*>(N + from), 0, (to - from) * sizeof(Eigen::Vector4f));
     });
     return st;
 }

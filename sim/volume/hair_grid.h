@@ -52,11 +52,18 @@
 // cells every step.
 //
 // Cost: every pass walks the sorted order, with each vertex's cell and
-// (m, v) copied into it, so the nodes a pass touches stay in the cache and
-// its own data streams; a node holds (M, P) only (λ_c = M_c·ℓ/m/Δ³: every
-// vertex carries the same hair length per mass); friction and the density
-// scan share one pass; the volume step sweeps a list of the nodes with
-// hair. Measured in docs/benchmarks.md ("B-sim with the hair-hair grid").
+// (m, v) written into it by the sort, so the nodes a pass touches stay in
+// the cache and its own data streams; the sort counts and scatters in
+// chunks on the threads (a stable sort's result is unique). A node holds
+// (M, P) only (λ_c = M_c·ℓ/m/Δ³: every vertex carries the same hair length
+// per mass), and only the nodes the vertices reach are stored, row by row
+// over each row's x span. After the splat one scan of the stored nodes
+// finds the densest node and the box above the target, the volume step
+// sweeps the nodes with hair in that box from a list holding each one's
+// neighbours, and one pass over the vertices reads each vertex's eight
+// nodes once for friction, the density it reads and the push (SSE lanes
+// doing the scalar operations in the scalar order: the same bits).
+// Measured in docs/benchmarks.md ("B-sim with the hair-hair grid").
 #pragma once
 
 #include "sim/volume/excess_diffusion.h"
@@ -89,7 +96,8 @@ struct GridInput {
 /// What one apply() did (diagnostics and tests).
 struct GridStats {
     float cellSize = 0.f;           ///< Δ used, m (coarser than the setting when the hair spreads too far)
-    size_t nodes = 0;
+    size_t nodes = 0;               ///< nodes of the box round the hair
+    size_t storedNodes = 0;         ///< of those, the nodes stored: those the vertices reach (hair_grid.cpp)
     float maxDensity = 0.f;         ///< largest density of a node a vertex reads, hairs per cm²
     size_t pushed = 0;              ///< vertices the volume step moved
 };
@@ -108,30 +116,34 @@ class HairGrid {
     float pushFraction(float h) const;
 
   private:
-    /// A gridded vertex in the passes' order: base node (i, j, k), its
-    /// index in the lattice, trilinear fractions.
-    struct Cell {
-        int i, j, k;
-        uint32_t node;
-        float tx, ty, tz;
-        uint32_t vertex;  ///< index into GridInput
+    /// A gridded vertex in the passes' order: trilinear fractions t, the x
+    /// index i of its base node (i, j, k) (its row (j, k) is where it is
+    /// sorted), (m, v); 32 bytes.
+    struct Entry {
+        alignas(16) float t[3];
+        int32_t i;
+        Eigen::Vector4f mv;
     };
     VolumeSettings s_;
-    std::vector<Cell> vertexCells_;  ///< per vertex
     std::vector<uint32_t> rowOf_;    ///< node row (j, k) of each vertex's base node; ~0: not gridded
-    std::vector<unsigned> rowStart_, fill_;
-    /// Gridded vertices sorted by node row (hair_grid.cpp): their cells and
-    /// (m, v), copied in that order so that every pass reads them in a stream.
-    std::vector<Cell> cells_;
-    std::vector<Eigen::Vector4f> massVel_;
-    std::vector<float> ratio_;       ///< r̄ = λ̄/λ₀ each sorted vertex reads
+    std::vector<uint32_t> rowStart_;  ///< first sorted vertex of each node row
+    std::vector<uint32_t> rowCount_;  ///< the sort's counts, then places, per chunk and row
+    /// Gridded vertices sorted by node row (hair_grid.cpp): their entries,
+    /// written in that order so that every pass reads them in a stream, and
+    /// their indices into GridInput.
+    std::vector<Entry> entries_;
+    std::vector<uint32_t> order_;
+    std::vector<int> spanLo_, spanHi_;  ///< per base row: the least and largest i of its vertices
+    std::vector<ptrdiff_t> rowBase_;   ///< per node row: node (i, j, k) is nodes_[rowBase_[row] + i]
+    std::vector<int> rowLo_, rowEnd_;  ///< per node row: the stored i span [lo, end)
+    std::vector<uint32_t> planeStart_; ///< first stored node of each plane (and the count at the end)
+    OccupiedNodes occupied_;           ///< the volume step's nodes with hair
+    std::vector<float> relaxed_;       ///< its E per stored node, then a zero slot
     /// Per node (m, P): mass and momentum, one SSE packet, so the splat
     /// adds w·(m, m·v) in one operation; zero between calls. The hair
     /// length is M·lengthPerMass (the same for every vertex), not stored:
     /// the passes wait on the lattice's memory, not on arithmetic.
     std::vector<Eigen::Vector4f> nodes_;
-    OccupiedNodes occupied_;         ///< the volume step's nodes with hair
-    std::vector<float> relaxed_;     ///< its E on the box of nodes
 };
 
 }  // namespace hp::volume
