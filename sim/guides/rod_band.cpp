@@ -92,6 +92,11 @@ template <int K, int B>
 }  // namespace
 
 HP_ROD_LANES_CLONES void bandedSolve(D4* __restrict band, D4* __restrict invD, D4* __restrict rhs, int n) {
+    bandedFactor(band, invD, n);
+    bandedSubstitute(band, invD, rhs, n);
+}
+
+HP_ROD_LANES_CLONES void bandedFactor(D4* __restrict band, D4* __restrict invD, int n) {
     // Factorization: rows of the three kinds in turn once steady.
     int i = 0;
     for (; i < std::min(n, kSteadyFrom); ++i) factorRow(band, invD, i);
@@ -101,6 +106,10 @@ HP_ROD_LANES_CLONES void bandedSolve(D4* __restrict band, D4* __restrict invD, D
         factorSteadyRow<2>(band, invD, i + 2, std::make_index_sequence<widthOf(2)>());
     }
     for (; i < n; ++i) factorRow(band, invD, i);
+}
+
+HP_ROD_LANES_CLONES void bandedSubstitute(const D4* __restrict band, const D4* __restrict invD, D4* __restrict rhs,
+                                          int n) {
     // L z = rhs (z in rhs).
     for (int r = 0; r < n; ++r) {
         const D4* Li = band + size_t(r) * kRowLen;
