@@ -26,14 +26,14 @@ using lanes::D4;
 using lanes::F4;
 typedef long long M4 __attribute__((vector_size(32)));  ///< a lane mask of D4 comparisons
 
-inline D4 pick(M4 m, D4 a, D4 b) { return m ? a : b; }
+[[gnu::always_inline]] inline D4 pick(M4 m, D4 a, D4 b) { return m ? a : b; }
 
 /// out = (J W Jᵀ + α̃)·p for the four lanes, J with the holonomy
 /// (constraintJacobian): Jᵀp = Σ_r p_r ∇C_r|frame fixed - Σ_k T_k ∇m_k with
 /// T_k = Σ_{j>k} σ_j, σ_j = K_{j,2} p_{j,a} - K_{j,1} p_{j,b} (suffix sums);
 /// (J q)_r = ∇C_r|frame fixed·q + (K_{j,2}, -K_{j,1})·ψ_j with
 /// ψ_j = -Σ_{k<j} ∇m_k·q (prefix sums). q: scratch of 3n.
-void applySystem(const RodScratch& sc, int n, const D4* p, D4* out, D4* q) {
+[[gnu::always_inline]] inline void applySystem(const RodScratch& sc, int n, const D4* p, D4* out, D4* q) {
     const int S = n - 1, N = 3 * S;
     const lanes::V3<F4>* grad = sc.grad.data();
     const F4* w = sc.w.data();
@@ -88,7 +88,7 @@ void applySystem(const RodScratch& sc, int n, const D4* p, D4* out, D4* q) {
     }
 }
 
-D4 dotRows(const D4* a, const D4* b, int N) {
+[[gnu::always_inline]] inline D4 dotRows(const D4* a, const D4* b, int N) {
     D4 s{};
     for (int r = 0; r < N; ++r) s += a[r] * b[r];
     return s;
