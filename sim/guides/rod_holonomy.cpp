@@ -134,6 +134,9 @@ HP_ROD_LANES_CLONES int holonomyIterate(RodScratch& sc, int n, const bool curled
             r[i] = pick(active, r[i] - a * ap[i], r[i]);
         }
         active &= dotRows(r, r, N) > tol;
+        bool more = false;
+        for (int l = 0; l < kLanes; ++l) more = more || active[l] != 0;
+        if (!more) break;  // (the next direction would go unused)
         for (int i = 0; i < N; ++i) z[i] = r[i];
         bandedSubstitute(band, invD, z, N);
         const D4 rz2 = dotRows(r, z, N);
