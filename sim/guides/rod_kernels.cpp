@@ -50,7 +50,8 @@ Vec2f bendConstraint(const Vec3f& u, float parentLen, const Vec3f& e, const Vec3
 bool curled(const RodStrand& s) {
     if (s.bendStiffness <= 0 || !s.restCurvature) return false;
     for (int j = 0; j + 1 < s.vertices; ++j)
-        if (s.restCurvature[j][0] != 0.f || s.restCurvature[j][1] != 0.f) return true;
+        if (std::abs(s.restCurvature[j][0]) > kStraightTurn || std::abs(s.restCurvature[j][1]) > kStraightTurn)
+            return true;
     return false;
 }
 

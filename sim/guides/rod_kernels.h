@@ -181,9 +181,17 @@ Vec3f frameStart(const Mat3f& R, const Vec3f& d);
 /// root frame R: C_j(x) = 0, so x is the stress-free shape.
 void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec2f* c);
 
+/// A rest turn |c_j| (either component, rad) at or below which a joint
+/// counts as straight: a straight groom's rest curvatures are its
+/// coordinates' rounding, up to 1.6·10⁻⁶ (B-sim's straight guides without
+/// pre-load); a pre-load's are 0.27 rad and more (B-sim's). The holonomy's
+/// term is O(|c|·|K|), negligible below it.
+constexpr float kStraightTurn = 1e-4f;
+
 /// True where the strand bends (EI > 0) and some rest curvature c_j is not
-/// zero: there the transported frame's holonomy enters the bending force,
-/// and rodSteps solves with the full Jacobian (constraintJacobian).
+/// zero (above kStraightTurn): there the transported frame's holonomy
+/// enters the bending force, and rodSteps solves with the full Jacobian
+/// (constraintJacobian).
 bool curled(const RodStrand& s);
 
 /// The Jacobian J of a strand's constraints at x with respect to the free
