@@ -3,7 +3,7 @@
 // gradients (rod_kernels.h constraintJacobian gives the equations). The
 // prefix sums ∇ψ_j = -Σ_{k<j} ∇m_k couple each joint to every vertex
 // root-ward of it, so J W Jᵀ is dense (a dense Cholesky of its 3(n-1) rows
-// made the default step 19 times dearer, docs/physics.md). Conjugate
+// made B-sim's step 19-21 times dearer, docs/physics.md). Conjugate
 // gradients (Hestenes and Stiefel, "Methods of conjugate gradients for
 // solving linear systems", 1952) need only products with it, each O(n) by
 // the prefix sums, and the banded factorization of the frame-fixed system,
