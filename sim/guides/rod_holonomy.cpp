@@ -28,70 +28,142 @@ typedef long long M4 __attribute__((vector_size(32)));  ///< a lane mask of D4 c
 
 [[gnu::always_inline]] inline D4 pick(M4 m, D4 a, D4 b) { return m ? a : b; }
 
+/// The step's float data widened once per call (the iterations read each
+/// entry ten times or more): gradients g[(3r + slot)·3 + c], the twist's
+/// gradients te/tp[3k + c], K_{j,1}, K_{j,2}, the inverse masses. Widening is
+/// exact, so the products are those of the float data.
+struct Wide {
+    const D4* g;
+    const D4* te;
+    const D4* tp;
+    const D4* ka;
+    const D4* kb;
+    const D4* w;
+    const D4* alpha;
+};
+
+Wide widenData(RodScratch& sc, int n) {
+    const int S = n - 1, N = 3 * S;
+    sc.wide.resize(size_t(9 * N + 6 * S + 2 * S + n));
+    D4* out = lanes::view(sc.wide);
+    Wide d{};
+    using lanes::widen;
+    d.g = out;
+    for (int i = 0; i < 3 * N; ++i) {
+        const lanes::V3<F4>& v = sc.grad[size_t(i)];
+        *out++ = widen(v.x);
+        *out++ = widen(v.y);
+        *out++ = widen(v.z);
+    }
+    auto put3 = [&](const std::vector<lanes::V3<F4>>& src, const D4*& dst) {
+        dst = out;
+        for (int k = 0; k < S; ++k) {
+            *out++ = widen(src[size_t(k)].x);
+            *out++ = widen(src[size_t(k)].y);
+            *out++ = widen(src[size_t(k)].z);
+        }
+    };
+    put3(sc.twistEdge, d.te);
+    put3(sc.twistParent, d.tp);
+    d.ka = out;
+    for (int k = 0; k < S; ++k) *out++ = widen(sc.curlA[size_t(k)]);
+    d.kb = out;
+    for (int k = 0; k < S; ++k) *out++ = widen(sc.curlB[size_t(k)]);
+    d.w = out;
+    for (int v = 0; v < n; ++v) *out++ = widen(sc.w[size_t(v)]);
+    d.alpha = lanes::view(sc.alphaRow);
+    return d;
+}
+
 /// out = (J W Jᵀ + α̃)·p for the four lanes, J with the holonomy
 /// (constraintJacobian): Jᵀp = Σ_r p_r ∇C_r|frame fixed - Σ_k T_k ∇m_k with
 /// T_k = Σ_{j>k} σ_j, σ_j = K_{j,2} p_{j,a} - K_{j,1} p_{j,b} (suffix sums);
 /// (J q)_r = ∇C_r|frame fixed·q + (K_{j,2}, -K_{j,1})·ψ_j with
-/// ψ_j = -Σ_{k<j} ∇m_k·q (prefix sums). q: scratch of 3n.
-[[gnu::always_inline]] inline void applySystem(const RodScratch& sc, int n, const D4* p, D4* out, D4* q) {
-    const int S = n - 1, N = 3 * S;
-    const lanes::V3<F4>* grad = sc.grad.data();
-    const F4* w = sc.w.data();
-    const F4* ka = sc.curlA.data();
-    const F4* kb = sc.curlB.data();
-    const lanes::V3<F4>* gE = sc.twistEdge.data();
-    const lanes::V3<F4>* gP = sc.twistParent.data();
-    using lanes::widen;
-    for (int i = 0; i < 3 * n; ++i) q[i] = D4{};
-    auto addTo = [&](int v, const lanes::V3<F4>& g, D4 s) {
-        q[3 * v] += widen(g.x) * s;
-        q[3 * v + 1] += widen(g.y) * s;
-        q[3 * v + 2] += widen(g.z) * s;
-    };
-    for (int r = 0; r < N; ++r)
-        for (int slot = 0; slot < 3; ++slot) {
-            const int vtx = r / 3 - 1 + slot;
-            if (vtx >= 1) addTo(vtx, grad[3 * r + slot], p[r]);
+/// ψ_j = -Σ_{k<j} ∇m_k·q (prefix sums). q: scratch of 3n (vertex 0, the
+/// root, is not read). Returns p·out.
+/// Two passes: q = W Jᵀp vertex by vertex from the tip (each vertex's sum
+/// complete when written: rows in increasing order, then the twist's terms
+/// of joints v+1, v, v-1), then J q and p·out joint by joint from the root.
+[[gnu::always_inline]] inline D4 applySystem(const Wide& d, int n, const D4* p, D4* out, D4* q) {
+    const int S = n - 1;
+    // T[k] for k = v+1, v, v-1 as the pass reaches vertex v.
+    auto sigma = [&](int k) { return d.kb[k] * p[3 * k] - d.ka[k] * p[3 * k + 1]; };
+    // From the tip, v = S: T_{v+1} and T_v are unused (no joints S, S+1), T_{S-1} = 0.
+    D4 tNext{}, tHere{}, tPrev{};
+    for (int v = S; v >= 1; --v) {
+        // v's rows: joint v-1 (slot 2), v (slot 1), v+1 (slot 0), k = 0..2 each.
+        D4 qx{}, qy{}, qz{};
+        for (int j = v - 1; j <= v + 1; ++j) {
+            if (j > S - 1) break;
+            const int slot = v - j + 1;
+            for (int k = 0; k < 3; ++k) {
+                const int r = 3 * j + k;
+                if (j == v + 1 && k == 2) continue;  // joint v+1's stretch row does not touch v
+                const D4* g = d.g + 3 * (3 * r + slot);
+                qx += g[0] * p[r];
+                qy += g[1] * p[r];
+                qz += g[2] * p[r];
+            }
         }
-    D4 T{};
-    for (int k = S - 1; k >= 0; --k) {
-        addTo(k + 1, gE[k], -T);
-        if (k >= 1) addTo(k, gE[k], T);
-        if (k >= 1) addTo(k, gP[k], -T);
-        if (k >= 2) addTo(k - 1, gP[k], T);
-        T += widen(kb[k]) * p[3 * k] - widen(ka[k]) * p[3 * k + 1];
+        // Twist: joint v+1's parent term, joint v's edge and parent terms,
+        // joint v-1's edge term (tHere = T_v, tNext = T_{v+1}, tPrev = T_{v-1}).
+        if (v + 1 <= S - 1 && v + 1 >= 2) {
+            const D4* g = d.tp + 3 * (v + 1);
+            qx += g[0] * tNext;
+            qy += g[1] * tNext;
+            qz += g[2] * tNext;
+        }
+        if (v <= S - 1) {
+            const D4* ge = d.te + 3 * v;
+            qx += ge[0] * tHere;
+            qy += ge[1] * tHere;
+            qz += ge[2] * tHere;
+            const D4* gp = d.tp + 3 * v;
+            const D4 m = -tHere;
+            qx += gp[0] * m;
+            qy += gp[1] * m;
+            qz += gp[2] * m;
+        }
+        {
+            const D4* ge = d.te + 3 * (v - 1);
+            const D4 m = -tPrev;
+            qx += ge[0] * m;
+            qy += ge[1] * m;
+            qz += ge[2] * m;
+        }
+        q[3 * v] = qx * d.w[v];
+        q[3 * v + 1] = qy * d.w[v];
+        q[3 * v + 2] = qz * d.w[v];
+        // Slide: T_{v-2} = T_{v-1} + σ_{v-1}.
+        tNext = tHere;
+        tHere = tPrev;
+        if (v >= 2) tPrev = tPrev + sigma(v - 1);
     }
-    for (int v = 0; v < n; ++v)
-        for (int c = 0; c < 3; ++c) q[3 * v + c] *= widen(w[v]);
-    auto dotAt = [&](int v, const lanes::V3<F4>& g) {
-        return widen(g.x) * q[3 * v] + (widen(g.y) * q[3 * v + 1] + widen(g.z) * q[3 * v + 2]);
-    };
-    D4 psi{};
-    const D4* alpha = lanes::view(const_cast<std::vector<lanes::D4Store>&>(sc.alphaRow));
+    auto dotAt = [&](int v, const D4* g) { return g[0] * q[3 * v] + (g[1] * q[3 * v + 1] + g[2] * q[3 * v + 2]); };
+    D4 psi{}, pap{};
     for (int j = 0; j < S; ++j) {
+        D4 o[3];
         for (int k = 0; k < 3; ++k) {
             const int r = 3 * j + k;
-            D4 o = alpha[r] * p[r];
+            o[k] = d.alpha[r] * p[r];
             for (int slot = 0; slot < 3; ++slot) {
                 const int vtx = j - 1 + slot;
-                if (vtx >= 1) o += dotAt(vtx, grad[3 * r + slot]);
+                if (vtx >= 1) o[k] += dotAt(vtx, d.g + 3 * (3 * r + slot));
             }
-            out[r] = o;
         }
-        out[3 * j] += widen(kb[j]) * psi;
-        out[3 * j + 1] -= widen(ka[j]) * psi;
+        o[0] += d.kb[j] * psi;
+        o[1] -= d.ka[j] * psi;
+        for (int k = 0; k < 3; ++k) {
+            out[3 * j + k] = o[k];
+            pap += p[3 * j + k] * o[k];
+        }
         // ∇m_j·q = ∂m_j/∂e_j·(q_{j+1} - q_j) + ∂m_j/∂e_{j-1}·(q_j - q_{j-1}); q_0 = 0 (the root).
-        D4 dm = dotAt(j + 1, gE[j]);
-        if (j >= 1) dm -= dotAt(j, gE[j]) - dotAt(j, gP[j]);
-        if (j >= 2) dm -= dotAt(j - 1, gP[j]);
+        D4 dm = dotAt(j + 1, d.te + 3 * j);
+        if (j >= 1) dm -= dotAt(j, d.te + 3 * j) - dotAt(j, d.tp + 3 * j);
+        if (j >= 2) dm -= dotAt(j - 1, d.tp + 3 * j);
         psi -= dm;
     }
-}
-
-[[gnu::always_inline]] inline D4 dotRows(const D4* a, const D4* b, int N) {
-    D4 s{};
-    for (int r = 0; r < N; ++r) s += a[r] * b[r];
-    return s;
+    return pap;
 }
 
 }  // namespace
@@ -100,6 +172,7 @@ HP_ROD_LANES_CLONES int holonomyIterate(RodScratch& sc, int n, const bool curled
     const int N = 3 * (n - 1);
     for (auto* v : {&sc.r, &sc.z, &sc.p, &sc.ap}) v->resize(size_t(N));
     sc.q.resize(size_t(3 * n));
+    const Wide d = widenData(sc, n);
     D4* x = lanes::view(sc.rhs);
     const D4* b = lanes::view(sc.b);
     D4* r = lanes::view(sc.r);
@@ -110,36 +183,45 @@ HP_ROD_LANES_CLONES int holonomyIterate(RodScratch& sc, int n, const bool curled
     const D4* band = lanes::view(sc.band);
     const D4* invD = lanes::view(sc.invD);
     // r = b - A x, from the frame-fixed system's solution x.
-    applySystem(sc, n, x, ap, q);
-    for (int i = 0; i < N; ++i) r[i] = b[i] - ap[i];
-    const D4 tol = 1e-10 * dotRows(b, b, N);  // |r|² ≤ 10⁻¹⁰|b|²: |r| ≤ 10⁻⁵|C|
+    applySystem(d, n, x, ap, q);
+    D4 bb{}, rr{};
+    for (int i = 0; i < N; ++i) {
+        r[i] = b[i] - ap[i];
+        bb += b[i] * b[i];
+        rr += r[i] * r[i];
+        z[i] = r[i];
+    }
+    const D4 tol = 1e-10 * bb;  // |r|² ≤ 10⁻¹⁰|b|²: |r| ≤ 10⁻⁵|C|
     M4 active = {curled[0] ? -1 : 0, curled[1] ? -1 : 0, curled[2] ? -1 : 0, curled[3] ? -1 : 0};
-    active &= dotRows(r, r, N) > tol;
-    for (int i = 0; i < N; ++i) z[i] = r[i];
-    bandedSubstitute(band, invD, z, N);
-    for (int i = 0; i < N; ++i) p[i] = z[i];
-    D4 rz = dotRows(r, z, N);
-    int iterations = 0;
-    for (int it = 0; it < 100; ++it) {
+    active &= rr > tol;
+    auto anyActive = [&] {
         bool any = false;
-        for (int l = 0; l < kLanes; ++l) {
-            any = any || active[l] != 0;
-            iterations += active[l] != 0 ? 1 : 0;
-        }
-        if (!any) break;
-        applySystem(sc, n, p, ap, q);
-        const D4 a = rz / dotRows(p, ap, N);
+        for (int l = 0; l < kLanes; ++l) any = any || active[l] != 0;
+        return any;
+    };
+    int iterations = 0;
+    if (!anyActive()) return 0;  // the frame-fixed solution already meets the tolerance
+    bandedSubstitute(band, invD, z, N);
+    D4 rz{};
+    for (int i = 0; i < N; ++i) {
+        p[i] = z[i];
+        rz += r[i] * z[i];
+    }
+    for (int it = 0; it < 100; ++it) {
+        for (int l = 0; l < kLanes; ++l) iterations += active[l] != 0 ? 1 : 0;
+        const D4 a = rz / applySystem(d, n, p, ap, q);
+        rr = D4{};
         for (int i = 0; i < N; ++i) {
             x[i] = pick(active, x[i] + a * p[i], x[i]);
             r[i] = pick(active, r[i] - a * ap[i], r[i]);
+            rr += r[i] * r[i];
+            z[i] = r[i];
         }
-        active &= dotRows(r, r, N) > tol;
-        bool more = false;
-        for (int l = 0; l < kLanes; ++l) more = more || active[l] != 0;
-        if (!more) break;  // (the next direction would go unused)
-        for (int i = 0; i < N; ++i) z[i] = r[i];
+        active &= rr > tol;
+        if (!anyActive()) break;  // (the next direction would go unused)
         bandedSubstitute(band, invD, z, N);
-        const D4 rz2 = dotRows(r, z, N);
+        D4 rz2{};
+        for (int i = 0; i < N; ++i) rz2 += r[i] * z[i];
         const D4 beta = rz2 / rz;
         for (int i = 0; i < N; ++i) p[i] = pick(active, z[i] + beta * p[i], p[i]);
         rz = pick(active, rz2, rz);

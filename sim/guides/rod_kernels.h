@@ -113,6 +113,7 @@ struct RodScratch {
     std::vector<lanes::F4> curlA, curlB;
     std::vector<lanes::V3<lanes::F4>> twistEdge, twistParent;
     std::vector<lanes::D4Store> alphaRow, b, r, z, p, ap, q;
+    std::vector<lanes::D4Store> wide;  ///< the float data above widened (rod_holonomy.cpp)
 };
 
 /// One strand's state and root target for rodSteps.
