@@ -89,6 +89,24 @@ template <int K, int B>
     }
 }
 
+/// Forward substitution's row i of kind K away from the root: acc -= L_im z_m
+/// over the envelope's B = widthOf(K) columns, in increasing m (the
+/// generic loop's order).
+template <int K, int B>
+[[gnu::always_inline]] inline void forwardTerms(D4& acc, const D4* __restrict Li, const D4* __restrict z, int i) {
+    if constexpr (B >= 1) {
+        acc -= Li[B] * z[i - B];
+        forwardTerms<K, B - 1>(acc, Li, z, i);
+    }
+}
+
+template <int K>
+[[gnu::always_inline]] inline void forwardRow(const D4* __restrict band, D4* __restrict z, int i) {
+    D4 acc = z[i];
+    forwardTerms<K, widthOf(K)>(acc, band + size_t(i) * kRowLen, z, i);
+    z[i] = acc;
+}
+
 }  // namespace
 
 HP_ROD_LANES_CLONES void bandedSolve(D4* __restrict band, D4* __restrict invD, D4* __restrict rhs, int n) {
@@ -110,13 +128,22 @@ HP_ROD_LANES_CLONES void bandedFactor(D4* __restrict band, D4* __restrict invD, 
 
 HP_ROD_LANES_CLONES void bandedSubstitute(const D4* __restrict band, const D4* __restrict invD, D4* __restrict rhs,
                                           int n) {
-    // L z = rhs (z in rhs).
-    for (int r = 0; r < n; ++r) {
+    // L z = rhs (z in rhs); rows from 6 on (envelopes not clipped at the
+    // root) unrolled by kind, the same sums in the same order.
+    auto forwardGeneric = [&](int r) {
         const D4* Li = band + size_t(r) * kRowLen;
         D4 acc = rhs[r];
         for (int m = envelopeStart(r); m < r; ++m) acc -= Li[r - m] * rhs[m];
         rhs[r] = acc;
+    };
+    int f = 0;
+    for (; f < std::min(n, 6); ++f) forwardGeneric(f);
+    for (; f + 3 <= n; f += 3) {
+        forwardRow<0>(band, rhs, f);
+        forwardRow<1>(band, rhs, f + 1);
+        forwardRow<2>(band, rhs, f + 2);
     }
+    for (; f < n; ++f) forwardGeneric(f);
     // Lᵀ x = D⁻¹ z, from the last row up.
     auto generic = [&](int r) {
         D4 acc = rhs[r] * invD[r];

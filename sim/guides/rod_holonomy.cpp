@@ -13,7 +13,9 @@
 #include "sim/guides/rod_kernels.h"
 #include "sim/guides/rod_band.h"
 
+#include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 // See rod_lanes.h: D4 values never cross a library boundary.
 #pragma GCC diagnostic ignored "-Wpsabi"
@@ -42,7 +44,7 @@ struct Wide {
     const D4* alpha;
 };
 
-Wide widenData(RodScratch& sc, int n) {
+[[gnu::always_inline]] inline Wide widenData(RodScratch& sc, int n) {
     const int S = n - 1, N = 3 * S;
     sc.wide.resize(size_t(9 * N + 6 * S + 2 * S + n));
     D4* out = lanes::view(sc.wide);
@@ -90,15 +92,18 @@ Wide widenData(RodScratch& sc, int n) {
     auto sigma = [&](int k) { return d.kb[k] * p[3 * k] - d.ka[k] * p[3 * k + 1]; };
     // From the tip, v = S: T_{v+1} and T_v are unused (no joints S, S+1), T_{S-1} = 0.
     D4 tNext{}, tHere{}, tPrev{};
-    for (int v = S; v >= 1; --v) {
+    // One vertex; `full`: an interior vertex, every term present (the
+    // conditions fold away and the loops unroll with fixed offsets).
+    auto vertex = [&](int v, auto full) __attribute__((always_inline)) {
+        constexpr bool F = decltype(full)::value;
         // v's rows: joint v-1 (slot 2), v (slot 1), v+1 (slot 0), k = 0..2 each.
         D4 qx{}, qy{}, qz{};
-        for (int j = v - 1; j <= v + 1; ++j) {
-            if (j > S - 1) break;
-            const int slot = v - j + 1;
-            for (int k = 0; k < 3; ++k) {
+        for (int jj = 0; jj < 3; ++jj) {
+            const int j = v - 1 + jj;
+            if (!F && j > S - 1) break;
+            const int slot = 2 - jj;
+            for (int k = 0; k < (jj == 2 ? 2 : 3); ++k) {  // joint v+1's stretch row does not touch v
                 const int r = 3 * j + k;
-                if (j == v + 1 && k == 2) continue;  // joint v+1's stretch row does not touch v
                 const D4* g = d.g + 3 * (3 * r + slot);
                 qx += g[0] * p[r];
                 qy += g[1] * p[r];
@@ -107,13 +112,13 @@ Wide widenData(RodScratch& sc, int n) {
         }
         // Twist: joint v+1's parent term, joint v's edge and parent terms,
         // joint v-1's edge term (tHere = T_v, tNext = T_{v+1}, tPrev = T_{v-1}).
-        if (v + 1 <= S - 1 && v + 1 >= 2) {
+        if (F || (v + 1 <= S - 1 && v + 1 >= 2)) {
             const D4* g = d.tp + 3 * (v + 1);
             qx += g[0] * tNext;
             qy += g[1] * tNext;
             qz += g[2] * tNext;
         }
-        if (v <= S - 1) {
+        if (F || v <= S - 1) {
             const D4* ge = d.te + 3 * v;
             qx += ge[0] * tHere;
             qy += ge[1] * tHere;
@@ -137,18 +142,23 @@ Wide widenData(RodScratch& sc, int n) {
         // Slide: T_{v-2} = T_{v-1} + σ_{v-1}.
         tNext = tHere;
         tHere = tPrev;
-        if (v >= 2) tPrev = tPrev + sigma(v - 1);
-    }
+        if (F || v >= 2) tPrev = tPrev + sigma(v - 1);
+    };
+    int vi = S;
+    for (; vi >= 1 && vi >= S - 1; --vi) vertex(vi, std::false_type());
+    for (; vi >= 2; --vi) vertex(vi, std::true_type());
+    for (; vi >= 1; --vi) vertex(vi, std::false_type());
     auto dotAt = [&](int v, const D4* g) { return g[0] * q[3 * v] + (g[1] * q[3 * v + 1] + g[2] * q[3 * v + 2]); };
     D4 psi{}, pap{};
-    for (int j = 0; j < S; ++j) {
+    auto joint = [&](int j, auto full) __attribute__((always_inline)) {
+        constexpr bool F = decltype(full)::value;
         D4 o[3];
         for (int k = 0; k < 3; ++k) {
             const int r = 3 * j + k;
             o[k] = d.alpha[r] * p[r];
             for (int slot = 0; slot < 3; ++slot) {
                 const int vtx = j - 1 + slot;
-                if (vtx >= 1) o[k] += dotAt(vtx, d.g + 3 * (3 * r + slot));
+                if (F || vtx >= 1) o[k] += dotAt(vtx, d.g + 3 * (3 * r + slot));
             }
         }
         o[0] += d.kb[j] * psi;
@@ -159,10 +169,13 @@ Wide widenData(RodScratch& sc, int n) {
         }
         // ∇m_j·q = ∂m_j/∂e_j·(q_{j+1} - q_j) + ∂m_j/∂e_{j-1}·(q_j - q_{j-1}); q_0 = 0 (the root).
         D4 dm = dotAt(j + 1, d.te + 3 * j);
-        if (j >= 1) dm -= dotAt(j, d.te + 3 * j) - dotAt(j, d.tp + 3 * j);
-        if (j >= 2) dm -= dotAt(j - 1, d.tp + 3 * j);
+        if (F || j >= 1) dm -= dotAt(j, d.te + 3 * j) - dotAt(j, d.tp + 3 * j);
+        if (F || j >= 2) dm -= dotAt(j - 1, d.tp + 3 * j);
         psi -= dm;
-    }
+    };
+    int j = 0;
+    for (; j < std::min(S, 2); ++j) joint(j, std::false_type());
+    for (; j < S; ++j) joint(j, std::true_type());
     return pap;
 }
 
