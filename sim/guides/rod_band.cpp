@@ -89,6 +89,18 @@ template <int K, int B>
     }
 }
 
+/// backTerm's terms in the opposite order, B from kBand down to 1: the
+/// newest unknown x[i+1] enters last, so a row waits on the one below it for
+/// one product and one difference, not for the whole sum (the
+/// preconditioner's substitutions, where the order of rounding is free).
+template <int K, int B>
+[[gnu::always_inline]] inline void backTermLatest(D4& acc, const D4* __restrict band, const D4* __restrict x, int i) {
+    if constexpr (B >= 1) {
+        if constexpr (B <= widthOf(kindOf(K, -B))) acc -= band[size_t(i + B) * kRowLen + size_t(B)] * x[i + B];
+        backTermLatest<K, B - 1>(acc, band, x, i);
+    }
+}
+
 /// Forward substitution's row i of kind K away from the root: acc -= L_im z_m
 /// over the envelope's B = widthOf(K) columns, in increasing m (the
 /// generic loop's order).
@@ -126,8 +138,11 @@ HP_ROD_LANES_CLONES void bandedFactor(D4* __restrict band, D4* __restrict invD, 
     for (; i < n; ++i) factorRow(band, invD, i);
 }
 
-HP_ROD_LANES_CLONES void bandedSubstitute(const D4* __restrict band, const D4* __restrict invD, D4* __restrict rhs,
-                                          int n) {
+namespace {
+
+template <bool Latest>
+[[gnu::always_inline]] inline void substitute(const D4* __restrict band, const D4* __restrict invD, D4* __restrict rhs,
+                                             int n) {
     // L z = rhs (z in rhs); rows from 6 on (envelopes not clipped at the
     // root) unrolled by kind, the same sums in the same order.
     auto forwardGeneric = [&](int r) {
@@ -157,16 +172,31 @@ HP_ROD_LANES_CLONES void bandedSubstitute(const D4* __restrict band, const D4* _
     for (; r >= 6 && r % 3 != 2; --r) generic(r);
     for (; r >= 8; r -= 3) {
         D4 acc = rhs[r] * invD[r];
-        backTerm<2, 1>(acc, band, rhs, r);
+        if constexpr (Latest) backTermLatest<2, kBand>(acc, band, rhs, r);
+        else backTerm<2, 1>(acc, band, rhs, r);
         rhs[r] = acc;
         acc = rhs[r - 1] * invD[r - 1];
-        backTerm<1, 1>(acc, band, rhs, r - 1);
+        if constexpr (Latest) backTermLatest<1, kBand>(acc, band, rhs, r - 1);
+        else backTerm<1, 1>(acc, band, rhs, r - 1);
         rhs[r - 1] = acc;
         acc = rhs[r - 2] * invD[r - 2];
-        backTerm<0, 1>(acc, band, rhs, r - 2);
+        if constexpr (Latest) backTermLatest<0, kBand>(acc, band, rhs, r - 2);
+        else backTerm<0, 1>(acc, band, rhs, r - 2);
         rhs[r - 2] = acc;
     }
     for (; r >= 0; --r) generic(r);
+}
+
+}  // namespace
+
+HP_ROD_LANES_CLONES void bandedSubstitute(const D4* __restrict band, const D4* __restrict invD, D4* __restrict rhs,
+                                          int n) {
+    substitute<false>(band, invD, rhs, n);
+}
+
+HP_ROD_LANES_CLONES void bandedPrecondition(const D4* __restrict band, const D4* __restrict invD, D4* __restrict rhs,
+                                            int n) {
+    substitute<true>(band, invD, rhs, n);
 }
 
 }  // namespace hp::rod

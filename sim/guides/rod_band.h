@@ -38,5 +38,9 @@ void bandedSolve(lanes::D4* band, lanes::D4* invD, lanes::D4* rhs, int n);
 /// rod_holonomy.cpp, precondition with it).
 void bandedFactor(lanes::D4* band, lanes::D4* invD, int n);
 void bandedSubstitute(const lanes::D4* band, const lanes::D4* invD, lanes::D4* rhs, int n);
+/// bandedSubstitute with the back substitution's sums in the opposite order
+/// (its rounding differs, its latency is a quarter): the holonomy's
+/// preconditioner, where no result depends on that order's bits.
+void bandedPrecondition(const lanes::D4* band, const lanes::D4* invD, lanes::D4* rhs, int n);
 
 }  // namespace hp::rod

@@ -149,7 +149,7 @@ struct Wide {
     for (; vi >= 2; --vi) vertex(vi, std::true_type());
     for (; vi >= 1; --vi) vertex(vi, std::false_type());
     auto dotAt = [&](int v, const D4* g) { return g[0] * q[3 * v] + (g[1] * q[3 * v + 1] + g[2] * q[3 * v + 2]); };
-    D4 psi{}, pap{};
+    D4 psi{}, pap[3] = {};
     auto joint = [&](int j, auto full) __attribute__((always_inline)) {
         constexpr bool F = decltype(full)::value;
         D4 o[3];
@@ -165,7 +165,7 @@ struct Wide {
         o[1] -= d.ka[j] * psi;
         for (int k = 0; k < 3; ++k) {
             out[3 * j + k] = o[k];
-            pap += p[3 * j + k] * o[k];
+            pap[k] += p[3 * j + k] * o[k];
         }
         // ∇m_j·q = ∂m_j/∂e_j·(q_{j+1} - q_j) + ∂m_j/∂e_{j-1}·(q_j - q_{j-1}); q_0 = 0 (the root).
         D4 dm = dotAt(j + 1, d.te + 3 * j);
@@ -176,7 +176,14 @@ struct Wide {
     int j = 0;
     for (; j < std::min(S, 2); ++j) joint(j, std::false_type());
     for (; j < S; ++j) joint(j, std::true_type());
-    return pap;
+    return (pap[0] + pap[1]) + pap[2];
+}
+
+/// a·b over N rows.
+[[gnu::always_inline]] inline D4 dotRows(const D4* a, const D4* b, int N) {
+    D4 s{};
+    for (int i = 0; i < N; ++i) s += a[i] * b[i];
+    return s;
 }
 
 }  // namespace
@@ -197,14 +204,9 @@ HP_ROD_LANES_CLONES int holonomyIterate(RodScratch& sc, int n, const bool curled
     const D4* invD = lanes::view(sc.invD);
     // r = b - A x, from the frame-fixed system's solution x.
     applySystem(d, n, x, ap, q);
-    D4 bb{}, rr{};
-    for (int i = 0; i < N; ++i) {
-        r[i] = b[i] - ap[i];
-        bb += b[i] * b[i];
-        rr += r[i] * r[i];
-        z[i] = r[i];
-    }
-    const D4 tol = 1e-10 * bb;  // |r|² ≤ 10⁻¹⁰|b|²: |r| ≤ 10⁻⁵|C|
+    for (int i = 0; i < N; ++i) z[i] = r[i] = b[i] - ap[i];
+    D4 rr = dotRows(r, r, N);
+    const D4 tol = 1e-10 * dotRows(b, b, N);  // |r|² ≤ 10⁻¹⁰|b|²: |r| ≤ 10⁻⁵|C|
     M4 active = {curled[0] ? -1 : 0, curled[1] ? -1 : 0, curled[2] ? -1 : 0, curled[3] ? -1 : 0};
     active &= rr > tol;
     auto anyActive = [&] {
@@ -214,27 +216,22 @@ HP_ROD_LANES_CLONES int holonomyIterate(RodScratch& sc, int n, const bool curled
     };
     int iterations = 0;
     if (!anyActive()) return 0;  // the frame-fixed solution already meets the tolerance
-    bandedSubstitute(band, invD, z, N);
-    D4 rz{};
-    for (int i = 0; i < N; ++i) {
-        p[i] = z[i];
-        rz += r[i] * z[i];
-    }
+    bandedPrecondition(band, invD, z, N);
+    for (int i = 0; i < N; ++i) p[i] = z[i];
+    D4 rz = dotRows(r, z, N);
     for (int it = 0; it < 100; ++it) {
         for (int l = 0; l < kLanes; ++l) iterations += active[l] != 0 ? 1 : 0;
         const D4 a = rz / applySystem(d, n, p, ap, q);
-        rr = D4{};
         for (int i = 0; i < N; ++i) {
             x[i] = pick(active, x[i] + a * p[i], x[i]);
             r[i] = pick(active, r[i] - a * ap[i], r[i]);
-            rr += r[i] * r[i];
             z[i] = r[i];
         }
+        rr = dotRows(r, r, N);
         active &= rr > tol;
         if (!anyActive()) break;  // (the next direction would go unused)
-        bandedSubstitute(band, invD, z, N);
-        D4 rz2{};
-        for (int i = 0; i < N; ++i) rz2 += r[i] * z[i];
+        bandedPrecondition(band, invD, z, N);
+        const D4 rz2 = dotRows(r, z, N);
         const D4 beta = rz2 / rz;
         for (int i = 0; i < N; ++i) p[i] = pick(active, z[i] + beta * p[i], p[i]);
         rz = pick(active, rz2, rz);
