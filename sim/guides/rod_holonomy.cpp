@@ -31,13 +31,15 @@ typedef long long M4 __attribute__((vector_size(32)));  ///< a lane mask of D4 c
 [[gnu::always_inline]] inline D4 pick(M4 m, D4 a, D4 b) { return m ? a : b; }
 
 /// The step's float data widened once per call (the iterations read each
-/// entry ten times or more): gradients g[(3r + slot)·3 + c], the twist's
-/// gradients te/tp[3k + c], K_{j,1}, K_{j,2}, the inverse masses. Widening is
-/// exact, so the products are those of the float data.
+/// entry ten times or more), by edge: the constraints depend on the
+/// vertices through the edges e_j = x_{j+1} - x_j, so joint j's gradients
+/// are those on e_{j-1} and e_j (the vertex gradient g_{j-1} = -∂C/∂e_{j-1},
+/// g_{j+1} = ∂C/∂e_j, g_j their negated sum). Per joint, 7 vectors of 3
+/// components: ∂C_a/∂e_{j-1}, ∂C_a/∂e_j, ∂C_b/∂e_{j-1}, ∂C_b/∂e_j, the
+/// stretch row's d_j, the reference twist's ∂m_j/∂e_j, ∂m_j/∂e_{j-1} (none at
+/// the ghost joint); K_{j,1}, K_{j,2}; the inverse masses. Widening is exact.
 struct Wide {
-    const D4* g;
-    const D4* te;
-    const D4* tp;
+    const D4* e;  ///< joint j's vectors at e[21j + 3m + c]
     const D4* ka;
     const D4* kb;
     const D4* w;
@@ -45,28 +47,30 @@ struct Wide {
 };
 
 [[gnu::always_inline]] inline Wide widenData(RodScratch& sc, int n) {
-    const int S = n - 1, N = 3 * S;
-    sc.wide.resize(size_t(9 * N + 6 * S + 2 * S + n));
+    const int S = n - 1;
+    sc.wide.resize(size_t(21 * S + 2 * S + n));
     D4* out = lanes::view(sc.wide);
     Wide d{};
     using lanes::widen;
-    d.g = out;
-    for (int i = 0; i < 3 * N; ++i) {
-        const lanes::V3<F4>& v = sc.grad[size_t(i)];
-        *out++ = widen(v.x);
-        *out++ = widen(v.y);
-        *out++ = widen(v.z);
-    }
-    auto put3 = [&](const std::vector<lanes::V3<F4>>& src, const D4*& dst) {
-        dst = out;
-        for (int k = 0; k < S; ++k) {
-            *out++ = widen(src[size_t(k)].x);
-            *out++ = widen(src[size_t(k)].y);
-            *out++ = widen(src[size_t(k)].z);
-        }
+    auto put = [&](const lanes::V3<F4>& v, F4 sign) __attribute__((always_inline)) {
+        *out++ = widen(sign * v.x);
+        *out++ = widen(sign * v.y);
+        *out++ = widen(sign * v.z);
     };
-    put3(sc.twistEdge, d.te);
-    put3(sc.twistParent, d.tp);
+    const F4 plus = lanes::splat<F4>(1.f), minus = lanes::splat<F4>(-1.f), zero{};
+    const lanes::V3<F4>* g = sc.grad.data();
+    d.e = out;
+    for (int j = 0; j < S; ++j) {
+        const int ra = 3 * j, rb = 3 * j + 1, rs = 3 * j + 2;
+        // Slot 0 (vertex j-1) is not written at the ghost joint.
+        put(g[3 * ra], j == 0 ? zero : minus);
+        put(g[3 * ra + 2], plus);
+        put(g[3 * rb], j == 0 ? zero : minus);
+        put(g[3 * rb + 2], plus);
+        put(g[3 * rs + 2], plus);
+        put(sc.twistEdge[size_t(j)], plus);
+        put(sc.twistParent[size_t(j)], plus);
+    }
     d.ka = out;
     for (int k = 0; k < S; ++k) *out++ = widen(sc.curlA[size_t(k)]);
     d.kb = out;
@@ -81,102 +85,56 @@ struct Wide {
 /// (constraintJacobian): Jᵀp = Σ_r p_r ∇C_r|frame fixed - Σ_k T_k ∇m_k with
 /// T_k = Σ_{j>k} σ_j, σ_j = K_{j,2} p_{j,a} - K_{j,1} p_{j,b} (suffix sums);
 /// (J q)_r = ∇C_r|frame fixed·q + (K_{j,2}, -K_{j,1})·ψ_j with
-/// ψ_j = -Σ_{k<j} ∇m_k·q (prefix sums). q: scratch of 3n (vertex 0, the
-/// root, is not read). Returns p·out.
-/// Two passes: q = W Jᵀp vertex by vertex from the tip (each vertex's sum
-/// complete when written: rows in increasing order, then the twist's terms
-/// of joints v+1, v, v-1), then J q and p·out joint by joint from the root.
+/// ψ_j = -Σ_{k<j} ∇m_k·q (prefix sums). Returns p·out.
+/// By edges: Jᵀp is f_{v-1} - f_v at vertex v with f_e the sum of
+/// p_r ∂C_r/∂e_e - T_k ∂m_k/∂e_e over the rows of joints e, e+1 (f_{-1}: the
+/// root's, unused; f_{S} = 0), q = W Jᵀp from the tip; then J q from the
+/// root through Δq_e = q_{e+1} - q_e (q_0 = 0, the root held).
 [[gnu::always_inline]] inline D4 applySystem(const Wide& d, int n, const D4* p, D4* out, D4* q) {
     const int S = n - 1;
-    // T[k] for k = v+1, v, v-1 as the pass reaches vertex v.
-    auto sigma = [&](int k) { return d.kb[k] * p[3 * k] - d.ka[k] * p[3 * k + 1]; };
-    // From the tip, v = S: T_{v+1} and T_v are unused (no joints S, S+1), T_{S-1} = 0.
-    D4 tNext{}, tHere{}, tPrev{};
-    // One vertex; `full`: an interior vertex, every term present (the
-    // conditions fold away and the loops unroll with fixed offsets).
-    auto vertex = [&](int v, auto full) __attribute__((always_inline)) {
-        constexpr bool F = decltype(full)::value;
-        // v's rows: joint v-1 (slot 2), v (slot 1), v+1 (slot 0), k = 0..2 each.
-        D4 qx{}, qy{}, qz{};
-        for (int jj = 0; jj < 3; ++jj) {
-            const int j = v - 1 + jj;
-            if (!F && j > S - 1) break;
-            const int slot = 2 - jj;
-            for (int k = 0; k < (jj == 2 ? 2 : 3); ++k) {  // joint v+1's stretch row does not touch v
-                const int r = 3 * j + k;
-                const D4* g = d.g + 3 * (3 * r + slot);
-                qx += g[0] * p[r];
-                qy += g[1] * p[r];
-                qz += g[2] * p[r];
-            }
+    D4 fx{}, fy{}, fz{};  // f_{e+1}
+    D4 T{}, Tn{};         // T_e (T_{S-1} = 0), T_{e+1}
+    for (int e = S - 1; e >= 0; --e) {
+        const D4* g = d.e + 21 * e;
+        const D4 pa = p[3 * e], pb = p[3 * e + 1], ps = p[3 * e + 2], mt = -T;
+        D4 x = (g[3] * pa + g[9] * pb) + (g[12] * ps + g[15] * mt);
+        D4 y = (g[4] * pa + g[10] * pb) + (g[13] * ps + g[16] * mt);
+        D4 z = (g[5] * pa + g[11] * pb) + (g[14] * ps + g[17] * mt);
+        if (e + 1 <= S - 1) {
+            const D4* h = g + 21;
+            const D4 qa = p[3 * e + 3], qb = p[3 * e + 4], mtn = -Tn;
+            x += (h[0] * qa + h[6] * qb) + h[18] * mtn;
+            y += (h[1] * qa + h[7] * qb) + h[19] * mtn;
+            z += (h[2] * qa + h[8] * qb) + h[20] * mtn;
         }
-        // Twist: joint v+1's parent term, joint v's edge and parent terms,
-        // joint v-1's edge term (tHere = T_v, tNext = T_{v+1}, tPrev = T_{v-1}).
-        if (F || (v + 1 <= S - 1 && v + 1 >= 2)) {
-            const D4* g = d.tp + 3 * (v + 1);
-            qx += g[0] * tNext;
-            qy += g[1] * tNext;
-            qz += g[2] * tNext;
-        }
-        if (F || v <= S - 1) {
-            const D4* ge = d.te + 3 * v;
-            qx += ge[0] * tHere;
-            qy += ge[1] * tHere;
-            qz += ge[2] * tHere;
-            const D4* gp = d.tp + 3 * v;
-            const D4 m = -tHere;
-            qx += gp[0] * m;
-            qy += gp[1] * m;
-            qz += gp[2] * m;
-        }
-        {
-            const D4* ge = d.te + 3 * (v - 1);
-            const D4 m = -tPrev;
-            qx += ge[0] * m;
-            qy += ge[1] * m;
-            qz += ge[2] * m;
-        }
-        q[3 * v] = qx * d.w[v];
-        q[3 * v + 1] = qy * d.w[v];
-        q[3 * v + 2] = qz * d.w[v];
-        // Slide: T_{v-2} = T_{v-1} + σ_{v-1}.
-        tNext = tHere;
-        tHere = tPrev;
-        if (F || v >= 2) tPrev = tPrev + sigma(v - 1);
-    };
-    int vi = S;
-    for (; vi >= 1 && vi >= S - 1; --vi) vertex(vi, std::false_type());
-    for (; vi >= 2; --vi) vertex(vi, std::true_type());
-    for (; vi >= 1; --vi) vertex(vi, std::false_type());
-    auto dotAt = [&](int v, const D4* g) { return g[0] * q[3 * v] + (g[1] * q[3 * v + 1] + g[2] * q[3 * v + 2]); };
-    D4 psi{}, pap[3] = {};
-    auto joint = [&](int j, auto full) __attribute__((always_inline)) {
-        constexpr bool F = decltype(full)::value;
-        D4 o[3];
-        for (int k = 0; k < 3; ++k) {
-            const int r = 3 * j + k;
-            o[k] = d.alpha[r] * p[r];
-            for (int slot = 0; slot < 3; ++slot) {
-                const int vtx = j - 1 + slot;
-                if (F || vtx >= 1) o[k] += dotAt(vtx, d.g + 3 * (3 * r + slot));
-            }
-        }
-        o[0] += d.kb[j] * psi;
-        o[1] -= d.ka[j] * psi;
-        for (int k = 0; k < 3; ++k) {
-            out[3 * j + k] = o[k];
-            pap[k] += p[3 * j + k] * o[k];
-        }
-        // ∇m_j·q = ∂m_j/∂e_j·(q_{j+1} - q_j) + ∂m_j/∂e_{j-1}·(q_j - q_{j-1}); q_0 = 0 (the root).
-        D4 dm = dotAt(j + 1, d.te + 3 * j);
-        if (F || j >= 1) dm -= dotAt(j, d.te + 3 * j) - dotAt(j, d.tp + 3 * j);
-        if (F || j >= 2) dm -= dotAt(j - 1, d.tp + 3 * j);
-        psi -= dm;
-    };
-    int j = 0;
-    for (; j < std::min(S, 2); ++j) joint(j, std::false_type());
-    for (; j < S; ++j) joint(j, std::true_type());
-    return (pap[0] + pap[1]) + pap[2];
+        const D4 w = d.w[e + 1];
+        q[3 * e + 3] = (x - fx) * w;
+        q[3 * e + 4] = (y - fy) * w;
+        q[3 * e + 5] = (z - fz) * w;
+        fx = x;
+        fy = y;
+        fz = z;
+        Tn = T;
+        T += d.kb[e] * pa - d.ka[e] * pb;  // T_{e-1} = T_e + σ_e
+    }
+    auto dot = [](const D4* g, const D4* v) { return g[0] * v[0] + (g[1] * v[1] + g[2] * v[2]); };
+    D4 psi{}, pap{};
+    D4 prev[3] = {}, cur[3];  // Δq_{j-1}, Δq_j
+    for (int j = 0; j < S; ++j) {
+        const D4* g = d.e + 21 * j;
+        for (int c = 0; c < 3; ++c) cur[c] = j == 0 ? q[3 + c] : q[3 * j + 3 + c] - q[3 * j + c];
+        const int r = 3 * j;
+        const D4 oa = (d.alpha[r] * p[r] + (dot(g + 3, cur) + dot(g, prev))) + d.kb[j] * psi;
+        const D4 ob = (d.alpha[r + 1] * p[r + 1] + (dot(g + 9, cur) + dot(g + 6, prev))) - d.ka[j] * psi;
+        const D4 os = d.alpha[r + 2] * p[r + 2] + dot(g + 12, cur);
+        out[r] = oa;
+        out[r + 1] = ob;
+        out[r + 2] = os;
+        pap += (p[r] * oa + p[r + 1] * ob) + p[r + 2] * os;
+        psi -= dot(g + 15, cur) + dot(g + 18, prev);  // ∇m_j·q
+        for (int c = 0; c < 3; ++c) prev[c] = cur[c];
+    }
+    return pap;
 }
 
 /// a·b over N rows.
