@@ -89,9 +89,44 @@ template <int K, int B>
     }
 }
 
+/// backTerm's terms in the opposite order, B from kBand down to 1: the
+/// newest unknown x[i+1] enters last, so a row waits on the one below it for
+/// one product and one difference, not for the whole sum (the
+/// preconditioner's substitutions, where the order of rounding is free).
+template <int K, int B>
+[[gnu::always_inline]] inline void backTermLatest(D4& acc, const D4* __restrict band, const D4* __restrict x, int i) {
+    if constexpr (B >= 1) {
+        if constexpr (B <= widthOf(kindOf(K, -B))) acc -= band[size_t(i + B) * kRowLen + size_t(B)] * x[i + B];
+        backTermLatest<K, B - 1>(acc, band, x, i);
+    }
+}
+
+/// Forward substitution's row i of kind K away from the root: acc -= L_im z_m
+/// over the envelope's B = widthOf(K) columns, in increasing m (the
+/// generic loop's order).
+template <int K, int B>
+[[gnu::always_inline]] inline void forwardTerms(D4& acc, const D4* __restrict Li, const D4* __restrict z, int i) {
+    if constexpr (B >= 1) {
+        acc -= Li[B] * z[i - B];
+        forwardTerms<K, B - 1>(acc, Li, z, i);
+    }
+}
+
+template <int K>
+[[gnu::always_inline]] inline void forwardRow(const D4* __restrict band, D4* __restrict z, int i) {
+    D4 acc = z[i];
+    forwardTerms<K, widthOf(K)>(acc, band + size_t(i) * kRowLen, z, i);
+    z[i] = acc;
+}
+
 }  // namespace
 
 HP_ROD_LANES_CLONES void bandedSolve(D4* __restrict band, D4* __restrict invD, D4* __restrict rhs, int n) {
+    bandedFactor(band, invD, n);
+    bandedSubstitute(band, invD, rhs, n);
+}
+
+HP_ROD_LANES_CLONES void bandedFactor(D4* __restrict band, D4* __restrict invD, int n) {
     // Factorization: rows of the three kinds in turn once steady.
     int i = 0;
     for (; i < std::min(n, kSteadyFrom); ++i) factorRow(band, invD, i);
@@ -101,13 +136,29 @@ HP_ROD_LANES_CLONES void bandedSolve(D4* __restrict band, D4* __restrict invD, D
         factorSteadyRow<2>(band, invD, i + 2, std::make_index_sequence<widthOf(2)>());
     }
     for (; i < n; ++i) factorRow(band, invD, i);
-    // L z = rhs (z in rhs).
-    for (int r = 0; r < n; ++r) {
+}
+
+namespace {
+
+template <bool Latest>
+[[gnu::always_inline]] inline void substitute(const D4* __restrict band, const D4* __restrict invD, D4* __restrict rhs,
+                                             int n) {
+    // L z = rhs (z in rhs); rows from 6 on (envelopes not clipped at the
+    // root) unrolled by kind, the same sums in the same order.
+    auto forwardGeneric = [&](int r) {
         const D4* Li = band + size_t(r) * kRowLen;
         D4 acc = rhs[r];
         for (int m = envelopeStart(r); m < r; ++m) acc -= Li[r - m] * rhs[m];
         rhs[r] = acc;
+    };
+    int f = 0;
+    for (; f < std::min(n, 6); ++f) forwardGeneric(f);
+    for (; f + 3 <= n; f += 3) {
+        forwardRow<0>(band, rhs, f);
+        forwardRow<1>(band, rhs, f + 1);
+        forwardRow<2>(band, rhs, f + 2);
     }
+    for (; f < n; ++f) forwardGeneric(f);
     // Lᵀ x = D⁻¹ z, from the last row up.
     auto generic = [&](int r) {
         D4 acc = rhs[r] * invD[r];
@@ -121,16 +172,31 @@ HP_ROD_LANES_CLONES void bandedSolve(D4* __restrict band, D4* __restrict invD, D
     for (; r >= 6 && r % 3 != 2; --r) generic(r);
     for (; r >= 8; r -= 3) {
         D4 acc = rhs[r] * invD[r];
-        backTerm<2, 1>(acc, band, rhs, r);
+        if constexpr (Latest) backTermLatest<2, kBand>(acc, band, rhs, r);
+        else backTerm<2, 1>(acc, band, rhs, r);
         rhs[r] = acc;
         acc = rhs[r - 1] * invD[r - 1];
-        backTerm<1, 1>(acc, band, rhs, r - 1);
+        if constexpr (Latest) backTermLatest<1, kBand>(acc, band, rhs, r - 1);
+        else backTerm<1, 1>(acc, band, rhs, r - 1);
         rhs[r - 1] = acc;
         acc = rhs[r - 2] * invD[r - 2];
-        backTerm<0, 1>(acc, band, rhs, r - 2);
+        if constexpr (Latest) backTermLatest<0, kBand>(acc, band, rhs, r - 2);
+        else backTerm<0, 1>(acc, band, rhs, r - 2);
         rhs[r - 2] = acc;
     }
     for (; r >= 0; --r) generic(r);
+}
+
+}  // namespace
+
+HP_ROD_LANES_CLONES void bandedSubstitute(const D4* __restrict band, const D4* __restrict invD, D4* __restrict rhs,
+                                          int n) {
+    substitute<false>(band, invD, rhs, n);
+}
+
+HP_ROD_LANES_CLONES void bandedPrecondition(const D4* __restrict band, const D4* __restrict invD, D4* __restrict rhs,
+                                            int n) {
+    substitute<true>(band, invD, rhs, n);
 }
 
 }  // namespace hp::rod

@@ -33,5 +33,14 @@ inline int envelopeStart(int i) {
 ///   D_i = A_ii - Σ_m L_im² D_m,  L_ij = (A_ij - Σ_m L_im D_m L_jm) / D_j,
 /// the sums over the envelope (envelopeStart), in increasing m.
 void bandedSolve(lanes::D4* band, lanes::D4* invD, lanes::D4* rhs, int n);
+/// bandedSolve's two halves: the factorization (band, invD), then the
+/// substitutions with it, as often as wanted (the holonomy's iterations,
+/// rod_holonomy.cpp, precondition with it).
+void bandedFactor(lanes::D4* band, lanes::D4* invD, int n);
+void bandedSubstitute(const lanes::D4* band, const lanes::D4* invD, lanes::D4* rhs, int n);
+/// bandedSubstitute with the back substitution's sums in the opposite order
+/// (its rounding differs, its latency is a quarter): the holonomy's
+/// preconditioner, where no result depends on that order's bits.
+void bandedPrecondition(const lanes::D4* band, const lanes::D4* invD, lanes::D4* rhs, int n);
 
 }  // namespace hp::rod

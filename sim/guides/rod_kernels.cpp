@@ -47,25 +47,68 @@ Vec2f bendConstraint(const Vec3f& u, float parentLen, const Vec3f& e, const Vec3
     return Vec2f(C[0], C[1]);
 }
 
-Eigen::MatrixXd equilibriumMatrix(const RodStrand& s, const Vec3f* x, const Mat3f& R) {
+bool curled(const RodStrand& s) {
+    if (s.bendStiffness <= 0 || !s.restCurvature) return false;
+    for (int j = 0; j + 1 < s.vertices; ++j)
+        if (std::abs(s.restCurvature[j][0]) > kStraightTurn || std::abs(s.restCurvature[j][1]) > kStraightTurn)
+            return true;
+    return false;
+}
+
+void constraintJacobian(const RodStrand& s, const Vec3f* x, const Mat3f& R, bool holonomy, Eigen::MatrixXd& J,
+                        Eigen::VectorXd* C) {
     const int S = s.vertices - 1;
-    Eigen::MatrixXd Jt = Eigen::MatrixXd::Zero(3 * S, 3 * S);
+    J.setZero(3 * S, 3 * S);
+    if (C) C->resize(3 * S);
+    // ∇ψ_j over the free vertices' coordinates: ψ_0 = 0, ψ_{j+1} = ψ_j - m_j.
+    Eigen::VectorXd gradPsi = Eigen::VectorXd::Zero(holonomy ? 3 * S : 0);
+    auto addAt = [&](Eigen::VectorXd& row, int v, const Eigen::Vector3d& g) {
+        if (v >= 1) row.segment<3>(3 * (v - 1)) += g;
+    };
     forJoints(s, x, R, [&](int j, const Vec3f& u, float ulen, const Vec3f& e, const Vec3f& a, bool ghost) {
         Vec3f g[2][3];
-        bendConstraint(u, ulen, e, a, Vec2f::Zero(), ghost, g);
-        const Vec3f d = e.normalized();
+        const Vec2f c = s.restCurvature ? s.restCurvature[j] : Vec2f::Zero();
+        const Vec2f Cj = bendConstraint(u, ulen, e, a, c, ghost, g);
+        const float len = e.norm();
+        const Vec3f d = e / len;
         for (int slot = 0; slot < 3; ++slot) {
-            const int v = j - 1 + slot;  // free vertex v has unknowns 3(v-1)..3(v-1)+2
+            const int v = j - 1 + slot;  // free vertex v has columns 3(v-1)..3(v-1)+2
             if (v < 1) continue;
             const Vec3f gs = slot == 2 ? d : slot == 1 ? Vec3f(-d) : Vec3f::Zero();
             for (int k = 0; k < 3; ++k) {
-                Jt(3 * (v - 1) + k, 3 * j) = g[0][slot][k];
-                Jt(3 * (v - 1) + k, 3 * j + 1) = g[1][slot][k];
-                Jt(3 * (v - 1) + k, 3 * j + 2) = gs[k];
+                J(3 * j, 3 * (v - 1) + k) = double(g[0][slot][k]);
+                J(3 * j + 1, 3 * (v - 1) + k) = double(g[1][slot][k]);
+                J(3 * j + 2, 3 * (v - 1) + k) = double(gs[k]);
             }
         }
+        if (C) {
+            (*C)[3 * j] = double(Cj[0]);
+            (*C)[3 * j + 1] = double(Cj[1]);
+            (*C)[3 * j + 2] = double(len) - double(s.restLength[j]);
+        }
+        if (!holonomy) return;
+        // ∂C_j/∂ψ_j = (K_2, -K_1): the frame turned by δψ about d_{j-1}.
+        const Vec2f K = Cj + c;
+        J.row(3 * j) += double(K[1]) * gradPsi.transpose();
+        J.row(3 * j + 1) -= double(K[0]) * gradPsi.transpose();
+        // The reference twist of joint j: ∂m_j/∂e_j = κb_j/(2|e_j|),
+        // ∂m_j/∂e_{j-1} = κb_j/(2|e_{j-1}|) (none at the ghost joint).
+        const Eigen::Vector3d kb = (2.f * u.cross(d) / std::max(1.f + u.dot(d), 1e-4f)).cast<double>();
+        const Eigen::Vector3d gEdge = kb / (2.0 * double(len));
+        addAt(gradPsi, j + 1, -gEdge);
+        addAt(gradPsi, j, gEdge);
+        if (!ghost) {
+            const Eigen::Vector3d gParent = kb / (2.0 * double(ulen));
+            addAt(gradPsi, j, -gParent);
+            addAt(gradPsi, j - 1, gParent);
+        }
     });
-    return Jt;
+}
+
+Eigen::MatrixXd equilibriumMatrix(const RodStrand& s, const Vec3f* x, const Mat3f& R) {
+    Eigen::MatrixXd J;
+    constraintJacobian(s, x, R, true, J, nullptr);
+    return J.transpose();
 }
 
 void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec2f* c) {

@@ -107,6 +107,13 @@ struct RodScratch {
     std::vector<lanes::D4Store> band;             ///< banded systems, (bandwidth + 1) per row
     std::vector<lanes::D4Store> rhs, invD;        ///< right-hand sides (then Δλ), 1/pivots
     std::vector<lanes::D4Store> diag, lambda;     ///< stretch pass: pivots and right-hand side
+    /// Curled strands (rod_holonomy.cpp): per joint K_j = C_j + c_j (two
+    /// rows) and the reference twist's gradients ∂m_j/∂e_j, ∂m_j/∂e_{j-1};
+    /// per row α̃ and the right-hand side -C; the iterations' vectors.
+    std::vector<lanes::F4> curlA, curlB;
+    std::vector<lanes::V3<lanes::F4>> twistEdge, twistParent;
+    std::vector<lanes::D4Store> alphaRow, b, r, z, p, ap, q;
+    std::vector<lanes::D4Store> wide;  ///< the float data above widened (rod_holonomy.cpp)
 };
 
 /// One strand's state and root target for rodSteps.
@@ -175,14 +182,56 @@ Vec3f frameStart(const Mat3f& R, const Vec3f& d);
 /// root frame R: C_j(x) = 0, so x is the stress-free shape.
 void restCurvature(const RodStrand& s, const Vec3f* x, const Mat3f& R, Vec2f* c);
 
-/// The equilibrium matrix Jᵀ of a strand at x: the gradients of its
-/// constraints with respect to the free vertices x_1..x_{n-1}, one column
-/// per constraint row (joint j: columns 3j, 3j+1 its two bend rows, 3j+2
-/// its stretch row; row 3(i-1)+k: vertex i's coordinate k), the stretch
-/// rows' gradients d_j. Square (3(n-1)) and invertible: block triangular
-/// from the tip (vertex n-1 appears only in the last joint's rows). The
-/// pre-load solves with it (sim/guides/rod_preload.h).
+/// A rest turn |c_j| (either component, rad) at or below which a joint
+/// counts as straight: a straight groom's rest curvatures are its
+/// coordinates' rounding, up to 1.6·10⁻⁶ (B-sim's straight guides without
+/// pre-load); a pre-load's are 0.27 rad and more (B-sim's). The holonomy's
+/// term is O(|c|·|K|), negligible below it.
+constexpr float kStraightTurn = 1e-4f;
+
+/// True where the strand bends (EI > 0) and some rest curvature c_j is not
+/// zero (above kStraightTurn): there the transported frame's holonomy
+/// enters the bending force, and rodSteps solves with the full Jacobian
+/// (constraintJacobian).
+bool curled(const RodStrand& s);
+
+/// The Jacobian J of a strand's constraints at x with respect to the free
+/// vertices x_1..x_{n-1} (3(n-1) square): row 3j, 3j+1 the bend rows of
+/// joint j, 3j+2 its stretch row C = |e_j| - l_j (gradient ±d_j); column
+/// 3(i-1)+k vertex i's coordinate k. C (if not null) receives C(x).
+/// holonomy: the bend rows' gradient includes the frame's turn. The frame
+/// of joint j is carried by parallel transport from the root through the
+/// turns of joints 0..j-1, so it turns about d_{j-1} by the holonomy
+/// ψ_j = -Σ_{k<j} m_k (m_k the reference twist of joint k; Bergou et al.
+/// 2008, "Discrete elastic rods"), and turning the frame by δψ turns
+/// K_j = (κb·a, κb·b) by δψ·(K_2, -K_1):
+///   ∇C_j = ∇C_j|frame fixed + (K_2, -K_1) ⊗ ∇ψ_j,  ∇ψ_j = -Σ_{k<j} ∇m_k,
+///   ∂m_k/∂e_{k-1} = κb_k/(2|e_{k-1}|),  ∂m_k/∂e_k = κb_k/(2|e_k|).
+/// Then Σ_j EI_j/l̄_j·∇C_jᵀ C_j is the gradient of bendEnergy for any rest
+/// curvature. Joint j's rows touch vertices up to j+1 only: block lower
+/// triangular, and invertible (vertex j+1 meets joint j only through the
+/// frame-fixed part, as without the holonomy).
+void constraintJacobian(const RodStrand& s, const Vec3f* x, const Mat3f& R, bool holonomy, Eigen::MatrixXd& J,
+                        Eigen::VectorXd* C);
+
+/// The equilibrium matrix Jᵀ of a strand at x (constraintJacobian with the
+/// holonomy, transposed: one column per constraint row, one row per free
+/// coordinate). Square (3(n-1)) and invertible. The pre-load solves with it
+/// (sim/guides/rod_preload.h): with the holonomy, the static equilibrium of
+/// the step that rodSteps takes for a curled strand.
 Eigen::MatrixXd equilibriumMatrix(const RodStrand& s, const Vec3f* x, const Mat3f& R);
+
+/// The solve of step 2 for the curled lanes of rodSteps (rod_holonomy.cpp):
+/// (J W Jᵀ + α̃) Δλ = -C with J = constraintJacobian(holonomy), by
+/// conjugate gradients preconditioned with the banded factorization of the
+/// frame-fixed system (sc.band, sc.invD after bandedFactor), from its
+/// solution (sc.rhs). J W Jᵀ is applied in O(n): Jᵀ by suffix sums of the
+/// twisting moments, J by prefix sums of the holonomy. Each lane iterates
+/// until its own residual |r| ≤ 10⁻⁵|C| (at most 100 times), so a
+/// strand's result does not depend on its batch. Lanes not in `curled` are
+/// left as they are. Returns the iterations of all lanes.
+int holonomyIterate(RodScratch& sc, int n, const bool curled[kLanes]);
+
 
 /// One XPBD step of length h for one strand (x: positions at the step's
 /// start, v: velocities; root at rootPos with frame rootFrame at the end):
@@ -191,7 +240,10 @@ Eigen::MatrixXd equilibriumMatrix(const RodStrand& s, const Vec3f* x, const Mat3
 ///     for bend rows, 0 for stretch rows (hard), J the constraint gradients,
 ///     W the inverse masses; the system is banded (bandwidth 8 over rows
 ///     ordered joint by joint) and solved by banded LDLᵀ in double;
-///     y += W Jᵀ Δλ;
+///     y += W Jᵀ Δλ. For a curled strand (curled(s)) J includes the
+///     frame's holonomy (constraintJacobian), so the step is the gradient
+///     of bendEnergy: the banded solve then preconditions conjugate
+///     gradients on the full system (holonomyIterate);
 ///  3. exact lengths and head clearance root to tip (strand::placeSegment);
 ///     a vertex that cannot be placed outside the head at its length is
 ///     pinned: put back at its length toward its place at the step's start,

@@ -84,7 +84,7 @@ inline void setLane(V3& v, int l, const Vec3f& p) {
 /// h: the step of the prediction and of α̃ (BDF2's h', rod_kernels.h
 /// bdf2Step); with history, the prediction starts from x̄, v̄ (bdf2Extrapolate),
 /// kept in sc.start for the velocities.
-void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, float h, RodScratch& sc) {
+void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, float h, bool holonomy, RodScratch& sc) {
     const RodStrand& s0 = *t[0].strand;
     const int n = s0.vertices, S = n - 1;
     V3* y = sc.y.data();
@@ -138,6 +138,23 @@ void assemble(const RodStepTarget* t, const int* src, const Vec3f& gravity, floa
         F4 C[2];
         V3 g[2][3];
         lanes::bendRows(u, ulen, e, a, c, j == 0, C, g);
+        if (holonomy) {
+            // Curled lanes (rod_holonomy.cpp): K_j = C_j + c_j, the reference
+            // twist's gradients κb_j/(2|e_j|) and κb_j/(2|e_{j-1}|) (none at
+            // the ghost joint), α̃ per row.
+            const F4 len = lanes::norm(e);
+            const V3 d = e / len;
+            const F4 cosTurn = 1.f + lanes::dot(u, d);
+            const F4 denom = lanes::select(cosTurn < 1e-4f, lanes::splat<F4>(1e-4f), cosTurn);
+            const V3 kb = (2.f * lanes::cross(u, d)) / denom;
+            sc.curlA[size_t(j)] = C[0] + c[0];
+            sc.curlB[size_t(j)] = C[1] + c[1];
+            sc.twistEdge[size_t(j)] = kb / (2.f * len);
+            sc.twistParent[size_t(j)] = j == 0 ? V3{} : kb / (2.f * ulen);
+            D4* alphaRow = lanes::view(sc.alphaRow);
+            alphaRow[3 * j] = alphaRow[3 * j + 1] = alpha;
+            alphaRow[3 * j + 2] = D4{};
+        }
         for (int k = 0; k < 2; ++k) {
             const int r = 3 * j + k;
             // A strand without bending stiffness has inert bend rows
@@ -279,9 +296,27 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
     // implicit Euler step of h' from x̄, v̄; velocities (y - x̄)/h'.
     const bool bdf2 = targets[0].xBack != nullptr;
     const float hv = bdf2 ? bdf2Step(h) : h;
-    assemble(targets, src, gravity, hv, sc);
-    bandedSolve(lanes::view(sc.band), lanes::view(sc.invD), lanes::view(sc.rhs), N);
-    // 2. y += W Jᵀ Δλ: row r of joint r/3 moves its vertices j-1, j, j+1.
+    // Curled strands' lanes (rod::curled) solve with the frame's holonomy
+    // (rod_holonomy.cpp); without one, the banded solve alone, as before.
+    bool curledLane[kLanes] = {};
+    bool anyCurled = false;
+    for (int k = 0; k < count; ++k) anyCurled = (curledLane[k] = curled(*targets[k].strand)) || anyCurled;
+    if (anyCurled) {
+        for (auto* v : {&sc.curlA, &sc.curlB}) v->resize(size_t(n));
+        for (auto* v : {&sc.twistEdge, &sc.twistParent}) v->resize(size_t(n));
+        sc.alphaRow.resize(size_t(N));
+        sc.b.resize(size_t(N));
+    }
+    assemble(targets, src, gravity, hv, anyCurled, sc);
+    if (anyCurled) {
+        std::memcpy(static_cast<void*>(sc.b.data()), sc.rhs.data(), size_t(N) * sizeof(lanes::D4Store));
+        bandedSolve(lanes::view(sc.band), lanes::view(sc.invD), lanes::view(sc.rhs), N);
+        holonomyIterate(sc, n, curledLane);
+    } else {
+        bandedSolve(lanes::view(sc.band), lanes::view(sc.invD), lanes::view(sc.rhs), N);
+    }
+    // 2. y += W Jᵀ Δλ: row r of joint r/3 moves its vertices j-1, j, j+1;
+    // in a curled lane also -Σ_k T_k ∇m_k (rod_kernels.h constraintJacobian).
     V3* y = sc.y.data();
     const F4* w = sc.w.data();
     for (int r = 0; r < N; ++r) {
@@ -289,6 +324,21 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
         for (int slot = 0; slot < 3; ++slot) {
             const int vtx = r / 3 - 1 + slot;
             if (vtx >= 1) y[vtx] = y[vtx] + (w[vtx] * dl) * sc.grad[size_t(3 * r + slot)];
+        }
+    }
+    if (anyCurled) {
+        const D4* dl = lanes::view(sc.rhs);
+        F4 mask{};
+        for (int k = 0; k < count; ++k) mask[k] = curledLane[k] ? 1.f : 0.f;
+        const auto on = mask != 0.f;  // the other lanes keep their bits
+        D4 T{};
+        for (int k = n - 2; k >= 0; --k) {
+            const F4 Tk = lanes::narrow(T);
+            const V3 gE = Tk * sc.twistEdge[size_t(k)], gP = Tk * sc.twistParent[size_t(k)];
+            y[k + 1] = lanes::select(on, y[k + 1] - w[k + 1] * gE, y[k + 1]);
+            if (k >= 1) y[k] = lanes::select(on, y[k] + w[k] * (gE - gP), y[k]);
+            if (k >= 2) y[k - 1] = lanes::select(on, y[k - 1] + w[k - 1] * gP, y[k - 1]);
+            T += lanes::widen(sc.curlB[size_t(k)]) * dl[3 * k] - lanes::widen(sc.curlA[size_t(k)]) * dl[3 * k + 1];
         }
     }
     stretchSolve(y, w, sc.rest.data(), n, lanes::view(sc.diag), lanes::view(sc.lambda), sc.dir.data(),
