@@ -72,6 +72,10 @@ enum class VoxelSplat { Nearest, Trilinear };
 /// fragment weighted by its strand's projected area in the voxel's column),
 /// or fragments (Dehlin and Styngberg 2017: each fragment adds 1, whatever the hair's width).
 enum class VoxelWeight { Crossings, Fragments };
+/// Where the strands are voxelized for the light grids: on the CPU
+/// (render/preview/cpu_voxels.h, the same grid), or by the GPU's rasterizer;
+/// Auto: the CPU on a software renderer (llvmpipe), the GPU otherwise.
+enum class VoxelizeOn { Auto, Gpu, Cpu };
 
 /// Most lights the preview shadows: each costs a voxelization of the hair, a
 /// sum along its light, a shadow map and a density grid (render/preview/
@@ -107,6 +111,7 @@ struct PreviewShadowSettings {
     VoxelWeight weight = VoxelWeight::Crossings;
     /// Fragments only: transmittance per counted fragment (or occupied voxel).
     float alpha = 0.85f;
+    VoxelizeOn voxelize = VoxelizeOn::Auto;
     /// With several shadowed lights, tessellate the strands once, from the
     /// first shadowed light, capture the pieces (transform feedback) and
     /// voxelize that geometry into every light's grid; false tessellates the
