@@ -92,21 +92,25 @@ TEST(PreviewCpuVoxels, GridMatchesTheGpuLightPasses) {
 // The same grids with one thread and with two, bit for bit, in every voxel
 // mode (integer deposits, summed by atomic adds in whatever order).
 TEST(PreviewCpuVoxels, SameBitsOnOneAndTwoThreads) {
-    const test::HairOnHead h = rigScene();
+    test::HairOnHead h = rigScene();
+    SyntheticHairSettings hs;
+    hs.strands = 40000;  // enough work that TBB's second thread takes part (a 3000-strand grid ends before it wakes)
+    h.strands = makeSyntheticHair(hs);
     Eigen::AlignedBox3f bounds;
     for (const Vec3f& p : h.strands.positions) bounds.extend(p);
     const std::vector<ShadowSlot> slots = fitShadowSlots(h.view.lights, 3, bounds);
     ASSERT_EQ(slots.size(), 3u);
     const int resolutions[3] = {96, 64, 48};
+    tbb::task_arena single(1), both(2);
+    std::vector<uint32_t> warm[kMaxShadowedLights];  // wakes the second thread before the grids compared
+    both.execute([&] { voxelizeSlotsOnCpu(&h.strands, slots, resolutions, PreviewSettings{}, 32, true, warm); });
     for (int mode = 0; mode < 3; ++mode) {
         PreviewSettings s;
         s.shadow.mode = mode == 0 ? VoxelMode::Binary : VoxelMode::Additive;
         s.shadow.splat = mode == 2 ? VoxelSplat::Trilinear : VoxelSplat::Nearest;
         std::vector<uint32_t> one[kMaxShadowedLights], two[kMaxShadowedLights];
-        tbb::task_arena(1).execute(
-            [&] { voxelizeSlotsOnCpu(&h.strands, slots, resolutions, s, 32, true, one); });
-        tbb::task_arena(2).execute(
-            [&] { voxelizeSlotsOnCpu(&h.strands, slots, resolutions, s, 32, true, two); });
+        single.execute([&] { voxelizeSlotsOnCpu(&h.strands, slots, resolutions, s, 32, true, one); });
+        both.execute([&] { voxelizeSlotsOnCpu(&h.strands, slots, resolutions, s, 32, true, two); });
         for (int k = 0; k < 3; ++k) {
             ASSERT_EQ(one[k].size(), size_t(resolutions[k]) * resolutions[k] * resolutions[k]);
             EXPECT_GT(std::accumulate(one[k].begin(), one[k].end(), uint64_t(0)), uint64_t(0));

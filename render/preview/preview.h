@@ -37,7 +37,9 @@
 //   voxelized from that light into an r32ui 3D texture with image atomics
 //   (Dehlin and Styngberg's binary/additive, nearest/trilinear), summed along
 //   the light in a compute pass into the light's density grid, transmittance
-//   alpha^C; times a PCF shadow map of the head from that light. Point lights
+//   alpha^C; times a PCF shadow map of the head from that light. On a
+//   software renderer the same grids are filled and summed on the CPU
+//   (render/preview/cpu_voxels.h, PreviewShadowSettings::voxelize). Point lights
 //   use a perspective frustum. The strands are tessellated once for all the
 //   lights (from the first; the pieces captured by transform feedback and
 //   drawn again as lines from the others' views).
