@@ -16,6 +16,7 @@ set(_hp_slow_tests
   test_preview:Preview.VoxelShadowsDarkenStrandBehindSlab      # llvmpipe raster
   test_preview_cpu_voxels:PreviewCpuVoxels.GridMatchesTheGpuLightPasses  # four renderers' programs, rig shadowed
   test_preview_cpu_voxels:PreviewCpuVoxels.SameBitsOnOneAndTwoThreads  # 40,000 strands voxelized 7 times
+  test_preview_cpu_voxels:PreviewCpuVoxels.OtherModesMatchTheGpu  # eight renderers' programs
   test_preview_shadows:PreviewShadows.SecondLightThroughHairIsBeerLambert  # four renders with shadows
   test_preview_shadows:PreviewShadows.ShadowingTheFillDarkensTheHair  # five renders under the rig
   test_preview_shadows:PreviewShadows.CapAndOrderOfShadowedLights  # three renderers' programs

@@ -89,6 +89,39 @@ TEST(PreviewCpuVoxels, GridMatchesTheGpuLightPasses) {
     }
 }
 
+// The other voxel modes (binary, trilinear) and Dehlin and Styngberg's
+// fragment count, one light, a point light's perspective frustum among
+// them: the same agreement.
+TEST(PreviewCpuVoxels, OtherModesMatchTheGpu) {
+    HP_REQUIRE_GL();
+    test::HairOnHead h = test::hairOnHead(320, 240);
+    for (int mode = 0; mode < 4; ++mode) {
+        PreviewSettings gs = gridSettings(VoxelizeOn::Gpu), cs = gridSettings(VoxelizeOn::Cpu);
+        for (PreviewSettings* s : {&gs, &cs}) {
+            s->shadow.mode = mode == 0 ? VoxelMode::Binary : VoxelMode::Additive;
+            s->shadow.splat = mode == 1 ? VoxelSplat::Trilinear : VoxelSplat::Nearest;
+            s->shadow.weight = mode == 2 ? VoxelWeight::Fragments : VoxelWeight::Crossings;
+        }
+        View v = h.view;
+        if (mode == 3) {  // a point light above and to the side, outside the hair's bounds
+            v.lights[0].type = LightType::Point;
+            v.lights[0].position = Vec3f(0.6f, 0.5f, 0.4f);
+        }
+        PreviewRenderer gpu(gs), cpu(cs);
+        PreviewFrame frame;
+        frame.strands = &h.strands;
+        gpu.draw(v, frame);
+        cpu.draw(v, frame);
+        const VoxelSnapshot g = gpu.readVoxels(0), c = cpu.readVoxels(0);
+        ASSERT_EQ(g.grid.perspective, mode == 3);
+        const auto [diff, mass] = l1AndMass(c.raw, g.raw);
+        const double cpuMass = std::accumulate(c.raw.begin(), c.raw.end(), 0.0);
+        ASSERT_GT(mass, 10.0) << "mode " << mode;
+        EXPECT_NEAR(cpuMass / mass, 1.0, 1e-3) << "mode " << mode;
+        EXPECT_LT(diff / mass, 0.005) << "mode " << mode << ": sum |CPU - GPU| " << diff << " of " << mass;
+    }
+}
+
 // The same grids with one thread and with two, bit for bit, in every voxel
 // mode (integer deposits, summed by atomic adds in whatever order).
 TEST(PreviewCpuVoxels, SameBitsOnOneAndTwoThreads) {
