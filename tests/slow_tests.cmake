@@ -24,6 +24,7 @@ set(_hp_slow_tests
   test_preview_skin:PreviewSkin.SkinThroughTheHairMatchesThePhysicalSlab  # two 64-spp physical renders
   test_preview_skin:PreviewSkin.ScalpBounceIsTheSkinsLightThroughTheHair  # three renders with shadows
   test_preview_compute:PreviewCompute.ComputeShadedVerticesMatchStageShadedOnes  # twenty-four renders
+  test_preview_line_pieces:PreviewLinePieces.ComputePiecesMatchTheTessellationStages  # sixteen renders
   test_preview_stage:PreviewStage.ViewerRendersUnderXvfb       # Xvfb start-up
   test_guides:Guides.StableOverTenThousandStepsWithATeleport   # 10^4 solver steps
   test_vdb:VdbFile.BytesAreIdenticalForOneAndTwoThreadsAndRepeatedWrites

@@ -7,6 +7,7 @@
 #include "core/log.h"
 #include "render/preview/cpu_voxels.h"
 #include "render/preview/gl_program.h"
+#include "render/preview/line_pieces.h"
 #include "render/preview/pass_clock.h"
 #include "render/preview/preview_gpu.h"
 #include "render/preview/voxel_programs.h"
@@ -43,6 +44,7 @@ struct PreviewRenderer::Impl {
     std::vector<float> cpuDensity;    ///< a slot's density summed on the CPU, for its upload
     bool densityFromCpu = false;      ///< the last frame's densities were summed on the CPU (readVoxels)
     ShadedPoints shadedPoints;
+    LinePieces linePieces;  ///< the thin strands' pieces from compute passes (line_pieces.h)
     GLuint cameraUbo = 0, emptyVao = 0, query = 0;
     GLuint lightUbo[kMaxShadowedLights] = {};  ///< one per shadowed light: its passes' grid
     GLsync fence = nullptr;
@@ -101,6 +103,7 @@ struct PreviewRenderer::Impl {
         shadows.destroy();
         captured.destroy();
         shadedPoints.destroy();
+        linePieces.destroy();
         glDeleteBuffers(1, &cameraUbo);
         glDeleteBuffers(kMaxShadowedLights, lightUbo);
         glDeleteVertexArrays(1, &emptyVao);
@@ -113,8 +116,9 @@ struct PreviewRenderer::Impl {
     void compileHairPrograms(int patchSize) {
         const bool perFragment = settings.shadePerFragment;
         const bool inCompute = settings.shadeInCompute && !perFragment;
+        const bool pieces = !perFragment && !inCompute && linePiecesInCompute(settings.piecesInCompute, stats.renderer);
         if (patchSize == strandPatchSize && perFragment == shadedPerFragment && inCompute == shadedInCompute &&
-            hairDefines == compiledHairDefines && strand.id())
+            hairDefines == compiledHairDefines && strand.id() && pieces == linePieces.compiled())
             return;
         std::vector<std::string> shading = perFragment ? std::vector<std::string>{"SHADE_PER_FRAGMENT"}
                                                        : std::vector<std::string>{};
@@ -139,6 +143,7 @@ struct PreviewRenderer::Impl {
         }
         strand = GlProgram("strand ribbons", camera, thick);
         strandLines = GlProgram("strand lines", lines, thin);
+        linePieces.compile(pieces, defines, shading);
         fur = GlProgram("generated hair",
                         {{ShaderStage::Vertex, "fur.vert"},
                          {ShaderStage::TessControl, "fur.tesc"},
@@ -363,7 +368,12 @@ struct PreviewRenderer::Impl {
         }
         if (lineWidth > 0.f) {
             glLineWidth(lineWidth);
-            drawStrands(strandLines);
+            if (linePieces.compiled() && strandsVisible) {
+                linePieces.build(strands);
+                mark("strand pieces (compute)");
+                linePieces.draw();
+            } else
+                drawStrands(strandLines);
             glLineWidth(1.f);
             mark("strand lines");
         }

@@ -146,6 +146,12 @@ struct PreviewSettings {
     /// of a 560 x 720 one, whose pieces span several vertices
     /// (docs/benchmarks.md).
     bool shadeInCompute = false;
+    /// The thin strands' line pieces (per-vertex shading, the line path):
+    /// made by compute passes and drawn as plain lines (1), or by the
+    /// tessellation stages (0); -1: compute on software rasterizers, which
+    /// run the tessellation stages on one thread (render/preview/line_pieces.h).
+    /// The same pieces and shading: pixels agree to FLIP ~1e-4.
+    int piecesInCompute = -1;
     /// Compile the hair programs for each frame's lights, flags and hair
     /// model (llvmpipe pays both sides of a branch on a uniform); false: one
     /// program that reads them from uniforms (the same pixels; tests).
