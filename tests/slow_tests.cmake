@@ -14,6 +14,9 @@ set(_hp_slow_tests
   test_hair_bsdf:HairBsdf.SampledWhiteFurnaceConservesEnergy
   test_compare:CompareReport.IsSelfContainedAndRendersInHeadlessChromium  # Chromium start-up
   test_preview:Preview.VoxelShadowsDarkenStrandBehindSlab      # llvmpipe raster
+  test_preview_cpu_voxels:PreviewCpuVoxels.GridMatchesTheGpuLightPasses  # four renderers' programs, rig shadowed
+  test_preview_cpu_voxels:PreviewCpuVoxels.SameBitsOnOneAndTwoThreads  # 40,000 strands voxelized 7 times
+  test_preview_cpu_voxels:PreviewCpuVoxels.OtherModesMatchTheGpu  # eight renderers' programs
   test_preview_shadows:PreviewShadows.SecondLightThroughHairIsBeerLambert  # four renders with shadows
   test_preview_shadows:PreviewShadows.ShadowingTheFillDarkensTheHair  # five renders under the rig
   test_preview_shadows:PreviewShadows.CapAndOrderOfShadowedLights  # three renderers' programs
@@ -21,6 +24,7 @@ set(_hp_slow_tests
   test_preview_skin:PreviewSkin.SkinThroughTheHairMatchesThePhysicalSlab  # two 64-spp physical renders
   test_preview_skin:PreviewSkin.ScalpBounceIsTheSkinsLightThroughTheHair  # three renders with shadows
   test_preview_compute:PreviewCompute.ComputeShadedVerticesMatchStageShadedOnes  # twenty-four renders
+  test_preview_line_pieces:PreviewLinePieces.ComputePiecesMatchTheTessellationStages  # sixteen renders
   test_preview_stage:PreviewStage.ViewerRendersUnderXvfb       # Xvfb start-up
   test_guides:Guides.StableOverTenThousandStepsWithATeleport   # 10^4 solver steps
   test_vdb:VdbFile.BytesAreIdenticalForOneAndTwoThreadsAndRepeatedWrites

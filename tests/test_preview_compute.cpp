@@ -84,6 +84,7 @@ TEST(PreviewCompute, ComputeShadedVerticesMatchStageShadedOnes) {
             stage.minPixelWidth = c.minPixelWidth;
             stage.curve = c.curve;
             stage.shadeInCompute = false;
+            stage.piecesInCompute = 0;  // the tessellation stages' pieces, as the compute shading's (line_pieces.h)
             PreviewSettings compute = stage;
             compute.shadeInCompute = true;
             PreviewStats stats;

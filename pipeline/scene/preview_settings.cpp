@@ -38,6 +38,8 @@ PreviewSettings makePreviewSettings(const Scene& s) {
         s.fail("preview.shadow.splat",
                "trilinear splatting spreads fractions of a fragment, which only adds up with voxel_mode: additive "
                "(Dehlin and Styngberg 2017 compare nearest/binary, nearest/additive and trilinear/additive)");
+    const std::string& voxelize = s.text("preview.shadow.voxelize");
+    sh.voxelize = voxelize == "cpu" ? VoxelizeOn::Cpu : voxelize == "gpu" ? VoxelizeOn::Gpu : VoxelizeOn::Auto;
     sh.weight = s.text("preview.shadow.weight") == "fragments" ? VoxelWeight::Fragments : VoxelWeight::Crossings;
 
     GeneratedHairSettings& g = p.generated;

@@ -5,7 +5,9 @@
 
 #include "core/errors.h"
 #include "core/log.h"
+#include "render/preview/cpu_voxels.h"
 #include "render/preview/gl_program.h"
+#include "render/preview/line_pieces.h"
 #include "render/preview/pass_clock.h"
 #include "render/preview/preview_gpu.h"
 #include "render/preview/voxel_programs.h"
@@ -17,17 +19,7 @@
 #include <cstring>
 
 namespace hp {
-
-namespace {
-
 using Files = std::vector<std::pair<ShaderStage, std::string>>;
-
-/// Segments per patch when hair is sorted: short enough that a piece of
-/// strand rarely straddles another in depth, long enough to keep the
-/// per-patch cost of software rasterizers down.
-constexpr int kSortedPatchSegments = 4;
-
-}  // namespace
 
 struct PreviewRenderer::Impl {
     PreviewSettings settings;
@@ -47,7 +39,12 @@ struct PreviewRenderer::Impl {
     RenderTargets targets;
     ShadowTargets shadows;
     CapturedPieces captured;
+    std::vector<uint32_t> cpuVoxels[kMaxShadowedLights];  ///< VoxelizeOn::Cpu: each slot's grid (cpu_voxels.h)
+    std::vector<uint32_t> cpuLinear;  ///< the same in the texture's order, when generated hair adds to it on the GPU
+    std::vector<float> cpuDensity;    ///< a slot's density summed on the CPU, for its upload
+    bool densityFromCpu = false;      ///< the last frame's densities were summed on the CPU (readVoxels)
     ShadedPoints shadedPoints;
+    LinePieces linePieces;  ///< the thin strands' pieces from compute passes (line_pieces.h)
     GLuint cameraUbo = 0, emptyVao = 0, query = 0;
     GLuint lightUbo[kMaxShadowedLights] = {};  ///< one per shadowed light: its passes' grid
     GLsync fence = nullptr;
@@ -106,6 +103,7 @@ struct PreviewRenderer::Impl {
         shadows.destroy();
         captured.destroy();
         shadedPoints.destroy();
+        linePieces.destroy();
         glDeleteBuffers(1, &cameraUbo);
         glDeleteBuffers(kMaxShadowedLights, lightUbo);
         glDeleteVertexArrays(1, &emptyVao);
@@ -118,8 +116,9 @@ struct PreviewRenderer::Impl {
     void compileHairPrograms(int patchSize) {
         const bool perFragment = settings.shadePerFragment;
         const bool inCompute = settings.shadeInCompute && !perFragment;
+        const bool pieces = !perFragment && !inCompute && linePiecesInCompute(settings.piecesInCompute, stats.renderer);
         if (patchSize == strandPatchSize && perFragment == shadedPerFragment && inCompute == shadedInCompute &&
-            hairDefines == compiledHairDefines && strand.id())
+            hairDefines == compiledHairDefines && strand.id() && pieces == linePieces.compiled())
             return;
         std::vector<std::string> shading = perFragment ? std::vector<std::string>{"SHADE_PER_FRAGMENT"}
                                                        : std::vector<std::string>{};
@@ -144,6 +143,7 @@ struct PreviewRenderer::Impl {
         }
         strand = GlProgram("strand ribbons", camera, thick);
         strandLines = GlProgram("strand lines", lines, thin);
+        linePieces.compile(pieces, defines, shading);
         fur = GlProgram("generated hair",
                         {{ShaderStage::Vertex, "fur.vert"},
                          {ShaderStage::TessControl, "fur.tesc"},
@@ -203,17 +203,23 @@ struct PreviewRenderer::Impl {
     /// voxelized from it and summed along it into the slot's density grid.
     /// With shareTessellation the first slot's pass captures its strand
     /// pieces and the others draw those (one tessellation for all lights).
-    void shadowPasses(bool mapOn, bool voxelsOn, const StrandFrame* strandFrame) {
+    void shadowPasses(bool mapOn, bool voxelsOn, bool onCpu, const StrandFrame* strandFrame) {
         const PreviewShadowSettings& sh = settings.shadow;
         const int n = int(slots.size());
         shadows.ensure(std::clamp(sh.shadowMapSize, 16, 16384), n, slotResolution);
         glDisable(GL_BLEND);
         const StrandBuffers& ls = lightStrandsUsed ? lightStrands : strands;
-        const bool share = voxelsOn && sh.shareTessellation && n > 1 && strandsVisible && ls.indexCount;
-        if (share)
+        const bool share = voxelsOn && sh.shareTessellation && n > 1 && strandsVisible && (ls.indexCount || onCpu);
+        if (onCpu)  // VoxelizeOn::Cpu: every grid filled here, uploaded below (cpu_voxels.h)
+            voxelizeSlotsOnCpu(strandsVisible ? strandFrame : nullptr, slots, slotResolution, settings,
+                               strands.maxPatchVertices, share, cpuVoxels);
+        else if (share)
             captured.ensure(lightPieceVertexBound(ls, *strandFrame, slots[0].grid, slotResolution[0],
                                                   std::clamp(settings.tessellationLevel, 1, 64),
-                                                  settings.tessellationPixels * float(supersample())));
+                                                  settings.tessellationPixels * float(supersample()),
+                                                  lightStrandsUsed ? kSortedPatchSegments : 0));
+        densityFromCpu = onCpu && !furVisible;
+        if (onCpu) mark("voxelize (CPU)");
         for (int k = 0; k < n; ++k) {
             glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightUbo[k]);
             if (mapOn) {
@@ -232,15 +238,27 @@ struct PreviewRenderer::Impl {
             }
             if (!voxelsOn) continue;
             const int res = slotResolution[k];
+            if (densityFromCpu) {  // summed on the CPU too (no generated hair to add on the GPU)
+                sumCpuVoxels(cpuVoxels[k], res, sh.sumAlongLight, cpuDensity);
+                glTextureSubImage3D(shadows.density[k], 0, 0, 0, 0, res, res, res, GL_RED, GL_FLOAT, cpuDensity.data());
+                mark("voxel sum (CPU) + upload");
+                continue;
+            }
             const GLuint zero = 0;
-            glClearTexImage(shadows.voxels[k], 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
-            mark("voxel clear");
+            if (onCpu) linearCpuVoxels(cpuVoxels[k], res, cpuLinear);
+            if (onCpu)
+                glTextureSubImage3D(shadows.voxels[k], 0, 0, 0, 0, res, res, res, GL_RED_INTEGER, GL_UNSIGNED_INT,
+                                    cpuLinear.data());
+            else
+                glClearTexImage(shadows.voxels[k], 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+            mark(onCpu ? "voxel upload" : "voxel clear");
             glBindFramebuffer(GL_FRAMEBUFFER, shadows.voxelFbo);
             glViewport(0, 0, res, res);
             glDisable(GL_DEPTH_TEST);
             glDepthMask(GL_FALSE);
             glBindImageTexture(0, shadows.voxels[k], 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
-            if (share && k == 0) {
+            if (onCpu) {  // only generated hair is left to voxelize
+            } else if (share && k == 0) {
                 // The program is bound before capturing starts (GL forbids
                 // changing it while transform feedback is active).
                 voxel.strands.use();
@@ -350,7 +368,12 @@ struct PreviewRenderer::Impl {
         }
         if (lineWidth > 0.f) {
             glLineWidth(lineWidth);
-            drawStrands(strandLines);
+            if (linePieces.compiled() && strandsVisible) {
+                linePieces.build(strands);
+                mark("strand pieces (compute)");
+                linePieces.draw();
+            } else
+                drawStrands(strandLines);
             glLineWidth(1.f);
             mark("strand lines");
         }
@@ -501,7 +524,8 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
     glNamedBufferSubData(cameraUbo, 0, sizeof(u), &u);
     hairDefines = settings.specializeShading ? hairShadingDefines(u) : std::vector<std::string>{};
     compileHairPrograms(strandPatchSize);  // follows a changed shading rate, lights or hair model
-    lightStrandsUsed = voxelsOn && drawStrandsNow && settings.blend == HairBlend::Sorted;
+    const bool onCpu = voxelsOn && voxelizeOnCpu(sh.voxelize, stats.renderer);
+    lightStrandsUsed = voxelsOn && !onCpu && drawStrandsNow && settings.blend == HairBlend::Sorted;
     if (lightStrandsUsed) lightStrands.upload(*frame.strands, 0);
     // Follows a changed patch size or voxel settings. The whole strands are
     // cut into at least a piece per kSortedPatchSegments segments, as many as
@@ -514,7 +538,7 @@ void PreviewRenderer::Impl::draw(const View& view, const PreviewFrame& frame) {
             setPassGrid(l, slots[k].grid, slotResolution[k]);
             glNamedBufferSubData(lightUbo[k], 0, sizeof(l), &l);
         }
-        shadowPasses(mapOn, voxelsOn, frame.strands);
+        shadowPasses(mapOn, voxelsOn, onCpu, frame.strands);
     }
     targets.ensure(cam.width, cam.height, samples(), supersample());
     cameraPass(voxelsOn, mapOn, lineWidth);
@@ -546,23 +570,7 @@ Image PreviewRenderer::render(const View& view, const PreviewFrame& frame) {
     return readback();
 }
 
-Image PreviewRenderer::readback() const {
-    const RenderTargets& t = impl_->targets;
-    if (!t.resolvedFbo) throw FrameError("preview: nothing drawn yet");
-    const int w = t.width, h = t.height;
-    std::vector<float> rgba(size_t(w) * h * 4), z(size_t(w) * h);
-    glGetTextureImage(t.resolvedColor, 0, GL_RGBA, GL_FLOAT, GLsizei(rgba.size() * sizeof(float)), rgba.data());
-    glGetTextureImage(t.resolvedDepth, 0, GL_RED, GL_FLOAT, GLsizei(z.size() * sizeof(float)), z.data());
-    Image image(w, h, {"R", "G", "B", "A", "Z"});
-    for (int y = 0; y < h; ++y) {
-        const size_t src = size_t(h - 1 - y) * w;  // GL rows start at the bottom
-        for (int x = 0; x < w; ++x) {
-            for (int c = 0; c < 4; ++c) image.at(x, y, c) = rgba[(src + x) * 4 + c];
-            image.at(x, y, 4) = z[src + x];
-        }
-    }
-    return image;
-}
+Image PreviewRenderer::readback() const { return impl_->targets.read(); }
 
 void PreviewRenderer::present(int x, int y, int width, int height) const {
     const Impl& m = *impl_;
@@ -581,16 +589,10 @@ VoxelSnapshot PreviewRenderer::readVoxels(int slot) const {
     const Impl& m = *impl_;
     VoxelSnapshot snap;
     if (!m.voxelsDrawn || slot < 0 || size_t(slot) >= m.slots.size()) return snap;
-    const int r = m.slotResolution[slot];
-    const size_t n = size_t(r) * r * r;
-    snap.resolution = r;
+    snap.resolution = m.slotResolution[slot];
     snap.grid = m.slots[size_t(slot)].grid;
-    std::vector<uint32_t> raw(n);
-    glGetTextureImage(m.shadows.voxels[slot], 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(n * 4), raw.data());
-    snap.raw.resize(n);
-    for (size_t i = 0; i < n; ++i) snap.raw[i] = float(raw[i]) / kVoxelUnit;
-    snap.summed.resize(n);
-    glGetTextureImage(m.shadows.density[slot], 0, GL_RED, GL_FLOAT, GLsizei(n * 4), snap.summed.data());
+    snap.raw = m.densityFromCpu ? cpuVoxelValues(m.cpuVoxels[slot], snap.resolution) : m.shadows.readRaw(slot);
+    snap.summed = m.shadows.readSummed(slot);
     return snap;
 }
 

@@ -37,7 +37,9 @@
 //   voxelized from that light into an r32ui 3D texture with image atomics
 //   (Dehlin and Styngberg's binary/additive, nearest/trilinear), summed along
 //   the light in a compute pass into the light's density grid, transmittance
-//   alpha^C; times a PCF shadow map of the head from that light. Point lights
+//   alpha^C; times a PCF shadow map of the head from that light. On a
+//   software renderer the same grids are filled and summed on the CPU
+//   (render/preview/cpu_voxels.h, PreviewShadowSettings::voxelize). Point lights
 //   use a perspective frustum. The strands are tessellated once for all the
 //   lights (from the first; the pieces captured by transform feedback and
 //   drawn again as lines from the others' views).
@@ -72,6 +74,10 @@ enum class VoxelSplat { Nearest, Trilinear };
 /// fragment weighted by its strand's projected area in the voxel's column),
 /// or fragments (Dehlin and Styngberg 2017: each fragment adds 1, whatever the hair's width).
 enum class VoxelWeight { Crossings, Fragments };
+/// Where the strands are voxelized for the light grids: on the CPU
+/// (render/preview/cpu_voxels.h, the same grid), or by the GPU's rasterizer;
+/// Auto: the CPU on a software renderer (llvmpipe), the GPU otherwise.
+enum class VoxelizeOn { Auto, Gpu, Cpu };
 
 /// Most lights the preview shadows: each costs a voxelization of the hair, a
 /// sum along its light, a shadow map and a density grid (render/preview/
@@ -107,6 +113,7 @@ struct PreviewShadowSettings {
     VoxelWeight weight = VoxelWeight::Crossings;
     /// Fragments only: transmittance per counted fragment (or occupied voxel).
     float alpha = 0.85f;
+    VoxelizeOn voxelize = VoxelizeOn::Auto;
     /// With several shadowed lights, tessellate the strands once, from the
     /// first shadowed light, capture the pieces (transform feedback) and
     /// voxelize that geometry into every light's grid; false tessellates the
@@ -139,6 +146,12 @@ struct PreviewSettings {
     /// of a 560 x 720 one, whose pieces span several vertices
     /// (docs/benchmarks.md).
     bool shadeInCompute = false;
+    /// The thin strands' line pieces (per-vertex shading, the line path):
+    /// made by compute passes and drawn as plain lines (1), or by the
+    /// tessellation stages (0); -1: compute on software rasterizers, which
+    /// run the tessellation stages on one thread (render/preview/line_pieces.h).
+    /// The same pieces and shading: pixels agree to FLIP ~1e-4.
+    int piecesInCompute = -1;
     /// Compile the hair programs for each frame's lights, flags and hair
     /// model (llvmpipe pays both sides of a branch on a uniform); false: one
     /// program that reads them from uniforms (the same pixels; tests).

@@ -122,7 +122,7 @@ void StrandBuffers::sortBackToFront(const StrandFrame& s, const Vec3f& eye, cons
 }
 
 size_t lightPieceVertexBound(const StrandBuffers& b, const StrandFrame& s, const LightGrid& grid, int resolution,
-                             int level, float pixels) {
+                             int level, float pixels, int minSegmentsPerPiece) {
     // strand.tesc measures a patch's length between its vertices 1 ..
     // segments + 1 in raster pixels of the light pass (grid coordinates times
     // the resolution) and cuts it into clamp(ceil(L / pixels), 1, most)
@@ -145,6 +145,10 @@ size_t lightPieceVertexBound(const StrandBuffers& b, const StrandFrame& s, const
             // 1% and one piece for the GPU's float rounding of L.
             pieces = std::min(most, std::max(1.0, length * 1.01 / double(pixels) + 2.0));
         }
+        // strand.tesc's MIN_SEGMENTS_PER_PIECE floor (without it the capture
+        // overflowed and the other lights lost the last strands' pieces).
+        if (minSegmentsPerPiece > 0)
+            pieces = std::max(pieces, std::min(std::ceil(double(segs) / double(minSegmentsPerPiece)), most));
         pieces = std::ceil(pieces);
         vertices += size_t(2.0 * (pieces + std::ceil(pieces / 64.0)));
     }

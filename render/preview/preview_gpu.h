@@ -61,6 +61,10 @@ inline constexpr int kFlagSortedHair = 16;
 inline constexpr int kHairKajiyaKay = 0;
 inline constexpr int kHairKajiyaKayTwoLobes = 1;
 inline constexpr int kHairFitted = 2;
+/// Segments per patch when hair is sorted: short enough that a piece of
+/// strand rarely straddles another in depth, long enough to keep the
+/// per-patch cost of software rasterizers down.
+inline constexpr int kSortedPatchSegments = 4;
 /// Fixed point of the r32ui voxel grid (kVoxelUnit in shaders/common.glsl).
 inline constexpr float kVoxelUnit = 4096.f;
 
@@ -176,6 +180,8 @@ struct RenderTargets {
 
     void ensure(int w, int h, int samples, int supersample);
     void destroy();
+    /// The resolved frame as R, G, B, A, Z (top row first).
+    Image read() const;
 };
 
 static_assert(kMaxShadowedLights == 4, "ShadowTargets::ensure/destroy and shaders/common.glsl spell out 4 slots");
@@ -199,6 +205,9 @@ struct ShadowTargets {
     /// grid of resolutions[k]³ per slot.
     void ensure(int mapSize, int slots, const int* resolutions);
     void destroy();
+    /// Slot k's voxel grid V (grid units / kVoxelUnit) and density C, x fastest, then y, z.
+    std::vector<float> readRaw(int k) const;
+    std::vector<float> readSummed(int k) const;
 };
 
 /// The strands' light-pass pieces captured once by transform feedback
@@ -218,12 +227,13 @@ struct CapturedPieces {
 /// Most vertices strand.tesc and strand.tese emit for the patches of
 /// `buffers` drawn from a light pass with grid `grid` of `resolution`²
 /// raster pixels: per patch, its pieces clamp(ceil(L / pixels), 1, segments
-/// level) (L its polyline's raster length; the most when `pixels` <= 0),
+/// level) (L its polyline's raster length; the most when `pixels` <= 0), at
+/// least ceil(segments / minSegmentsPerPiece) when that is > 0,
 /// plus the rounding of the isolines (at most one piece per 64), two
 /// vertices a piece. A bound, never below the count, so the capture buffer
 /// never overflows.
 size_t lightPieceVertexBound(const StrandBuffers& buffers, const StrandFrame& strands, const LightGrid& grid,
-                             int resolution, int level, float pixels);
+                             int resolution, int level, float pixels, int minSegmentsPerPiece);
 
 /// Whether the ribbon pass can draw anything: true unless every strand vertex
 /// lies in front of the camera and is at most `lineWidth` pixels wide there

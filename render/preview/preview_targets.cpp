@@ -88,6 +88,23 @@ void RenderTargets::ensure(int w, int h, int s, int ss) {
     checkComplete(headFbo, "camera head depth");
 }
 
+Image RenderTargets::read() const {
+    if (!resolvedFbo) throw FrameError("preview: nothing drawn yet");
+    const int w = width, h = height;
+    std::vector<float> rgba(size_t(w) * h * 4), z(size_t(w) * h);
+    glGetTextureImage(resolvedColor, 0, GL_RGBA, GL_FLOAT, GLsizei(rgba.size() * sizeof(float)), rgba.data());
+    glGetTextureImage(resolvedDepth, 0, GL_RED, GL_FLOAT, GLsizei(z.size() * sizeof(float)), z.data());
+    Image image(w, h, {"R", "G", "B", "A", "Z"});
+    for (int y = 0; y < h; ++y) {
+        const size_t src = size_t(h - 1 - y) * w;  // GL rows start at the bottom
+        for (int x = 0; x < w; ++x) {
+            for (int c = 0; c < 4; ++c) image.at(x, y, c) = rgba[(src + x) * 4 + c];
+            image.at(x, y, 4) = z[src + x];
+        }
+    }
+    return image;
+}
+
 void RenderTargets::destroy() {
     deleteFramebuffers({&msFbo, &resolvedFbo, &headFbo});
     deleteTextures({&opaque, &accum, &reveal, &minDepth, &depth, &resolvedColor, &resolvedDepth, &headDepth});
@@ -156,6 +173,22 @@ void ShadowTargets::ensure(int size, int slots, const int* resolutions) {
         for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
             glTextureParameteri(density[k], wrap, GL_CLAMP_TO_EDGE);
     }
+}
+
+std::vector<float> ShadowTargets::readRaw(int k) const {
+    const size_t n = size_t(resolution[k]) * size_t(resolution[k]) * size_t(resolution[k]);
+    std::vector<uint32_t> units(n);
+    glGetTextureImage(voxels[k], 0, GL_RED_INTEGER, GL_UNSIGNED_INT, GLsizei(n * 4), units.data());
+    std::vector<float> raw(n);
+    for (size_t i = 0; i < n; ++i) raw[i] = float(units[i]) / kVoxelUnit;
+    return raw;
+}
+
+std::vector<float> ShadowTargets::readSummed(int k) const {
+    const size_t n = size_t(resolution[k]) * size_t(resolution[k]) * size_t(resolution[k]);
+    std::vector<float> summed(n);
+    glGetTextureImage(density[k], 0, GL_RED, GL_FLOAT, GLsizei(n * 4), summed.data());
+    return summed;
 }
 
 void ShadowTargets::destroy() {

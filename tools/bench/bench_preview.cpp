@@ -10,7 +10,7 @@
 //                 [--profile] [--png out.png] [--shading kajiya-kay|fitted]
 //                 [--lights one|rig] [--other-resolution N] [--max-lights N]
 //                 [--share 0|1] [--voxels 0|1] [--shadow-map 0|1] [--msaa N] [--pieces P]
-//                 [--compute 0|1]
+//                 [--compute 0|1] [--voxelize auto|gpu|cpu] [--line-pieces auto|stages|compute]
 // --shading fitted shades with the hair material fitted to the physical
 // fibre (render/reference/hair_fit.h, melanin 1.3) and dual scattering; the
 // default keeps the plain Kajiya-Kay material the benchmark always had.
@@ -24,7 +24,12 @@
 // --voxels 0, --shadow-map 0, --msaa N, --pieces P (tessellationPixels),
 // --compute 1 (shade the strand vertices in a compute pass,
 // PreviewSettings::shadeInCompute; the default 0 shades every tessellated
-// point in the tessellation stage).
+// point in the tessellation stage), --voxelize gpu|cpu
+// (PreviewShadowSettings::voxelize: the light grids rasterized by the GPU or
+// splatted on the CPU; auto, the default, the CPU on llvmpipe),
+// --line-pieces stages|compute (PreviewSettings::piecesInCompute: the thin
+// strands' pieces by the tessellation stages or by compute passes; auto, the
+// default, compute on llvmpipe).
 // Per strand count: median, min and max of the timed frames (draw + glFinish,
 // wall and process CPU time, llvmpipe's threads included), readback time,
 // peak resident memory; --profile adds a per-pass breakdown of one extra frame
@@ -73,7 +78,8 @@ int main(int argc, char** argv) {
     bool profile = false;
     bool fitted = false, rig = false;
     int otherResolution = -1;
-    int voxels = -1, shadowMap = -1, msaa = -1, maxLights = -1, share = -1, compute = -1;
+    VoxelizeOn voxelize = VoxelizeOn::Auto;
+    int voxels = -1, shadowMap = -1, msaa = -1, maxLights = -1, share = -1, compute = -1, linePieces = -1;
     float pieces = -1.f;
     std::string png;
     for (int i = 1; i < argc; ++i) {
@@ -101,8 +107,14 @@ int main(int argc, char** argv) {
             shadowMap = std::atoi(argv[++i]);
         } else if (a == "--max-lights" && more) {
             maxLights = std::atoi(argv[++i]);
+        } else if (a == "--line-pieces" && more) {
+            const std::string v = argv[++i];
+            linePieces = v == "compute" ? 1 : v == "stages" ? 0 : -1;
         } else if (a == "--compute" && more) {
             compute = std::atoi(argv[++i]);
+        } else if (a == "--voxelize" && more) {
+            const std::string v = argv[++i];
+            voxelize = v == "cpu" ? VoxelizeOn::Cpu : v == "gpu" ? VoxelizeOn::Gpu : VoxelizeOn::Auto;
         } else if (a == "--share" && more) {
             share = std::atoi(argv[++i]);
         } else if (a == "--msaa" && more) {
@@ -112,7 +124,7 @@ int main(int argc, char** argv) {
         } else if (a == "--png" && more) {
             png = argv[++i];
         } else {
-            std::cerr << "usage: bench_preview [--strands N,M] [--frames N] [--warmup N] [--profile] [--png FILE] [--shading kajiya-kay|fitted] [--lights one|rig] [--other-resolution N] [--max-lights N] [--share 0|1] [--voxels 0|1] [--shadow-map 0|1] [--msaa N] [--pieces P] [--compute 0|1]\n";
+            std::cerr << "usage: bench_preview [--strands N,M] [--frames N] [--warmup N] [--profile] [--png FILE] [--shading kajiya-kay|fitted] [--lights one|rig] [--other-resolution N] [--max-lights N] [--share 0|1] [--voxels 0|1] [--shadow-map 0|1] [--msaa N] [--pieces P] [--compute 0|1] [--voxelize auto|gpu|cpu] [--line-pieces auto|stages|compute]\n";
             return 1;
         }
     }
@@ -128,7 +140,9 @@ int main(int argc, char** argv) {
         if (msaa >= 0) settings.msaa = msaa;
         if (maxLights >= 0) settings.shadow.maxLights = maxLights;
         if (share >= 0) settings.shadow.shareTessellation = share != 0;
+        settings.shadow.voxelize = voxelize;
         if (compute >= 0) settings.shadeInCompute = compute != 0;
+        settings.piecesInCompute = linePieces;
         if (pieces >= 0.f) settings.tessellationPixels = pieces;
         const TriangleMesh head = makeSphereMesh(Vec3f::Zero(), 0.1f, 32, 64);
         std::printf("bench_preview: %s\n", context->description().c_str());
