@@ -37,7 +37,8 @@ constexpr double kMaxSpan = 16.5;
 struct PieceBatch {
     alignas(32) double t0[kMaxPieces + 3];
     alignas(32) double t1[kMaxPieces + 3];
-    alignas(16) int32_t cell[3][kMaxPieces + 3];  // tile-local cell (lx, ly, lz)
+    int32_t cell[3][kMaxPieces + 3];  // tile-local cell (lx, ly, lz); rows 1 and 2 need not be
+                                      // 16-byte aligned (kMaxPieces + 3 ints a row): read unaligned
     int count = 0;
 };
 
@@ -86,9 +87,9 @@ void depositBatch(TileBuffer<1>& tile, const Segment& s, PieceBatch& batch) {
         const __m256d t0 = _mm256_load_pd(batch.t0 + p), t1 = _mm256_load_pd(batch.t1 + p);
         const __m256d mid = _mm256_mul_pd(half, _mm256_add_pd(t0, t1)), h = _mm256_mul_pd(half, _mm256_sub_pd(t1, t0));
         const __m256d kh = _mm256_mul_pd(k, h);
-        const __m128i lx = _mm_load_si128(reinterpret_cast<const __m128i*>(batch.cell[0] + p));
-        const __m128i ly = _mm_load_si128(reinterpret_cast<const __m128i*>(batch.cell[1] + p));
-        const __m128i lz = _mm_load_si128(reinterpret_cast<const __m128i*>(batch.cell[2] + p));
+        const __m128i lx = _mm_loadu_si128(reinterpret_cast<const __m128i*>(batch.cell[0] + p));
+        const __m128i ly = _mm_loadu_si128(reinterpret_cast<const __m128i*>(batch.cell[1] + p));
+        const __m128i lz = _mm_loadu_si128(reinterpret_cast<const __m128i*>(batch.cell[2] + p));
         // f at t = 0: a − c, c the cell's corner (0,0,0) in index space (exact integers).
         const __m256d bx = _mm256_sub_pd(ax, _mm256_cvtepi32_pd(_mm_add_epi32(lx, ox)));
         const __m256d by = _mm256_sub_pd(ay, _mm256_cvtepi32_pd(_mm_add_epi32(ly, oy)));
