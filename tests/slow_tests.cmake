@@ -31,7 +31,7 @@ set(_hp_slow_tests
   test_voxelizer:Voxelizer.ConservesHairVolumeOfAHeadOfHairToFloatRounding  # 20,000 strands at 1 mm
   test_shot_simulation:ShotSimulation.DefaultClipKeepsLengthsRootsAndClearance
   test_shot_simulation:ShotSimulation.CheckpointRestoreContinuesBitForBit
-  test_hair_grid:Volume.BallOfStrandsDroppedOnSphereStaysLessDense   # two 3 s drops of 48 strands
+  test_hair_volume:Volume.BallOfStrandsDroppedOnSphereStaysLessDense   # two 3 s drops of 48 strands
   test_shot_simulation:ShotSimulation.HairHangsUnderGravityAndSwingsWithTheHead  # three shots, 120 frames
   test_shot_simulation:ShotSimulation.DefaultShotCrownHairDoesNotStandMidShakeOrTurned  # the whole default shot, 84 frames
   test_sim_guards:SimGuards.LongViolentRunStaysBoundedAndFinite  # 10^4+ steps

@@ -3,7 +3,7 @@
 // momentum kept pair by pair, roots never moved, approaching vertices kept
 // a wisp diameter apart while start overlaps are held, a crossed pair sent
 // back, the same bits on any thread count). The guide solver with it on:
-// Volume.WispContactKeepsCrossingWispsApart in test_hair_grid.cpp.
+// Volume.WispContactKeepsCrossingWispsApart in test_hair_volume.cpp.
 #include "sim/volume/wisp_contact.h"
 
 #include "volume_support.h"

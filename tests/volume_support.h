@@ -1,4 +1,4 @@
-// Shared by the hair-hair grid's tests (test_hair_grid.cpp, test_wisp_contact.cpp):
+// Shared by the hair-hair grid's tests (test_hair_grid.cpp, test_hair_volume.cpp, test_wisp_contact.cpp):
 // the ways of running a volume kernel's chunks that its determinism tests compare.
 #pragma once
 
