@@ -308,13 +308,10 @@ HP_ROD_LANES_CLONES int rodSteps(const RodStepTarget* targets, int count, const 
         sc.b.resize(size_t(N));
     }
     assemble(targets, src, gravity, hv, anyCurled, sc);
-    if (anyCurled) {
-        std::memcpy(static_cast<void*>(sc.b.data()), sc.rhs.data(), size_t(N) * sizeof(lanes::D4Store));
-        bandedSolve(lanes::view(sc.band), lanes::view(sc.invD), lanes::view(sc.rhs), N);
-        holonomyIterate(sc, n, curledLane);
-    } else {
-        bandedSolve(lanes::view(sc.band), lanes::view(sc.invD), lanes::view(sc.rhs), N);
-    }
+    // The curled lanes' iterations need the right-hand side the banded solve overwrites.
+    if (anyCurled) std::memcpy(static_cast<void*>(sc.b.data()), sc.rhs.data(), size_t(N) * sizeof(lanes::D4Store));
+    bandedSolve(lanes::view(sc.band), lanes::view(sc.invD), lanes::view(sc.rhs), N);
+    if (anyCurled) holonomyIterate(sc, n, curledLane);
     // 2. y += W Jᵀ Δλ: row r of joint r/3 moves its vertices j-1, j, j+1;
     // in a curled lane also -Σ_k T_k ∇m_k (rod_kernels.h constraintJacobian).
     V3* y = sc.y.data();
