@@ -3,6 +3,7 @@
 // voxelize.frag's deposits, mirrored line by line.
 #include "render/preview/cpu_voxels.h"
 
+#include "render/preview/gl_context.h"  // softwareRasterizer
 #include "render/preview/preview_gpu.h"  // kVoxelUnit, kSortedPatchSegments (no GL headers)
 
 #include <tbb/blocked_range.h>
@@ -335,7 +336,7 @@ std::vector<float> cpuVoxelValues(const std::vector<uint32_t>& voxels, int resol
 
 bool voxelizeOnCpu(VoxelizeOn voxelize, const std::string& renderer) {
     if (voxelize != VoxelizeOn::Auto) return voxelize == VoxelizeOn::Cpu;
-    return renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos;
+    return softwareRasterizer(renderer);
 }
 
 }  // namespace hp

@@ -156,8 +156,7 @@ std::unique_ptr<EglState> tryCandidate(const Candidate& c, std::string& why) {
         return nullptr;
     }
     const std::string r = renderer ? renderer : "unknown renderer";
-    impl->software = r.find("llvmpipe") != std::string::npos || r.find("softpipe") != std::string::npos ||
-                     r.find("swrast") != std::string::npos;
+    impl->software = softwareRasterizer(r);
     impl->description = cat(r, " | ", version ? version : "?", " | ", c.name);
     return impl;
 }
@@ -211,6 +210,12 @@ void GlContext::makeCurrent() {
 }
 
 const std::string& GlContext::description() const { return impl_->egl->description; }
+bool softwareRasterizer(const std::string& renderer) {
+    for (const char* name : {"llvmpipe", "softpipe", "swrast"})
+        if (renderer.find(name) != std::string::npos) return true;
+    return false;
+}
+
 bool GlContext::software() const { return impl_->egl->software; }
 
 }  // namespace hp

@@ -10,6 +10,11 @@
 
 namespace hp {
 
+/// True when GL_RENDERER names a software rasterizer (llvmpipe, softpipe,
+/// swrast): the preview then does on the CPU, or in compute passes, the
+/// work such a renderer runs on one thread.
+bool softwareRasterizer(const std::string& renderer);
+
 /// Owns an EGL display and an OpenGL 4.5 core context with no surface
 /// (rendering goes to framebuffer objects).
 class GlContext {

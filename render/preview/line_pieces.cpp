@@ -1,5 +1,7 @@
 #include "render/preview/line_pieces.h"
 
+#include "render/preview/gl_context.h"  // softwareRasterizer
+
 #include <epoxy/gl.h>
 
 #include <algorithm>
@@ -27,7 +29,7 @@ void ensureBuffer(unsigned& id, size_t& capacity, size_t bytes) {
 
 bool linePiecesInCompute(int setting, const std::string& renderer) {
     if (setting >= 0) return setting > 0;
-    return renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos;
+    return softwareRasterizer(renderer);
 }
 
 void LinePieces::compile(bool on, const std::vector<std::string>& defines, const std::vector<std::string>& shading) {
