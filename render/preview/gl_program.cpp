@@ -5,6 +5,8 @@
 
 #include <epoxy/gl.h>
 
+#include <algorithm>
+
 namespace hp {
 
 namespace {
@@ -99,5 +101,10 @@ GlProgram& GlProgram::operator=(GlProgram&& other) noexcept {
 void GlProgram::use() const { glUseProgram(id_); }
 
 int GlProgram::uniform(const char* name) const { return glGetUniformLocation(id_, name); }
+
+void dispatchRows(size_t invocations) {
+    const size_t groups = (invocations + 63) / 64, row = std::max<size_t>(1, std::min<size_t>(groups, 65535));
+    glDispatchCompute(GLuint(row), GLuint((groups + row - 1) / row), 1);
+}
 
 }  // namespace hp

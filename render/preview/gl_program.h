@@ -2,6 +2,7 @@
 // ids are plain unsigned so this header needs no GL headers).
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <utility>
 #include <vector>
@@ -35,5 +36,11 @@ class GlProgram {
     unsigned id_ = 0;
     std::string name_;
 };
+
+/// Dispatches the bound compute program over `invocations` threads in
+/// groups of 64 (the programs' local size), laid out in rows of at most
+/// 65535 groups (GL's least guaranteed count per dimension): the shader
+/// takes its index as gl_GlobalInvocationID.y · gl_NumWorkGroups.x · 64 + gl_GlobalInvocationID.x.
+void dispatchRows(size_t invocations);
 
 }  // namespace hp

@@ -10,12 +10,6 @@ namespace hp {
 
 namespace {
 
-void dispatchRows(size_t invocations) {
-    // Rows of at most 65535 groups of 64 (GL's least guaranteed count per dimension).
-    const size_t groups = (invocations + 63) / 64, row = std::max<size_t>(1, std::min<size_t>(groups, 65535));
-    glDispatchCompute(GLuint(row), GLuint((groups + row - 1) / row), 1);
-}
-
 /// A buffer of at least `bytes` in `id` (grown by half again: strands move).
 void ensureBuffer(unsigned& id, size_t& capacity, size_t bytes) {
     if (id && capacity >= bytes) return;

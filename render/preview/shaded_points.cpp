@@ -54,10 +54,7 @@ void ShadedPoints::shade(const StrandBuffers& strands, const GlProgram& program)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, strands.vertices.id());
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, flags);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, buffer);
-        const size_t invocations = vertexCount;
-        // Rows of at most 65535 groups (GL's least guaranteed count per dimension).
-        const size_t groups = (invocations + 63) / 64, row = std::min<size_t>(groups, 65535);
-        glDispatchCompute(GLuint(row), GLuint((groups + row - 1) / row), 1);
+        dispatchRows(vertexCount);
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);  // the tessellation stage reads it as a buffer texture
     }
     glBindTextureUnit(kUnit, texture);
