@@ -99,13 +99,14 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     };
 
     // Head-local positions and their bounds (min and max do not depend on
-    // the order or the chunks).
+    // the order or the chunks), and the copy of x the caller asked for.
     std::atomic<float> bound[6];
     for (int a = 0; a < 3; ++a) {
         bound[a] = INFINITY;
         bound[3 + a] = -INFINITY;
     }
     run(n, [&](size_t b, size_t e) {
+        if (in.before) std::copy(in.x + b, in.x + e, in.before + b);
         __m128 lo4 = _mm_set1_ps(INFINITY), hi4 = _mm_set1_ps(-INFINITY);
         for (size_t i = b; i < e; ++i) {
             const __m128 p = local(in.x[i]);
@@ -428,80 +429,98 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     }
 
     // One pass over the sorted vertices reads each vertex's eight nodes
-    // once for friction, the density it reads and the volume push.
+    // once for friction, the density it reads and the volume push, four
+    // vertices at a time, one in each SSE lane: every lane does a scalar
+    // loop's operations on its vertex in the scalar order (SSE rounds each
+    // lane as the scalar operation does), so the same bits; a lane past the
+    // chunk's end repeats the last vertex and writes nothing.
     std::atomic<size_t> pushed{0};
     run(gridded, [&, N, E, C, vertexOf, RB, RS, sy, toRatio, s, push, invD](size_t b, size_t e) {
         size_t moved = 0;
         size_t row = size_t(std::upper_bound(RS, RS + rows + 1, uint32_t(b)) - RS) - 1;  // the row of entry b
-        for (size_t o = b; o < e; ++o) {
-            while (o >= RS[row + 1]) ++row;
-            const Entry& c = C[o];
-            // The eight nodes in the order di + 2·dj + 4·dk, four at a time
-            // (SSE): their masses in lanes, w = (wx·wy)·wz and w/M lane by
-            // lane, then V = V + (w/M)·(M, P) node by node in that order,
-            // the sums r = Σ w·ratio in that order too: the same operations
-            // one by one as a scalar loop (SSE rounds each lane as the
-            // scalar operation does), so the same bits.
-            const __m128 wx = _mm_setr_ps(1.f - c.t[0], c.t[0], 1.f - c.t[0], c.t[0]);
-            const __m128 wy = _mm_setr_ps(1.f - c.t[1], 1.f - c.t[1], c.t[1], c.t[1]);
-            const __m128 wxy = _mm_mul_ps(wx, wy);
-            const __m128 w[2] = {_mm_mul_ps(wxy, _mm_set1_ps(1.f - c.t[2])), _mm_mul_ps(wxy, _mm_set1_ps(c.t[2]))};
-            __m128 V = _mm_setzero_ps();  // (Σ w, V̄): lane 0 unused
-            float r = 0.f;
-            for (int dk = 0; dk < 2; ++dk) {
-                const float* row0 = N[RB[row + size_t(dk) * sy] + c.i].data();
-                const float* row1 = N[RB[row + size_t(dk) * sy + 1] + c.i].data();
-                const __m128 nd[4] = {_mm_load_ps(row0), _mm_load_ps(row0 + 4), _mm_load_ps(row1),
-                                      _mm_load_ps(row1 + 4)};
-                const __m128 M = _mm_movelh_ps(_mm_unpacklo_ps(nd[0], nd[1]), _mm_unpacklo_ps(nd[2], nd[3]));
-                const __m128 q = _mm_div_ps(w[dk], M);
-                const __m128 has = _mm_cmpgt_ps(M, _mm_setzero_ps());
-                const __m128 wr = _mm_mul_ps(w[dk], _mm_mul_ps(M, _mm_set1_ps(toRatio)));
-                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0x00), _mm_mul_ps(_mm_shuffle_ps(q, q, 0x00), nd[0])));
-                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0x55), _mm_mul_ps(_mm_shuffle_ps(q, q, 0x55), nd[1])));
-                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0xaa), _mm_mul_ps(_mm_shuffle_ps(q, q, 0xaa), nd[2])));
-                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0xff), _mm_mul_ps(_mm_shuffle_ps(q, q, 0xff), nd[3])));
-                r += _mm_cvtss_f32(wr);
-                r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0x55));
-                r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0xaa));
-                r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0xff));
+        const __m128 ratio4 = _mm_set1_ps(toRatio);
+        const __m128 dW[2] = {_mm_set1_ps(-invD), _mm_set1_ps(invD)};  // w' of the lower and upper node
+        for (size_t o0 = b; o0 < e; o0 += 4) {
+            const size_t lanes = std::min<size_t>(4, e - o0);
+            size_t at[4];                    // entry of each lane
+            ptrdiff_t node[4][4];            // lane, dj + 2·dk: the index of node (i, j + dj, k + dk)
+            __m128 T[4];
+            for (size_t l = 0; l < 4; ++l) {
+                const size_t o = o0 + std::min(l, lanes - 1);
+                while (o >= RS[row + 1]) ++row;
+                at[l] = o;
+                T[l] = _mm_load_ps(C[o].t);  // t and i's bits
+                for (int dk = 0; dk < 2; ++dk)
+                    for (int dj = 0; dj < 2; ++dj) node[l][dj + 2 * dk] = RB[row + size_t(dk) * sy + size_t(dj)] + C[o].i;
             }
-            alignas(16) float Vs[4];
-            _mm_store_ps(Vs, V);
-            const Vec3f v = c.mv.tail<3>();
-            in.v[vertexOf[o]] = v + s * (Vec3f(Vs[1], Vs[2], Vs[3]) - v);
-            // The volume push where a node the vertex reads holds excess
-            // (elsewhere ∇E = 0): x ← x − c·Δ²·∇E/max(1, r̄), ∇E = Σ E_n·∇w_n
-            // with ∇w_n = (w'x·wy·wz, wx·w'y·wz, wx·wy·w'z), w' = ∓1/Δ, the
-            // terms summed node by node, the three axes in SSE lanes.
-            if (!relaxed) continue;
-            __m128 En[2];  // E of the nodes di + 2·dj of planes dk = 0, 1
+            _MM_TRANSPOSE4_PS(T[0], T[1], T[2], T[3]);  // T[a]: t of axis a, lane by lane
+            const __m128 wx[2] = {_mm_sub_ps(one, T[0]), T[0]}, wy[2] = {_mm_sub_ps(one, T[1]), T[1]},
+                         wz[2] = {_mm_sub_ps(one, T[2]), T[2]};
+            // Friction: V̄ = Σ_n (w_n/M_n)·P_n over the nodes with mass, and
+            // r = Σ_n w_n·M_n·toRatio, node n = di + 2·dj + 4·dk in order.
+            __m128 Vx = zero, Vy = zero, Vz = zero, r = zero;
             for (int dk = 0; dk < 2; ++dk)
-                En[dk] = _mm_loadh_pi(_mm_loadl_pi(zero, reinterpret_cast<const __m64*>(E + RB[row + size_t(dk) * sy] + c.i)),
-                                      reinterpret_cast<const __m64*>(E + RB[row + size_t(dk) * sy + 1] + c.i));
-            if (_mm_movemask_ps(_mm_or_ps(_mm_cmpneq_ps(En[0], zero), _mm_cmpneq_ps(En[1], zero))) == 0) continue;
-            // ∇w_n = (A_di·B_dj)·C_dk lane by lane, A = (w'x, wx, wx),
-            // B = (wy, w'y, wy), C = (wz, wz, w'z); lane 3 unused.
-            const float tx = c.t[0], ty = c.t[1], tz = c.t[2];
-            const __m128 A[2] = {_mm_setr_ps(-invD, 1.f - tx, 1.f - tx, 0.f), _mm_setr_ps(invD, tx, tx, 0.f)};
-            const __m128 B[2] = {_mm_setr_ps(1.f - ty, -invD, 1.f - ty, 0.f), _mm_setr_ps(ty, invD, ty, 0.f)};
-            const __m128 Cz[2] = {_mm_setr_ps(1.f - tz, 1.f - tz, -invD, 0.f), _mm_setr_ps(tz, tz, invD, 0.f)};
-            const __m128 AB[4] = {_mm_mul_ps(A[0], B[0]), _mm_mul_ps(A[1], B[0]), _mm_mul_ps(A[0], B[1]),
-                                  _mm_mul_ps(A[1], B[1])};  // index di + 2·dj
-            __m128 grad = _mm_setzero_ps();
-            for (int dk = 0; dk < 2; ++dk) {
-                const __m128 Ek = En[dk];
-                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0x00), _mm_mul_ps(AB[0], Cz[dk])));
-                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0x55), _mm_mul_ps(AB[1], Cz[dk])));
-                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0xaa), _mm_mul_ps(AB[2], Cz[dk])));
-                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0xff), _mm_mul_ps(AB[3], Cz[dk])));
+                for (int dj = 0; dj < 2; ++dj)
+                    for (int di = 0; di < 2; ++di) {
+                        // Lane l's node (M, P), transposed to M, Px, Py, Pz lane by lane.
+                        __m128 M = _mm_load_ps(N[node[0][dj + 2 * dk] + di].data());  // lane 0's, until transposed
+                        __m128 Px = _mm_load_ps(N[node[1][dj + 2 * dk] + di].data());
+                        __m128 Py = _mm_load_ps(N[node[2][dj + 2 * dk] + di].data());
+                        __m128 Pz = _mm_load_ps(N[node[3][dj + 2 * dk] + di].data());
+                        _MM_TRANSPOSE4_PS(M, Px, Py, Pz);
+                        const __m128 w = _mm_mul_ps(_mm_mul_ps(wx[di], wy[dj]), wz[dk]);
+                        const __m128 q = _mm_div_ps(w, M);
+                        const __m128 has = _mm_cmpgt_ps(M, zero);
+                        Vx = _mm_add_ps(Vx, _mm_and_ps(has, _mm_mul_ps(q, Px)));
+                        Vy = _mm_add_ps(Vy, _mm_and_ps(has, _mm_mul_ps(q, Py)));
+                        Vz = _mm_add_ps(Vz, _mm_and_ps(has, _mm_mul_ps(q, Pz)));
+                        r = _mm_add_ps(r, _mm_mul_ps(w, _mm_mul_ps(M, ratio4)));
+                    }
+            alignas(16) float vx[4], vy[4], vz[4], rs[4];
+            _mm_store_ps(vx, Vx);
+            _mm_store_ps(vy, Vy);
+            _mm_store_ps(vz, Vz);
+            _mm_store_ps(rs, r);
+            for (size_t l = 0; l < lanes; ++l) {
+                const Vec3f v = C[at[l]].mv.tail<3>();
+                in.v[vertexOf[at[l]]] = v + s * (Vec3f(vx[l], vy[l], vz[l]) - v);
             }
-            alignas(16) float G[4];
-            _mm_store_ps(G, grad);
-            const Vec3f gv(G[0], G[1], G[2]);
-            if (gv.squaredNorm() > 0.f) {
-                in.x[vertexOf[o]] -= (push / std::max(1.f, r)) * (R * gv);
-                ++moved;
+            // The volume push where a node a vertex reads holds excess
+            // (elsewhere ∇E = 0): x ← x − c·Δ²·∇E/max(1, r̄), ∇E = Σ_n E_n·∇w_n,
+            // ∇w_n = (w'x·wy·wz, wx·w'y·wz, wx·wy·w'z) as ((a·b)·c), w' = ∓1/Δ.
+            if (!relaxed) continue;
+            __m128 En[8];  // E of node n, lane by lane
+            __m128 any = zero;
+            for (int p = 0; p < 4; ++p) {  // p = dj + 2·dk: each lane's nodes di = 0, 1 in one 8-byte load
+                __m128 pair[4];
+                for (int l = 0; l < 4; ++l) pair[l] = _mm_loadl_pi(zero, reinterpret_cast<const __m64*>(E + node[l][p]));
+                const __m128 lo01 = _mm_unpacklo_ps(pair[0], pair[1]), lo23 = _mm_unpacklo_ps(pair[2], pair[3]);
+                const int dj = p & 1, dk = p >> 1;
+                En[4 * dk + 2 * dj] = _mm_movelh_ps(lo01, lo23);
+                En[4 * dk + 2 * dj + 1] = _mm_movehl_ps(lo23, lo01);
+                any = _mm_or_ps(any, _mm_or_ps(_mm_cmpneq_ps(En[4 * dk + 2 * dj], zero),
+                                                 _mm_cmpneq_ps(En[4 * dk + 2 * dj + 1], zero)));
+            }
+            if (_mm_movemask_ps(any) == 0) continue;
+            __m128 gx = zero, gy = zero, gz = zero;
+            for (int dk = 0; dk < 2; ++dk)
+                for (int dj = 0; dj < 2; ++dj)
+                    for (int di = 0; di < 2; ++di) {
+                        const __m128 En_ = En[di + 2 * dj + 4 * dk];
+                        gx = _mm_add_ps(gx, _mm_mul_ps(En_, _mm_mul_ps(_mm_mul_ps(dW[di], wy[dj]), wz[dk])));
+                        gy = _mm_add_ps(gy, _mm_mul_ps(En_, _mm_mul_ps(_mm_mul_ps(wx[di], dW[dj]), wz[dk])));
+                        gz = _mm_add_ps(gz, _mm_mul_ps(En_, _mm_mul_ps(_mm_mul_ps(wx[di], wy[dj]), dW[dk])));
+                    }
+            alignas(16) float g[3][4];
+            _mm_store_ps(g[0], gx);
+            _mm_store_ps(g[1], gy);
+            _mm_store_ps(g[2], gz);
+            for (size_t l = 0; l < lanes; ++l) {
+                const Vec3f gv(g[0][l], g[1][l], g[2][l]);
+                if (gv.squaredNorm() > 0.f) {
+                    in.x[vertexOf[at[l]]] -= (push / std::max(1.f, rs[l])) * (R * gv);
+                    ++moved;
+                }
             }
         }
         pushed += moved;

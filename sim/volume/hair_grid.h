@@ -92,6 +92,9 @@ struct GridInput {
     float lengthPerMass = 0.f;      ///< hair length a kilogram of guide stands for, m/kg
     Eigen::Isometry3f head = Eigen::Isometry3f::Identity();  ///< the frame the grid follows
     float h = 0.f;                  ///< substep, s
+    /// If set, receives x as it was before the volume push (`count`
+    /// entries), copied in a pass that reads x anyway.
+    Vec3f* before = nullptr;
 };
 
 /// What one apply() did (diagnostics and tests).
