@@ -247,6 +247,7 @@ TEST(ExcessDiffusion, RaggedRowsMatchWholeBoxSweeps) {
     const ParallelFor reversed = [](size_t count, const std::function<void(size_t, size_t)>& f) {
         for (size_t b = count; b > 0; --b) f(b - 1, b);
     };
+    size_t excessNodes = 0;
     for (int sweeps : {1, 2, 3, 4, 6}) {
         std::vector<float> ref(box.size(), 0.f), next(box.size());
         for (int s = 0; s < sweeps; ++s) {
@@ -269,7 +270,12 @@ TEST(ExcessDiffusion, RaggedRowsMatchWholeBoxSweeps) {
                         << sweeps << " sweeps, row " << r << ", i " << i << ": " << got << " against " << want;
                 }
             }
-            EXPECT_GT(nonzero, 100u) << "the excess spread";
+            if (sweeps == 1) {
+                EXPECT_GT(nonzero, 50u) << "nodes with excess";
+                excessNodes = nonzero;
+            } else {
+                EXPECT_GT(nonzero, excessNodes) << "the excess spread beyond its nodes, " << sweeps << " sweeps";
+            }
         }
     }
 }
