@@ -187,19 +187,7 @@ struct GuideSolver::Impl final : solver::StrandModel {
     /// clearance and computes velocities from positions, so the volume push
     /// adds no velocity.
     void couple(const solver::Substep& sub) {
-        // Copied in chunks on the threads where there is enough to copy
-        // (a serial copy costs both threads its time; a parallel one of a
-        // few thousand vertices costs more in waking the other thread).
-        constexpr size_t kParallelCopy = 8192;
-        beforePush.resize(set.x.size());
-        if (set.x.size() < kParallelCopy) {
-            std::copy(set.x.begin(), set.x.end(), beforePush.begin());
-        } else {
-            skeleton.parallel(set.x.size(), set.x.size() / 8, [&](size_t b, size_t e) {
-                std::copy(set.x.begin() + std::ptrdiff_t(b), set.x.begin() + std::ptrdiff_t(e),
-                          beforePush.begin() + std::ptrdiff_t(b));
-            });
-        }
+        beforePush.resize(set.x.size());  // filled by the grid's first pass over x
         volume::GridInput in;
         in.x = set.x.data();
         in.v = set.v.data();
@@ -208,6 +196,7 @@ struct GuideSolver::Impl final : solver::StrandModel {
         in.lengthPerMass = float(double(set.settings.hairsPerGuide) / set.settings.guideMassPerLength());
         in.head = sub.headTransform;
         in.h = sub.h;
+        in.before = beforePush.data();
         const volume::GridStats st = grid->apply(in, [&](size_t count, const std::function<void(size_t, size_t)>& f) {
             skeleton.parallel(count, std::max<size_t>(1, count / 64), f);
         });

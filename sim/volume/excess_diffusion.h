@@ -62,46 +62,48 @@ struct NodeBox {
 void jacobiSweep(const NodeBox& box, const float* e, const uint8_t* occupied, float c, const float* in, float* out,
                  int k0, int k1);
 
-/// The occupied nodes the sweeps visit and their excess e, listed plane by
-/// plane (plane k's at [first[k], first[k] + count[k])), each with the
-/// indices of its six neighbours (x−, x+, y−, y+, z−, z+) in the value
-/// arrays. A neighbour that does not exist (outside the grid) is the
-/// `zero` slot, and one not listed holds 0 too: adding either to the sum
-/// adds nothing, not even a sign (the sum starts at +0 and every E is ≥ 0),
-/// so the values are those of skipping it. Reused call after call.
-struct OccupiedNodes {
-    std::vector<uint32_t> node;                      ///< value index of the listed node
-    std::vector<std::array<uint32_t, 6>> neighbour;  ///< value indices of its neighbours
-    std::vector<float> excess;                       ///< e there
-    std::vector<uint32_t> first, count;              ///< per plane
-    size_t values = 0;                               ///< entries of a value array, the zero slot included
-    uint32_t zero = 0;                               ///< the slot that stays 0
-    std::vector<float> scratch;                      ///< the sweeps' second buffer
-
-    /// Sizes the lists: `planes` planes, plane k's room from start[k] to
-    /// start[k + 1] (start has planes + 1 entries), counts 0; value arrays
-    /// of `valueCount` entries with slot `zeroSlot` kept 0.
-    void reset(size_t planes, const uint32_t* start, size_t valueCount, uint32_t zeroSlot);
-    /// Lists a node of plane k (any plane from one thread at a time).
-    void add(size_t k, uint32_t at, const std::array<uint32_t, 6>& around, float e) {
-        const size_t t = first[k] + count[k]++;
-        node[t] = at;
-        neighbour[t] = around;
-        excess[t] = e;
-    }
+/// Grid nodes stored row by row (hair_grid.h's layout): node row
+/// r = k·ny + j holds the nodes i in [lo[r], end[r]) at slot base[r] + i,
+/// with one zero slot either side (base[r] + lo[r] − 1 and base[r] +
+/// end[r]), so that a row's x neighbours are its slots' neighbours; a row
+/// with lo ≥ end holds nothing and has no slots. Plane k's slots are
+/// [planeStart[k], planeStart[k + 1]) (nz + 1 entries).
+struct NodeRows {
+    int nx = 0, ny = 0, nz = 0;
+    const ptrdiff_t* base = nullptr;
+    const int* lo = nullptr;
+    const int* end = nullptr;
+    const uint32_t* planeStart = nullptr;
 };
 
-/// E after `sweeps` Jacobi sweeps from E⁰ = 0 (the file comment) on the
-/// listed nodes, 0 in every other slot; the planes of each sweep run
-/// through `parallel`; `out` receives E (list.values entries). The same
-/// values, term by term, as jacobiSweep over a whole box whose occupied
-/// nodes are the listed ones.
-void relaxListed(OccupiedNodes& list, float c, int sweeps, float* out, const ParallelFor& parallel);
+/// The first sweep from E⁰ = 0 at a node of excess ex (NaN: a node
+/// without hair, or a zero slot): E¹ = ex/(1 + 6c), 0 without hair.
+inline float firstSweep(float ex, float inv) { return ex == ex ? ex * inv : 0.f; }
 
-/// relaxListed on the nodes with occupied[n] != 0 and excess e[n] of a
-/// box (value slots: the box's nodes, then the zero slot); `out` receives
-/// box.size() values.
+/// One Jacobi sweep on the stored rows of planes [k0, k1): out = (ex +
+/// c·Σ_{6 neighbours} in)/(1 + 6c) on nodes with hair (ex not NaN), 0 on
+/// nodes without and on the zero slots; a neighbour not stored counts 0.
+/// The six neighbours are added in jacobiSweep's order (x, y, z; minus,
+/// plus) to a sum starting at +0, in SSE lanes (each lane rounds as the
+/// scalar operation does): the same bits as jacobiSweep on a box whose
+/// nodes with hair are the stored ones with ex not NaN. Pure: writes out's
+/// slots of those planes only.
+void sweepRows(const NodeRows& rows, const float* ex, float c, const float* in, float* out, int k0, int k1);
+
+/// E after `sweeps` Jacobi sweeps from E⁰ = 0 on stored rows whose excess
+/// ex lies on planes [e0, e1) only (0 or NaN on every other plane). On entry
+/// `a` holds the first sweep, firstSweep(ex, 1/(1 + 6c)), on every slot;
+/// `b` is scratch of the same size. Sweep s reaches s − 1 planes beyond
+/// the excess, so it runs on planes [e0 − s + 1, e1 + s − 1) only (beyond
+/// them E^s is exactly 0), each sweep's planes through `parallel`. Returns
+/// the buffer holding E (a or b), every slot valid.
+const float* relaxRows(const NodeRows& rows, const float* ex, float c, int sweeps, int e0, int e1, float* a,
+                       float* b, const ParallelFor& parallel);
+
+/// relaxRows on the nodes with occupied[n] != 0 and excess e[n] of a
+/// box (every row stored whole); `out` receives box.size() values. For
+/// tests: the same values as jacobiSweep K times from E⁰ = 0.
 void relaxExcess(const NodeBox& box, const float* e, const uint8_t* occupied, float c, int sweeps, float* out,
-                 OccupiedNodes& scratch, const ParallelFor& parallel);
+                 const ParallelFor& parallel);
 
 }  // namespace hp::volume

@@ -99,13 +99,14 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     };
 
     // Head-local positions and their bounds (min and max do not depend on
-    // the order or the chunks).
+    // the order or the chunks), and the copy of x the caller asked for.
     std::atomic<float> bound[6];
     for (int a = 0; a < 3; ++a) {
         bound[a] = INFINITY;
         bound[3 + a] = -INFINITY;
     }
     run(n, [&](size_t b, size_t e) {
+        if (in.before) std::copy(in.x + b, in.x + e, in.before + b);
         __m128 lo4 = _mm_set1_ps(INFINITY), hi4 = _mm_set1_ps(-INFINITY);
         for (size_t i = b; i < e; ++i) {
             const __m128 p = local(in.x[i]);
@@ -170,17 +171,24 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     const size_t rows = size_t(ny) * size_t(nz);
     constexpr uint32_t kNone = ~0u;
     rowOf_.resize(n);
-    // The counting sort in chunks of vertices: each chunk counts its rows,
-    // the offsets interleave the chunks row by row, then each chunk writes
-    // its vertices' entries straight to their places (the cell found again:
-    // cheaper than storing it). A stable sort's result is unique, so the
-    // chunks change nothing but the time.
+    // The counting sort in chunks of vertices: each chunk counts its rows
+    // and the x span of each row's base nodes, the offsets interleave the
+    // chunks row by row, then each chunk writes its vertices' entries
+    // straight to their places (the cell found again: cheaper than storing
+    // it). A stable sort's result is unique, so the chunks change nothing
+    // but the time.
     const size_t chunks = serial ? 1 : kSortChunks;
     auto chunkBegin = [&](size_t ch) { return n * ch / chunks; };
     rowCount_.assign(chunks * rows, 0u);  // chunk-major: chunks on two threads share no cache line
+    // A chunk's span of a row is set by its first vertex there (count 0 to
+    // 1), so these need no clearing.
+    chunkLo_.resize(chunks * rows);
+    chunkHi_.resize(chunks * rows);
     run(chunks, [&](size_t cb, size_t ce) {
         for (size_t ch = cb; ch < ce; ++ch) {
             uint32_t* count = rowCount_.data() + ch * rows;
+            int* spanLo = chunkLo_.data() + ch * rows;
+            int* spanHi = chunkHi_.data() + ch * rows;
             for (size_t i = chunkBegin(ch), end = chunkBegin(ch + 1); i < end; ++i) {
                 const __m128 p = local(in.x[i]);
                 if (!valid(i, p)) {
@@ -190,28 +198,82 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
                 __m128 t;
                 const __m128i base = locate(p, t);
                 const uint32_t r = uint32_t(size_t(laneOf(base, 2)) * size_t(ny) + size_t(laneOf(base, 1)));
+                const int x = laneOf(base, 0);
                 rowOf_[i] = r;
-                ++count[r];
+                if (count[r]++ == 0) {
+                    spanLo[r] = spanHi[r] = x;
+                } else {
+                    spanLo[r] = std::min(spanLo[r], x);
+                    spanHi[r] = std::max(spanHi[r], x);
+                }
             }
         }
     });
+
+    // The offsets, and the nodes the vertices can touch, stored row by
+    // row: node row (j, k) holds the x span its four base rows (j − 1..j,
+    // k − 1..k) reach, i_min to i_max + 1, so a node is N[rowBase[row] + i],
+    // with a zero slot either side (the volume step's sweeps read a row's x
+    // neighbours without a test). On B-sim's 845 guides this stores 42% of
+    // the box's nodes (rod: 30,300 of 72,813; rope, its hair standing out
+    // from the sphere: 51% of 181,476); the splat, the gathers and the
+    // clear then touch less memory. The sums are the same, term by term,
+    // as on the whole box. One serial loop over the rows: a row's layout
+    // reads the spans of rows before it only.
     rowStart_.resize(rows + 1);
+    spanLo_.resize(rows);
+    spanHi_.resize(rows);
+    rowBase_.resize(rows);
+    rowLo_.resize(rows);
+    rowEnd_.resize(rows);
+    planeStart_.resize(size_t(nz) + 1);
     uint32_t total = 0;
+    size_t stored = 0, storedNodes = 0;
     for (size_t r = 0; r < rows; ++r) {
         rowStart_[r] = total;
+        int slo = std::numeric_limits<int>::max(), shi = -1;
         for (size_t ch = 0; ch < chunks; ++ch) {
             uint32_t& at = rowCount_[ch * rows + r];
             const uint32_t count = at;
+            if (count) {
+                slo = std::min(slo, chunkLo_[ch * rows + r]);
+                shi = std::max(shi, chunkHi_[ch * rows + r]);
+            }
             at = total;  // now chunk ch's next place in row r
             total += count;
         }
+        spanLo_[r] = slo;
+        spanHi_[r] = shi;
+        const size_t j = r % size_t(ny), k = r / size_t(ny);
+        if (j == 0) planeStart_[k] = uint32_t(stored);
+        int ilo = slo, ihi = shi;  // base rows (j, k), (j − 1, k), (j, k − 1), (j − 1, k − 1)
+        if (j > 0) ilo = std::min(ilo, spanLo_[r - 1]), ihi = std::max(ihi, spanHi_[r - 1]);
+        if (k > 0) ilo = std::min(ilo, spanLo_[r - size_t(ny)]), ihi = std::max(ihi, spanHi_[r - size_t(ny)]);
+        if (j > 0 && k > 0) ilo = std::min(ilo, spanLo_[r - size_t(ny) - 1]), ihi = std::max(ihi, spanHi_[r - size_t(ny) - 1]);
+        if (ihi < 0) {
+            rowBase_[r] = 0;  // no vertex reaches this row
+            rowLo_[r] = rowEnd_[r] = 0;
+            continue;
+        }
+        rowBase_[r] = ptrdiff_t(stored) + 1 - ilo;
+        rowLo_[r] = ilo;
+        rowEnd_[r] = ihi + 2;
+        storedNodes += size_t(ihi + 2 - ilo);
+        stored += size_t(ihi + 2 - ilo) + 2;
     }
     rowStart_[rows] = total;
+    planeStart_[size_t(nz)] = uint32_t(stored);
+    st.storedNodes = storedNodes;
     const size_t gridded = total;
     entries_.resize(gridded);
     order_.resize(gridded);
-    run(chunks, [&](size_t cb, size_t ce) {
+    if (nodes_.size() < stored) nodes_.resize(stored);
+    Eigen::Vector4f* const N = nodes_.data();
+    run(chunks, [&, N](size_t cb, size_t ce) {
         for (size_t ch = cb; ch < ce; ++ch) {
+            // The nodes are cleared here, in chunks, before the splat.
+            std::memset(static_cast<void*>(N + stored * ch / chunks), 0,
+                        (stored * (ch + 1) / chunks - stored * ch / chunks) * sizeof(Eigen::Vector4f));
             uint32_t* at = rowCount_.data() + ch * rows;
             for (size_t i = chunkBegin(ch), end = chunkBegin(ch + 1); i < end; ++i) {
                 if (rowOf_[i] == kNone) continue;
@@ -229,54 +291,6 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
         }
     });
 
-    // The nodes the vertices can touch, stored row by row: node row (j, k)
-    // holds the x span its four base rows (j − 1..j, k − 1..k) reach, i_min
-    // to i_max + 1, so a node is N[rowBase[row] + i]. On B-sim's 845 guides
-    // this stores 42% of the box's nodes (rod: 30,300 of 72,813; rope,
-    // its hair standing out from the sphere: 51% of 181,476); the splat,
-    // the gathers and the clear then touch less memory. The sums are the
-    // same, term by term, as on the whole box.
-    spanLo_.assign(rows, std::numeric_limits<int>::max());
-    spanHi_.assign(rows, -1);
-    run(rows, [&](size_t b, size_t e) {
-        for (size_t r = b; r < e; ++r) {
-            int ilo = std::numeric_limits<int>::max(), ihi = -1;
-            for (size_t o = rowStart_[r]; o < rowStart_[r + 1]; ++o) {
-                ilo = std::min(ilo, entries_[o].i);
-                ihi = std::max(ihi, entries_[o].i);
-            }
-            spanLo_[r] = ilo;
-            spanHi_[r] = ihi;
-        }
-    });
-    rowBase_.resize(rows);
-    rowLo_.resize(rows);
-    rowEnd_.resize(rows);
-    planeStart_.resize(size_t(nz) + 1);
-    size_t stored = 0;
-    for (size_t r = 0; r < rows; ++r) {
-        const size_t j = r % size_t(ny), k = r / size_t(ny);
-        if (j == 0) planeStart_[k] = uint32_t(stored);
-        int ilo = spanLo_[r], ihi = spanHi_[r];  // base rows (j, k), (j − 1, k), (j, k − 1), (j − 1, k − 1)
-        if (j > 0) ilo = std::min(ilo, spanLo_[r - 1]), ihi = std::max(ihi, spanHi_[r - 1]);
-        if (k > 0) ilo = std::min(ilo, spanLo_[r - size_t(ny)]), ihi = std::max(ihi, spanHi_[r - size_t(ny)]);
-        if (j > 0 && k > 0) ilo = std::min(ilo, spanLo_[r - size_t(ny) - 1]), ihi = std::max(ihi, spanHi_[r - size_t(ny) - 1]);
-        if (ihi < 0) {
-            rowBase_[r] = 0;  // no vertex reaches this row
-            rowLo_[r] = rowEnd_[r] = 0;
-            continue;
-        }
-        rowBase_[r] = ptrdiff_t(stored) - ilo;
-        rowLo_[r] = ilo;
-        rowEnd_[r] = ihi + 2;  // i_min .. i_max + 1
-        stored += size_t(ihi + 2 - ilo);
-    }
-    planeStart_[size_t(nz)] = uint32_t(stored);
-    // The node array is all zeros between calls (apply() clears the nodes it
-    // used before returning), so only growth costs a fill.
-    if (nodes_.size() < stored) nodes_.resize(stored, Eigen::Vector4f::Zero());
-    st.storedNodes = stored;
-
     // Even slabs, then odd slabs: each writes node planes k and k+1 only
     // (their rows lie in that order in the node array, so apart from other
     // slabs of its parity).
@@ -291,7 +305,6 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
             });
         }
     };
-    Eigen::Vector4f* const N = nodes_.data();
     const Entry* const C = entries_.data();
     const uint32_t* const vertexOf = order_.data();
     const ptrdiff_t* const RB = rowBase_.data();
@@ -331,193 +344,189 @@ GridStats HairGrid::apply(const GridInput& in, const ParallelFor& parallel) {
     const int* const RL = rowLo_.data();
     const int* const RE = rowEnd_.data();
 
-    // The densest node and the box of nodes above the target (minima and
-    // maxima: the same whatever the order), plane by plane over the stored
-    // nodes: every node with hair is a node some vertex reads.
+    // The volume step's excess ex = max(0, r − 1) on the nodes with hair
+    // (NaN on the others and on the zero slots), its first Jacobi sweep
+    // E¹ = ex/(1 + 6c) (excess_diffusion.h) and the densest node, in one
+    // pass over the stored nodes, plane by plane (a plane's slots are
+    // contiguous), four nodes at a time; the planes holding excess bound
+    // the later sweeps. Maxima and minima: the same whatever the order.
+    const bool pushes = push > 0.f;
+    if (pushes) {
+        excess_.resize(stored);
+        sweepA_.resize(stored);
+        sweepB_.resize(stored);
+    }
+    const float inv = 1.f / (1.f + 6.f * cPush);
     std::atomic<float> maxR{0.f};
-    std::atomic<int> boxLo[3] = {nx, ny, nz}, boxHi[3] = {-1, -1, -1};
-    auto lower = [](std::atomic<int>& a, int v) {
-        for (int m = a.load(); v < m && !a.compare_exchange_weak(m, v);) {
-        }
-    };
-    auto raise = [](std::atomic<int>& a, int v) {
-        for (int m = a.load(); v > m && !a.compare_exchange_weak(m, v);) {
-        }
-    };
-    run(size_t(nz), [&, N, RB, RL, RE, toRatio](size_t b, size_t e) {
-        float localMax = 0.f;
-        int lo3[3] = {nx, ny, nz}, hi3[3] = {-1, -1, -1};
-        for (size_t k = b; k < e; ++k)
-            for (int j = 0; j < ny; ++j) {
-                const size_t r = k * size_t(ny) + size_t(j);
-                for (int i = RL[r]; i < RE[r]; ++i) {
-                    const float ratio = N[RB[r] + i][0] * toRatio;
-                    localMax = std::max(localMax, ratio);
-                    if (!(ratio > 1.f)) continue;
-                    const int at[3] = {i, j, int(k)};
-                    for (int a = 0; a < 3; ++a) {
-                        lo3[a] = std::min(lo3[a], at[a]);
-                        hi3[a] = std::max(hi3[a], at[a]);
-                    }
-                }
+    std::atomic<int> excessLo{nz}, excessEnd{0};
+    run(size_t(nz), [&, N, toRatio, inv, pushes](size_t b, size_t e) {
+        const __m128 ratio4 = _mm_set1_ps(toRatio), inv4 = _mm_set1_ps(inv),
+                     nan4 = _mm_set1_ps(std::numeric_limits<float>::quiet_NaN());
+        float* const ex = excess_.data();
+        float* const E1 = sweepA_.data();
+        __m128 max4 = zero;
+        int klo = nz, kend = 0;
+        for (size_t k = b; k < e; ++k) {
+            size_t q = planeStart_[k];
+            const size_t qEnd = planeStart_[k + 1];
+            __m128 above = zero;  // lanes with r > 1
+            for (; q + 4 <= qEnd; q += 4) {
+                const __m128 M = _mm_movelh_ps(_mm_unpacklo_ps(_mm_load_ps(N[q].data()), _mm_load_ps(N[q + 1].data())),
+                                               _mm_unpacklo_ps(_mm_load_ps(N[q + 2].data()), _mm_load_ps(N[q + 3].data())));
+                const __m128 r = _mm_mul_ps(M, ratio4);
+                max4 = _mm_max_ps(max4, r);
+                above = _mm_or_ps(above, _mm_cmpgt_ps(r, one));
+                if (!pushes) continue;
+                const __m128 has = _mm_cmpgt_ps(M, zero);
+                const __m128 x = _mm_max_ps(_mm_sub_ps(r, one), zero);  // std::max(0.f, r − 1)
+                _mm_storeu_ps(ex + q, _mm_or_ps(_mm_and_ps(has, x), _mm_andnot_ps(has, nan4)));
+                _mm_storeu_ps(E1 + q, _mm_and_ps(has, _mm_mul_ps(x, inv4)));
             }
-        for (int a = 0; a < 3; ++a) {
-            lower(boxLo[a], lo3[a]);
-            raise(boxHi[a], hi3[a]);
+            float tailMax = 0.f;
+            bool tailAbove = false;
+            for (; q < qEnd; ++q) {
+                const float M = N[q][0], r = M * toRatio;
+                tailMax = std::max(tailMax, r);
+                tailAbove = tailAbove || r > 1.f;
+                if (!pushes) continue;
+                ex[q] = M > 0.f ? std::max(0.f, r - 1.f) : std::numeric_limits<float>::quiet_NaN();
+                E1[q] = firstSweep(ex[q], inv);
+            }
+            max4 = _mm_max_ps(max4, _mm_set1_ps(tailMax));
+            if (tailAbove || _mm_movemask_ps(above) != 0) {
+                klo = std::min(klo, int(k));
+                kend = int(k) + 1;
+            }
         }
+        alignas(16) float m4[4];
+        _mm_store_ps(m4, max4);
+        const float localMax = std::max(std::max(m4[0], m4[1]), std::max(m4[2], m4[3]));
         for (float m = maxR.load(); localMax > m && !maxR.compare_exchange_weak(m, localMax);) {
+        }
+        for (int m = excessLo.load(); klo < m && !excessLo.compare_exchange_weak(m, klo);) {
+        }
+        for (int m = excessEnd.load(); kend > m && !excessEnd.compare_exchange_weak(m, kend);) {
         }
     });
     st.maxDensity = maxR.load() * s_.targetDensity;
 
-    // The volume step's excess, relaxed implicitly (excess_diffusion.h) on
-    // the nodes with hair in the box of nodes above the target grown by the
-    // sweeps' reach, kept in relaxed_ (stored node order, then a zero slot)
-    // for the gather. K sweeps from E⁰ = 0 reach K − 1 nodes beyond the
-    // excess (E¹ is nonzero only on it, each sweep one node further), so
-    // beyond that margin E is 0, and a node at the margin reads 0 from
-    // outside it either way: the same E as on the whole lattice.
-    const bool relaxed = push > 0.f && boxHi[0].load() >= 0;
+    // The rest of the implicit volume step (excess_diffusion.h): K sweeps
+    // from E⁰ = 0 reach K − 1 nodes beyond the excess, so only the planes
+    // that near it are swept, and the same E as on the whole lattice.
+    const bool relaxed = pushes && excessLo.load() < excessEnd.load();
+    const float* E = nullptr;
     if (relaxed) {
-        const int reach = kSweeps - 1, last[3] = {nx - 1, ny - 1, nz - 1};
-        int bl[3], bh[3];
-        for (int a = 0; a < 3; ++a) {
-            bl[a] = std::max(0, boxLo[a].load() - reach);
-            bh[a] = std::min(last[a], boxHi[a].load() + reach);
-        }
-        const uint32_t none = uint32_t(stored);
-        occupied_.reset(size_t(nz), planeStart_.data(), stored + 1, none);
-        // Plane by plane (each plane from one thread), row by row, with
-        // the four neighbouring rows' bases and spans read once a row.
-        run(size_t(bh[2] - bl[2] + 1), [&, N, RB, RL, RE, toRatio](size_t b, size_t e) {
-            uint32_t* const nodeOut = occupied_.node.data();
-            std::array<uint32_t, 6>* const aroundOut = occupied_.neighbour.data();
-            float* const excessOut = occupied_.excess.data();
-            for (size_t kk = b; kk < e; ++kk) {
-                const int k = bl[2] + int(kk);
-                const size_t t0 = occupied_.first[size_t(k)];
-                size_t t = t0;
-                for (int j = bl[1]; j <= bh[1]; ++j) {
-                    const size_t r = size_t(k) * size_t(ny) + size_t(j);
-                    // Rows y−, y+, z−, z+; one outside the lattice spans nothing.
-                    const size_t near[4] = {r - 1, r + 1, r - size_t(ny), r + size_t(ny)};
-                    const bool has[4] = {j > 0, j + 1 < ny, k > 0, k + 1 < nz};
-                    ptrdiff_t nb[4];
-                    int nlo[4], nend[4];
-                    for (int a = 0; a < 4; ++a) {
-                        nb[a] = has[a] ? RB[near[a]] : 0;
-                        nlo[a] = has[a] ? RL[near[a]] : 0;
-                        nend[a] = has[a] ? RE[near[a]] : 0;
-                    }
-                    const ptrdiff_t base = RB[r];
-                    const int rowLo = RL[r], rowEnd = RE[r];
-                    for (int i = std::max(bl[0], rowLo), end = std::min(bh[0] + 1, rowEnd); i < end; ++i) {
-                        const uint32_t q = uint32_t(base + i);
-                        const float m = N[q][0];
-                        if (!(m > 0.f)) continue;
-                        auto at = [&](int a) { return i >= nlo[a] && i < nend[a] ? uint32_t(nb[a] + i) : none; };
-                        nodeOut[t] = q;
-                        aroundOut[t] = {i > rowLo ? q - 1 : none, i + 1 < rowEnd ? q + 1 : none, at(0), at(1), at(2), at(3)};
-                        excessOut[t] = std::max(0.f, m * toRatio - 1.f);
-                        ++t;
-                    }
-                }
-                occupied_.count[size_t(k)] = uint32_t(t - t0);
-            }
-        });
-        relaxed_.resize(stored + 1);
-        relaxListed(occupied_, cPush, kSweeps, relaxed_.data(), run);
+        NodeRows nodeRows;
+        nodeRows.nx = nx;
+        nodeRows.ny = ny;
+        nodeRows.nz = nz;
+        nodeRows.base = RB;
+        nodeRows.lo = RL;
+        nodeRows.end = RE;
+        nodeRows.planeStart = planeStart_.data();
+        E = relaxRows(nodeRows, excess_.data(), cPush, kSweeps, excessLo.load(), excessEnd.load(), sweepA_.data(),
+                      sweepB_.data(), run);
     }
-    const float* const E = relaxed_.data();
 
     // One pass over the sorted vertices reads each vertex's eight nodes
-    // once for friction, the density it reads and the volume push.
+    // once for friction, the density it reads and the volume push, four
+    // vertices at a time, one in each SSE lane: every lane does a scalar
+    // loop's operations on its vertex in the scalar order (SSE rounds each
+    // lane as the scalar operation does), so the same bits; a lane past the
+    // chunk's end repeats the last vertex and writes nothing.
     std::atomic<size_t> pushed{0};
     run(gridded, [&, N, E, C, vertexOf, RB, RS, sy, toRatio, s, push, invD](size_t b, size_t e) {
         size_t moved = 0;
         size_t row = size_t(std::upper_bound(RS, RS + rows + 1, uint32_t(b)) - RS) - 1;  // the row of entry b
-        for (size_t o = b; o < e; ++o) {
-            while (o >= RS[row + 1]) ++row;
-            const Entry& c = C[o];
-            // The eight nodes in the order di + 2·dj + 4·dk, four at a time
-            // (SSE): their masses in lanes, w = (wx·wy)·wz and w/M lane by
-            // lane, then V = V + (w/M)·(M, P) node by node in that order,
-            // the sums r = Σ w·ratio in that order too: the same operations
-            // one by one as a scalar loop (SSE rounds each lane as the
-            // scalar operation does), so the same bits.
-            const __m128 wx = _mm_setr_ps(1.f - c.t[0], c.t[0], 1.f - c.t[0], c.t[0]);
-            const __m128 wy = _mm_setr_ps(1.f - c.t[1], 1.f - c.t[1], c.t[1], c.t[1]);
-            const __m128 wxy = _mm_mul_ps(wx, wy);
-            const __m128 w[2] = {_mm_mul_ps(wxy, _mm_set1_ps(1.f - c.t[2])), _mm_mul_ps(wxy, _mm_set1_ps(c.t[2]))};
-            __m128 V = _mm_setzero_ps();  // (Σ w, V̄): lane 0 unused
-            float r = 0.f;
-            for (int dk = 0; dk < 2; ++dk) {
-                const float* row0 = N[RB[row + size_t(dk) * sy] + c.i].data();
-                const float* row1 = N[RB[row + size_t(dk) * sy + 1] + c.i].data();
-                const __m128 nd[4] = {_mm_load_ps(row0), _mm_load_ps(row0 + 4), _mm_load_ps(row1),
-                                      _mm_load_ps(row1 + 4)};
-                const __m128 M = _mm_movelh_ps(_mm_unpacklo_ps(nd[0], nd[1]), _mm_unpacklo_ps(nd[2], nd[3]));
-                const __m128 q = _mm_div_ps(w[dk], M);
-                const __m128 has = _mm_cmpgt_ps(M, _mm_setzero_ps());
-                const __m128 wr = _mm_mul_ps(w[dk], _mm_mul_ps(M, _mm_set1_ps(toRatio)));
-                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0x00), _mm_mul_ps(_mm_shuffle_ps(q, q, 0x00), nd[0])));
-                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0x55), _mm_mul_ps(_mm_shuffle_ps(q, q, 0x55), nd[1])));
-                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0xaa), _mm_mul_ps(_mm_shuffle_ps(q, q, 0xaa), nd[2])));
-                V = _mm_add_ps(V, _mm_and_ps(_mm_shuffle_ps(has, has, 0xff), _mm_mul_ps(_mm_shuffle_ps(q, q, 0xff), nd[3])));
-                r += _mm_cvtss_f32(wr);
-                r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0x55));
-                r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0xaa));
-                r += _mm_cvtss_f32(_mm_shuffle_ps(wr, wr, 0xff));
+        const __m128 ratio4 = _mm_set1_ps(toRatio);
+        const __m128 dW[2] = {_mm_set1_ps(-invD), _mm_set1_ps(invD)};  // w' of the lower and upper node
+        for (size_t o0 = b; o0 < e; o0 += 4) {
+            const size_t lanes = std::min<size_t>(4, e - o0);
+            size_t at[4];                    // entry of each lane
+            ptrdiff_t node[4][4];            // lane, dj + 2·dk: the index of node (i, j + dj, k + dk)
+            __m128 T[4];
+            for (size_t l = 0; l < 4; ++l) {
+                const size_t o = o0 + std::min(l, lanes - 1);
+                while (o >= RS[row + 1]) ++row;
+                at[l] = o;
+                T[l] = _mm_load_ps(C[o].t);  // t and i's bits
+                for (int dk = 0; dk < 2; ++dk)
+                    for (int dj = 0; dj < 2; ++dj) node[l][dj + 2 * dk] = RB[row + size_t(dk) * sy + size_t(dj)] + C[o].i;
             }
-            alignas(16) float Vs[4];
-            _mm_store_ps(Vs, V);
-            const Vec3f v = c.mv.tail<3>();
-            in.v[vertexOf[o]] = v + s * (Vec3f(Vs[1], Vs[2], Vs[3]) - v);
-            // The volume push where a node the vertex reads holds excess
-            // (elsewhere ∇E = 0): x ← x − c·Δ²·∇E/max(1, r̄), ∇E = Σ E_n·∇w_n
-            // with ∇w_n = (w'x·wy·wz, wx·w'y·wz, wx·wy·w'z), w' = ∓1/Δ, the
-            // terms summed node by node, the three axes in SSE lanes.
-            if (!relaxed) continue;
-            __m128 En[2];  // E of the nodes di + 2·dj of planes dk = 0, 1
+            _MM_TRANSPOSE4_PS(T[0], T[1], T[2], T[3]);  // T[a]: t of axis a, lane by lane
+            const __m128 wx[2] = {_mm_sub_ps(one, T[0]), T[0]}, wy[2] = {_mm_sub_ps(one, T[1]), T[1]},
+                         wz[2] = {_mm_sub_ps(one, T[2]), T[2]};
+            // Friction: V̄ = Σ_n (w_n/M_n)·P_n over the nodes with mass, and
+            // r = Σ_n w_n·M_n·toRatio, node n = di + 2·dj + 4·dk in order.
+            __m128 Vx = zero, Vy = zero, Vz = zero, r = zero;
             for (int dk = 0; dk < 2; ++dk)
-                En[dk] = _mm_loadh_pi(_mm_loadl_pi(zero, reinterpret_cast<const __m64*>(E + RB[row + size_t(dk) * sy] + c.i)),
-                                      reinterpret_cast<const __m64*>(E + RB[row + size_t(dk) * sy + 1] + c.i));
-            if (_mm_movemask_ps(_mm_or_ps(_mm_cmpneq_ps(En[0], zero), _mm_cmpneq_ps(En[1], zero))) == 0) continue;
-            // ∇w_n = (A_di·B_dj)·C_dk lane by lane, A = (w'x, wx, wx),
-            // B = (wy, w'y, wy), C = (wz, wz, w'z); lane 3 unused.
-            const float tx = c.t[0], ty = c.t[1], tz = c.t[2];
-            const __m128 A[2] = {_mm_setr_ps(-invD, 1.f - tx, 1.f - tx, 0.f), _mm_setr_ps(invD, tx, tx, 0.f)};
-            const __m128 B[2] = {_mm_setr_ps(1.f - ty, -invD, 1.f - ty, 0.f), _mm_setr_ps(ty, invD, ty, 0.f)};
-            const __m128 Cz[2] = {_mm_setr_ps(1.f - tz, 1.f - tz, -invD, 0.f), _mm_setr_ps(tz, tz, invD, 0.f)};
-            const __m128 AB[4] = {_mm_mul_ps(A[0], B[0]), _mm_mul_ps(A[1], B[0]), _mm_mul_ps(A[0], B[1]),
-                                  _mm_mul_ps(A[1], B[1])};  // index di + 2·dj
-            __m128 grad = _mm_setzero_ps();
-            for (int dk = 0; dk < 2; ++dk) {
-                const __m128 Ek = En[dk];
-                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0x00), _mm_mul_ps(AB[0], Cz[dk])));
-                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0x55), _mm_mul_ps(AB[1], Cz[dk])));
-                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0xaa), _mm_mul_ps(AB[2], Cz[dk])));
-                grad = _mm_add_ps(grad, _mm_mul_ps(_mm_shuffle_ps(Ek, Ek, 0xff), _mm_mul_ps(AB[3], Cz[dk])));
+                for (int dj = 0; dj < 2; ++dj)
+                    for (int di = 0; di < 2; ++di) {
+                        // Lane l's node (M, P), transposed to M, Px, Py, Pz lane by lane.
+                        __m128 M = _mm_load_ps(N[node[0][dj + 2 * dk] + di].data());  // lane 0's, until transposed
+                        __m128 Px = _mm_load_ps(N[node[1][dj + 2 * dk] + di].data());
+                        __m128 Py = _mm_load_ps(N[node[2][dj + 2 * dk] + di].data());
+                        __m128 Pz = _mm_load_ps(N[node[3][dj + 2 * dk] + di].data());
+                        _MM_TRANSPOSE4_PS(M, Px, Py, Pz);
+                        const __m128 w = _mm_mul_ps(_mm_mul_ps(wx[di], wy[dj]), wz[dk]);
+                        const __m128 q = _mm_div_ps(w, M);
+                        const __m128 has = _mm_cmpgt_ps(M, zero);
+                        Vx = _mm_add_ps(Vx, _mm_and_ps(has, _mm_mul_ps(q, Px)));
+                        Vy = _mm_add_ps(Vy, _mm_and_ps(has, _mm_mul_ps(q, Py)));
+                        Vz = _mm_add_ps(Vz, _mm_and_ps(has, _mm_mul_ps(q, Pz)));
+                        r = _mm_add_ps(r, _mm_mul_ps(w, _mm_mul_ps(M, ratio4)));
+                    }
+            alignas(16) float vx[4], vy[4], vz[4], rs[4];
+            _mm_store_ps(vx, Vx);
+            _mm_store_ps(vy, Vy);
+            _mm_store_ps(vz, Vz);
+            _mm_store_ps(rs, r);
+            for (size_t l = 0; l < lanes; ++l) {
+                const Vec3f v = C[at[l]].mv.tail<3>();
+                in.v[vertexOf[at[l]]] = v + s * (Vec3f(vx[l], vy[l], vz[l]) - v);
             }
-            alignas(16) float G[4];
-            _mm_store_ps(G, grad);
-            const Vec3f gv(G[0], G[1], G[2]);
-            if (gv.squaredNorm() > 0.f) {
-                in.x[vertexOf[o]] -= (push / std::max(1.f, r)) * (R * gv);
-                ++moved;
+            // The volume push where a node a vertex reads holds excess
+            // (elsewhere ∇E = 0): x ← x − c·Δ²·∇E/max(1, r̄), ∇E = Σ_n E_n·∇w_n,
+            // ∇w_n = (w'x·wy·wz, wx·w'y·wz, wx·wy·w'z) as ((a·b)·c), w' = ∓1/Δ.
+            if (!relaxed) continue;
+            __m128 En[8];  // E of node n, lane by lane
+            __m128 any = zero;
+            for (int p = 0; p < 4; ++p) {  // p = dj + 2·dk: each lane's nodes di = 0, 1 in one 8-byte load
+                __m128 pair[4];
+                for (int l = 0; l < 4; ++l) pair[l] = _mm_loadl_pi(zero, reinterpret_cast<const __m64*>(E + node[l][p]));
+                const __m128 lo01 = _mm_unpacklo_ps(pair[0], pair[1]), lo23 = _mm_unpacklo_ps(pair[2], pair[3]);
+                const int dj = p & 1, dk = p >> 1;
+                En[4 * dk + 2 * dj] = _mm_movelh_ps(lo01, lo23);
+                En[4 * dk + 2 * dj + 1] = _mm_movehl_ps(lo23, lo01);
+                any = _mm_or_ps(any, _mm_or_ps(_mm_cmpneq_ps(En[4 * dk + 2 * dj], zero),
+                                                 _mm_cmpneq_ps(En[4 * dk + 2 * dj + 1], zero)));
+            }
+            if (_mm_movemask_ps(any) == 0) continue;
+            __m128 gx = zero, gy = zero, gz = zero;
+            for (int dk = 0; dk < 2; ++dk)
+                for (int dj = 0; dj < 2; ++dj)
+                    for (int di = 0; di < 2; ++di) {
+                        const __m128 En_ = En[di + 2 * dj + 4 * dk];
+                        gx = _mm_add_ps(gx, _mm_mul_ps(En_, _mm_mul_ps(_mm_mul_ps(dW[di], wy[dj]), wz[dk])));
+                        gy = _mm_add_ps(gy, _mm_mul_ps(En_, _mm_mul_ps(_mm_mul_ps(wx[di], dW[dj]), wz[dk])));
+                        gz = _mm_add_ps(gz, _mm_mul_ps(En_, _mm_mul_ps(_mm_mul_ps(wx[di], wy[dj]), dW[dk])));
+                    }
+            alignas(16) float g[3][4];
+            _mm_store_ps(g[0], gx);
+            _mm_store_ps(g[1], gy);
+            _mm_store_ps(g[2], gz);
+            for (size_t l = 0; l < lanes; ++l) {
+                const Vec3f gv(g[0][l], g[1][l], g[2][l]);
+                if (gv.squaredNorm() > 0.f) {
+                    in.x[vertexOf[at[l]]] -= (push / std::max(1.f, rs[l])) * (R * gv);
+                    ++moved;
+                }
             }
         }
         pushed += moved;
     });
     st.pushed = pushed;
 
-    // Leave the array all zeros for the next call: the stored rows hold
-    // little beyond what the splat wrote, so they are cleared whole, in
-    // chunks on the threads (a serial pass costs both threads its time).
-    run(kSortChunks, [&, N](size_t b, size_t e) {
-        const size_t from = stored * b / kSortChunks, to = stored * e / kSortChunks;
-        std::memset(static_cast<void*>(N + from), 0, (to - from) * sizeof(Eigen::Vector4f));
-    });
     return st;
 }
 

@@ -57,12 +57,13 @@
 // chunks on the threads (a stable sort's result is unique). A node holds
 // (M, P) only (λ_c = M_c·ℓ/m/Δ³: every vertex carries the same hair length
 // per mass), and only the nodes the vertices reach are stored, row by row
-// over each row's x span. After the splat one scan of the stored nodes
-// finds the densest node and the box above the target, the volume step
-// sweeps the nodes with hair in that box from a list holding each one's
-// neighbours, and one pass over the vertices reads each vertex's eight
-// nodes once for friction, the density it reads and the push (SSE lanes
-// doing the scalar operations in the scalar order: the same bits).
+// over each row's x span with a zero slot either side. After the splat one
+// pass over the stored nodes finds the densest node, the excess and the
+// first Jacobi sweep; the later sweeps run over the stored rows of the
+// planes the excess reaches, four nodes at a time (excess_diffusion.h);
+// and one pass over the vertices reads each vertex's eight nodes once for
+// friction, the density it reads and the push (SSE lanes doing the scalar
+// operations in the scalar order: the same bits).
 // Measured in docs/benchmarks.md ("B-sim with the hair-hair grid").
 #pragma once
 
@@ -91,6 +92,9 @@ struct GridInput {
     float lengthPerMass = 0.f;      ///< hair length a kilogram of guide stands for, m/kg
     Eigen::Isometry3f head = Eigen::Isometry3f::Identity();  ///< the frame the grid follows
     float h = 0.f;                  ///< substep, s
+    /// If set, receives x as it was before the volume push (`count`
+    /// entries), copied in a pass that reads x anyway.
+    Vec3f* before = nullptr;
 };
 
 /// What one apply() did (diagnostics and tests).
@@ -134,15 +138,18 @@ class HairGrid {
     std::vector<Entry> entries_;
     std::vector<uint32_t> order_;
     std::vector<int> spanLo_, spanHi_;  ///< per base row: the least and largest i of its vertices
+    std::vector<int> chunkLo_, chunkHi_;  ///< the same per chunk of the sort and row (set where it counts)
     std::vector<ptrdiff_t> rowBase_;   ///< per node row: node (i, j, k) is nodes_[rowBase_[row] + i]
-    std::vector<int> rowLo_, rowEnd_;  ///< per node row: the stored i span [lo, end)
+    std::vector<int> rowLo_, rowEnd_;  ///< per node row: the stored i span [lo, end), a zero slot either side
     std::vector<uint32_t> planeStart_; ///< first stored node of each plane (and the count at the end)
-    OccupiedNodes occupied_;           ///< the volume step's nodes with hair
-    std::vector<float> relaxed_;       ///< its E per stored node, then a zero slot
+    /// The volume step's excess (NaN where no hair) and its two sweep
+    /// buffers, per stored node slot (excess_diffusion.h's NodeRows).
+    std::vector<float> excess_, sweepA_, sweepB_;
     /// Per node (m, P): mass and momentum, one SSE packet, so the splat
-    /// adds w·(m, m·v) in one operation; zero between calls. The hair
+    /// adds w·(m, m·v) in one operation. The hair
     /// length is M·lengthPerMass (the same for every vertex), not stored:
-    /// the passes wait on the lattice's memory, not on arithmetic.
+    /// the passes wait on the lattice's memory, not on arithmetic. Cleared
+    /// by each call before its splat.
     std::vector<Eigen::Vector4f> nodes_;
 };
 
