@@ -243,7 +243,7 @@ TEST(VdbFile, ParallelLeafBuffersGiveOpenVdbsSerialBytes) {
         in.close();
         ASSERT_EQ(grids.size(), 2u);
         openvdb::io::File out(theirs.string());
-        out.setCompression(openvdb::io::COMPRESS_ACTIVE_MASK | (half ? 0u : openvdb::io::COMPRESS_BLOSC));
+        out.setCompression(uint32_t(openvdb::io::COMPRESS_ACTIVE_MASK) | (half ? 0u : uint32_t(openvdb::io::COMPRESS_BLOSC)));
         out.write(grids);
         out.close();
         std::string a = test::readFile(ours), b = test::readFile(theirs);

@@ -145,7 +145,9 @@ void fillTrees(openvdb::FloatTree& densityTree, openvdb::Vec3STree* velocityTree
             const size_t b = first + i;
             const Vec3i& o = grid.blockOrigin(b);
             const openvdb::Coord origin(o.x(), o.y(), o.z());
-            densityLeaves[i] = std::make_unique<DensityLeaf>(origin, 0.f, false);
+            // PartialCreate: the buffer is allocated by data() below without
+            // being cleared first (every value is written).
+            densityLeaves[i] = std::make_unique<DensityLeaf>(openvdb::PartialCreate(), origin, 0.f, false);
             const float* density = grid.blockDensity(b);
             // Whole buffers and 64-bit mask words: inactive voxels hold the
             // background 0, as the block does.
@@ -161,7 +163,7 @@ void fillTrees(openvdb::FloatTree& densityTree, openvdb::Vec3STree* velocityTree
                 mask.getWord<uint64_t>(w) = bits;
             }
             if (velocityTree) {
-                velocityLeaves[i] = std::make_unique<VelocityLeaf>(origin, openvdb::Vec3s(0.f), false);
+                velocityLeaves[i] = std::make_unique<VelocityLeaf>(openvdb::PartialCreate(), origin, openvdb::Vec3s(0.f), false);
                 const Vec3f* velocity = grid.blockVelocity(b);
                 openvdb::Vec3s* vvalues = velocityLeaves[i]->buffer().data();
                 for (int v = 0; v < DensityGrid::kBlockVoxels; ++v)
