@@ -105,7 +105,11 @@ void walkTile(const Segment& s, const Vec3i& origin, Piece&& piece) {
     __m128d pxy = _mm_add_pd(_mm_set_pd(w.cell[1], w.cell[0]), fxy), pz = _mm_add_sd(_mm_set_sd(w.cell[2]), fz);
     __m128d txy = _mm_set_pd(w.tMax[1], w.tMax[0]), tz = _mm_set_sd(w.tMax[2]);
     const __m128d ones = _mm_castsi128_pd(_mm_set1_epi32(-1));
-    int cell[3] = {w.cell[0], w.cell[1], w.cell[2]};
+    // The cell in three registers, each advanced by its step and a mask
+    // (cell[e] += step[e] with e computed went through memory: a store and
+    // three reloads a piece).
+    int cx = w.cell[0], cy = w.cell[1], cz = w.cell[2];
+    const int stepX = w.step[0], stepY = w.step[1], stepZ = w.step[2];
     double t = w.tIn;
     for (;;) {
         // e = 1 if t_y < t_x, else 0; then 2 if t_z < t_e.
@@ -114,16 +118,18 @@ void walkTile(const Segment& s, const Vec3i& origin, Piece&& piece) {
         const __m128d te = _mm_or_pd(_mm_and_pd(yFirst, ty), _mm_andnot_pd(yFirst, txy));
         const __m128d zFirst = _mm_cmplt_sd(tz, te);                       // low lane: t_z < t_e
         const double tNext = _mm_cvtsd_f64(_mm_or_pd(_mm_and_pd(zFirst, tz), _mm_andnot_pd(zFirst, te)));
-        const int e = _mm_movemask_pd(zFirst) & 1 ? 2 : (_mm_movemask_pd(yFirst) & 1);
+        const int zBit = _mm_movemask_pd(zFirst) & 1, yBit = _mm_movemask_pd(yFirst) & 1;  // e = z, y or x
         const double t1 = std::min(tNext, 1.0);
         // The tile owns voxels 0..kTile-1, so cells -1..kTile-1 reach it.
-        const int lx = cell[0] - ox, ly = cell[1] - oy, lz = cell[2] - oz;
+        const int lx = cx - ox, ly = cy - oy, lz = cz - oz;
         if (t1 > t && unsigned(lx + 1) <= unsigned(kTile) && unsigned(ly + 1) <= unsigned(kTile) &&
             unsigned(lz + 1) <= unsigned(kTile))
             piece(lx, ly, lz, t, t1, _mm_sub_pd(pxy, fxy), _mm_cvtsd_f64(_mm_sub_sd(pz, fz)));
         if (tNext >= w.tOut) return;  // tOut ≤ 1: the segment's end or the box's
         t = std::max(t, t1);
-        cell[e] += w.step[e];
+        cx += stepX & -((zBit | yBit) ^ 1);
+        cy += stepY & -(yBit & (zBit ^ 1));
+        cz += stepZ & -zBit;
         // Masks of the axis that advances: x, y in the pair, z in the low lane.
         const __m128d notZ = _mm_andnot_pd(_mm_unpacklo_pd(zFirst, zFirst), ones);
         const __m128d yLanes = _mm_unpacklo_pd(yFirst, yFirst);

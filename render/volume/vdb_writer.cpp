@@ -16,6 +16,9 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <memory>
+#include <streambuf>
+#include <string>
 #include <mutex>
 
 namespace hp {
@@ -120,29 +123,31 @@ openvdb::math::Transform::Ptr toVdbTransform(const GridTransform& t) {
 
 /// Fills the density tree (values × scale) and, if given, the velocity tree
 /// from the grid's blocks, adding each block to `digest`. Blocks and OpenVDB
-/// leaves are both 8³ in x-major
-/// order, so each block becomes one leaf: created serially (topology
-/// changes are not thread-safe), filled in parallel. With `consume`, each
-/// block is freed once copied, so the grid and the trees are not both whole
-/// in memory.
+/// leaves are both 8³ in x-major order, so each block becomes one leaf: the
+/// leaves are allocated and filled in parallel, then attached to the tree
+/// serially (topology changes are not thread-safe; addLeaf only links a
+/// pointer, where touchLeaf also allocated and cleared the leaf on that one
+/// thread). With `consume`, each block is freed once copied, so the grid
+/// and the trees are not both whole in memory.
 void fillTrees(openvdb::FloatTree& densityTree, openvdb::Vec3STree* velocityTree, const DensityGrid& grid,
                float scale, DensityGrid* consume, Digest* digest) {
-    static_assert(openvdb::FloatTree::LeafNodeType::DIM == DensityGrid::kBlockSize,
-                  "DensityGrid blocks must match OpenVDB leaves");
+    using DensityLeaf = openvdb::FloatTree::LeafNodeType;
+    using VelocityLeaf = openvdb::Vec3STree::LeafNodeType;
+    static_assert(DensityLeaf::DIM == DensityGrid::kBlockSize, "DensityGrid blocks must match OpenVDB leaves");
     // In batches, so that with `consume` the memory freed by one batch's
     // blocks holds the next batch's leaves.
     constexpr size_t kBatch = 4096;
-    std::vector<openvdb::FloatTree::LeafNodeType*> densityLeaves(kBatch);
-    std::vector<openvdb::Vec3STree::LeafNodeType*> velocityLeaves(kBatch);
+    std::vector<std::unique_ptr<DensityLeaf>> densityLeaves(kBatch);
+    std::vector<std::unique_ptr<VelocityLeaf>> velocityLeaves(kBatch);
     for (size_t first = 0; first < grid.blockCount(); first += kBatch) {
         const size_t count = std::min(kBatch, grid.blockCount() - first);
-        for (size_t i = 0; i < count; ++i) {
-            const Vec3i& o = grid.blockOrigin(first + i);
-            densityLeaves[i] = densityTree.touchLeaf(openvdb::Coord(o.x(), o.y(), o.z()));
-            if (velocityTree) velocityLeaves[i] = velocityTree->touchLeaf(openvdb::Coord(o.x(), o.y(), o.z()));
-        }
         tbb::parallel_for(size_t(0), count, [&](size_t i) {
             const size_t b = first + i;
+            const Vec3i& o = grid.blockOrigin(b);
+            const openvdb::Coord origin(o.x(), o.y(), o.z());
+            // PartialCreate: the buffer is allocated by data() below without
+            // being cleared first (every value is written).
+            densityLeaves[i] = std::make_unique<DensityLeaf>(openvdb::PartialCreate(), origin, 0.f, false);
             const float* density = grid.blockDensity(b);
             // Whole buffers and 64-bit mask words: inactive voxels hold the
             // background 0, as the block does.
@@ -158,22 +163,94 @@ void fillTrees(openvdb::FloatTree& densityTree, openvdb::Vec3STree* velocityTree
                 mask.getWord<uint64_t>(w) = bits;
             }
             if (velocityTree) {
+                velocityLeaves[i] = std::make_unique<VelocityLeaf>(openvdb::PartialCreate(), origin, openvdb::Vec3s(0.f), false);
                 const Vec3f* velocity = grid.blockVelocity(b);
                 openvdb::Vec3s* vvalues = velocityLeaves[i]->buffer().data();
                 for (int v = 0; v < DensityGrid::kBlockVoxels; ++v)
                     vvalues[v] = openvdb::Vec3s(velocity[v].x(), velocity[v].y(), velocity[v].z());
                 velocityLeaves[i]->getValueMask() = mask;
             }
-            const Vec3i& o = grid.blockOrigin(b);
             const uint64_t seed = (uint64_t(uint32_t(o.x())) << 42) ^ (uint64_t(uint32_t(o.y())) << 21) ^ uint32_t(o.z());
             digest->add(density, sizeof(float) * DensityGrid::kBlockVoxels, seed);
             if (velocityTree) digest->add(grid.blockVelocity(b), sizeof(Vec3f) * DensityGrid::kBlockVoxels, ~seed);
             if (consume) consume->releaseBlock(b);
         });
+        for (size_t i = 0; i < count; ++i) {
+            densityTree.addLeaf(densityLeaves[i].release());
+            if (velocityTree) velocityTree->addLeaf(velocityLeaves[i].release());
+        }
     }
     openvdb::tools::pruneInactive(densityTree);
     if (velocityTree) openvdb::tools::pruneInactive(*velocityTree);
 }
+
+/// A stream buffer that appends to a string: one chunk of leaves serialized in memory.
+class StringBuffer final : public std::streambuf {
+  public:
+    std::string bytes;
+
+  protected:
+    std::streamsize xsputn(const char* s, std::streamsize n) override {
+        bytes.append(s, size_t(n));
+        return n;
+    }
+    int_type overflow(int_type c) override {
+        if (!traits_type::eq_int_type(c, traits_type::eof())) bytes.push_back(traits_type::to_char_type(c));
+        return traits_type::not_eof(c);
+    }
+};
+
+/// An OpenVDB grid whose buffers (the leaves' values: nearly all of the
+/// file) are serialized in parallel. Grid::writeBuffers streams the leaves
+/// one after the other in the tree's depth-first order, each by
+/// LeafNode::writeBuffers (value mask, then the values: active-mask
+/// compression, half conversion, Blosc), all on the archive's one thread.
+/// Here chunks of leaves in that same order go through the same
+/// LeafNode::writeBuffers into memory streams on TBB's threads and are then
+/// written in order: the same bytes (VdbFile.ParallelLeafBuffersGiveOpenVdbsSerialBytes).
+/// Each chunk's stream takes the archive stream's format state (copyfmt):
+/// OpenVDB keeps the compression flags, the background value and the stream
+/// metadata in iword/pword slots, which LeafNode::writeBuffers reads.
+template <typename GridT>
+class ParallelBuffersGrid final : public GridT {
+  public:
+    using GridT::GridT;
+    using Ptr = std::shared_ptr<ParallelBuffersGrid>;
+
+    void writeBuffers(std::ostream& os) const override {
+        if (GridT::hasMultiPassIO()) {  // point grids: passes over the whole tree
+            GridT::writeBuffers(os);
+            return;
+        }
+        using LeafT = typename GridT::TreeType::LeafNodeType;
+        std::vector<const LeafT*> leaves;
+        leaves.reserve(this->tree().leafCount());
+        this->tree().getNodes(leaves);  // depth-first, the order of Tree::writeBuffers
+        const bool toHalf = this->saveFloatAsHalf();
+        // Rounds of chunks, so at most a round's bytes (~8 MiB of half
+        // values) wait in memory before the archive's stream takes them.
+        constexpr size_t kChunk = 256, kChunksPerRound = 32;
+        std::vector<std::string> chunks(kChunksPerRound);
+        for (size_t first = 0; first < leaves.size(); first += kChunk * kChunksPerRound) {
+            const size_t end = std::min(leaves.size(), first + kChunk * kChunksPerRound);
+            const size_t count = (end - first + kChunk - 1) / kChunk;
+            tbb::parallel_for(size_t(0), count, [&](size_t c) {
+                StringBuffer buffer;
+                buffer.bytes.reserve(kChunk * (sizeof(typename LeafT::ValueType) * LeafT::SIZE + 80));
+                std::ostream chunk(&buffer);
+                chunk.copyfmt(os);
+                const size_t from = first + c * kChunk, to = std::min(end, from + kChunk);
+                for (size_t i = from; i < to; ++i) leaves[i]->writeBuffers(chunk, toHalf);
+                if (!chunk) throw openvdb::IoError("cannot serialize leaf buffers in memory");
+                chunks[c] = std::move(buffer.bytes);
+            });
+            for (size_t c = 0; c < count; ++c) os.write(chunks[c].data(), std::streamsize(chunks[c].size()));
+        }
+    }
+};
+
+using DensityVdbGrid = ParallelBuffersGrid<openvdb::FloatGrid>;
+using VelocityVdbGrid = ParallelBuffersGrid<openvdb::Vec3SGrid>;
 
 }  // namespace
 
@@ -185,7 +262,7 @@ void writeGrids(const std::filesystem::path& file, const DensityGrid& grid, cons
     const openvdb::math::Transform::Ptr transform = toVdbTransform(grid.transform());
     const float scale = float(settings.densityScale);
 
-    openvdb::FloatGrid::Ptr density = openvdb::FloatGrid::create(0.f);
+    auto density = std::make_shared<DensityVdbGrid>(0.f);
     density->setName("density");
     density->setGridClass(openvdb::GRID_FOG_VOLUME);
     density->setTransform(transform);
@@ -207,9 +284,9 @@ void writeGrids(const std::filesystem::path& file, const DensityGrid& grid, cons
     density->insertMeta("density_scale", openvdb::DoubleMetadata(settings.densityScale));
 
     openvdb::GridPtrVec grids{density};
-    openvdb::Vec3SGrid::Ptr velocity;
+    VelocityVdbGrid::Ptr velocity;
     if (settings.velocity && grid.hasVelocity()) {
-        velocity = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.f));
+        velocity = std::make_shared<VelocityVdbGrid>(openvdb::Vec3s(0.f));
         velocity->setName("velocity");
         velocity->setTransform(transform);
         velocity->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);

@@ -159,14 +159,35 @@ void extractBlocks(TileBuffer<C>& tile, TileBlocks* out) {
                 if (!spare) spare.reset(new DensityGrid::DensityBlock);  // every voxel written below
                 DensityGrid::DensityBlock& density = *spare;
                 bool any = false;
-                for (int x = 0; x < kBlock; ++x)
-                    for (int y = 0; y < kBlock; ++y) {
-                        const double* row = values + size_t(TileBuffer<C>::index(x0 + x, y0 + y, z0)) * C;
-                        for (int z = 0; z < kBlock; ++z) {
-                            any |= row[z * C] > 0;
-                            density[size_t(DensityGrid::voxelOffset(x, y, z))] = float(row[z * C]);
+                if constexpr (C == 1) {
+                    // A row of 8 voxels in SSE2: four pairs rounded to floats
+                    // (cvtpd2ps rounds as float(double) does) and compared
+                    // with 0 (GCC compiled the scalar loop to a compare, a
+                    // set and an or per voxel).
+                    const __m128d zero = _mm_setzero_pd();
+                    __m128d positive = zero;
+                    for (int x = 0; x < kBlock; ++x)
+                        for (int y = 0; y < kBlock; ++y) {
+                            const double* row = values + TileBuffer<C>::index(x0 + x, y0 + y, z0);
+                            float* to = density.data() + DensityGrid::voxelOffset(x, y, 0);
+                            const __m128d v0 = _mm_loadu_pd(row), v1 = _mm_loadu_pd(row + 2),
+                                          v2 = _mm_loadu_pd(row + 4), v3 = _mm_loadu_pd(row + 6);
+                            positive = _mm_or_pd(positive, _mm_or_pd(_mm_or_pd(_mm_cmpgt_pd(v0, zero), _mm_cmpgt_pd(v1, zero)),
+                                                                     _mm_or_pd(_mm_cmpgt_pd(v2, zero), _mm_cmpgt_pd(v3, zero))));
+                            _mm_storeu_ps(to, _mm_movelh_ps(_mm_cvtpd_ps(v0), _mm_cvtpd_ps(v1)));
+                            _mm_storeu_ps(to + 4, _mm_movelh_ps(_mm_cvtpd_ps(v2), _mm_cvtpd_ps(v3)));
                         }
-                    }
+                    any = _mm_movemask_pd(positive) != 0;
+                } else {
+                    for (int x = 0; x < kBlock; ++x)
+                        for (int y = 0; y < kBlock; ++y) {
+                            const double* row = values + size_t(TileBuffer<C>::index(x0 + x, y0 + y, z0)) * C;
+                            for (int z = 0; z < kBlock; ++z) {
+                                any |= row[z * C] > 0;
+                                density[size_t(DensityGrid::voxelOffset(x, y, z))] = float(row[z * C]);
+                            }
+                        }
+                }
                 if (!any) continue;
                 out->origins.push_back(tile.origin + Vec3i(x0, y0, z0));
                 out->density.push_back(std::move(spare));
@@ -197,8 +218,21 @@ void extractBlocks(TileBuffer<C>& tile, TileBlocks* out) {
                 // the clearing. An odd row's extra double is the next voxel of
                 // the same row (zHi < kPad − 1 then), cleared or zero anyway:
                 // extraction is done.
+                // A row of 9 (all but the last cell block) as five explicit
+                // pair stores: GCC turned the loop into a `rep stos` per row,
+                // whose start-up was 40% of extracting.
                 double* row = values + (size_t(x * kPad + y) * kPad + zLo) * C;
-                for (int i = 0; i < (zHi - zLo + 1) * C; i += 2) _mm_storeu_pd(row + i, _mm_setzero_pd());
+                const int count = (zHi - zLo + 1) * C;
+                if (count == 9) {
+                    const __m128d zero = _mm_setzero_pd();
+                    _mm_storeu_pd(row, zero);
+                    _mm_storeu_pd(row + 2, zero);
+                    _mm_storeu_pd(row + 4, zero);
+                    _mm_storeu_pd(row + 6, zero);
+                    _mm_storeu_pd(row + 8, zero);
+                } else {
+                    for (int i = 0; i < count; i += 2) _mm_storeu_pd(row + i, _mm_setzero_pd());
+                }
             }
     }
     std::fill(std::begin(tile.touched), std::end(tile.touched), 0);

@@ -115,42 +115,58 @@ struct TileSpan {
     size_t count() const { return size_t(size[0]) * size[1] * size[2]; }
 };
 
+/// How many equal parts a segment spanning `d` (index space) is cut into.
+size_t partsOf(const Vec3d& d) { return size_t(std::max(1.0, std::ceil(d.cwiseAbs().maxCoeff() / kMaxPartVoxels))); }
+
 /// All segments with volume, prepared in index space, strands in Morton
 /// order of their middle vertex: the segments one tile needs then lie close
 /// together in memory (a Fibonacci lattice's strand order jumps around the
 /// head, which made every tile's segment loads cache misses).
+///
+/// Two parallel passes over the strands, each mapping a vertex to index
+/// space once: the first checks the range, takes the Morton code and counts
+/// the parts; the second writes the segments. (The range check, the order,
+/// the counts and the segments were four passes, the last two mapping each
+/// vertex twice per segment: seven maps a vertex. The values are the same
+/// expressions of the same mapped vertices, bit for bit.)
 BulkVector<Segment> prepareSegments(const StrandFrame& strands, const GridTransform& transform, const TileReach& reach,
                                     std::vector<SegmentVelocity>* velocities, BulkVector<TileSpan>* spans) {
     const size_t n = strands.strandCount();
+    const double limit = double(DensityGrid::kMaxIndex) - 2 * kTile;
     std::vector<std::pair<uint64_t, uint32_t>> order(n);
-    tbb::parallel_for(size_t(0), n, [&](size_t s) {
-        const uint32_t count = strands.vertexCount(s);
-        uint64_t code = 0;
-        if (count > 0) {
-            const Vec3d p = transform.toIndex(strands.positions[strands.first(s) + count / 2].cast<double>());
-            auto q = [](double v) { return uint32_t(int64_t(std::floor(v)) >> kTileLog2) & 0x1FFFFF; };
-            code = morton(q(p.x()), q(p.y()), q(p.z()));
+    std::vector<size_t> partCount(n);
+    std::atomic<bool> outOfRange{false};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t s = range.begin(); s != range.end(); ++s) {
+            const uint32_t begin = strands.first(s), end = strands.offsets[s + 1], middle = begin + (end - begin) / 2;
+            uint64_t code = 0;
+            size_t parts = 0;
+            bool inRange = true;
+            Vec3d previous = Vec3d::Zero();
+            for (uint32_t v = begin; v < end; ++v) {
+                const Vec3d p = transform.toIndex(strands.positions[v].cast<double>());
+                if (!(p.cwiseAbs().maxCoeff() <= limit)) {
+                    inRange = false;  // reported by checkRange below (parts would overflow)
+                    break;
+                }
+                if (v > begin) parts += partsOf(p - previous);
+                if (v == middle) {
+                    auto q = [](double x) { return uint32_t(int64_t(std::floor(x)) >> kTileLog2) & 0x1FFFFF; };
+                    code = morton(q(p.x()), q(p.y()), q(p.z()));
+                }
+                previous = p;
+            }
+            if (!inRange) outOfRange = true;
+            order[s] = {code, uint32_t(s)};
+            partCount[s] = parts;
         }
-        order[s] = {code, uint32_t(s)};
     });
+    if (outOfRange) checkRange(strands, transform);  // throws, naming the first such vertex
     tbb::parallel_sort(order.begin(), order.end());  // unique pairs: a deterministic order
 
-    // Parts per segment (long segments split), then each strand's first part.
-    auto partsOf = [&](uint32_t v) {
-        const double length = (transform.toIndex(strands.positions[v].cast<double>()) -
-                               transform.toIndex(strands.positions[v - 1].cast<double>()))
-                                  .cwiseAbs()
-                                  .maxCoeff();
-        return size_t(std::max(1.0, std::ceil(length / kMaxPartVoxels)));
-    };
+    // Each strand's first part.
     std::vector<size_t> first(n + 1, 0);
-    tbb::parallel_for(size_t(0), n, [&](size_t i) {
-        const size_t s = order[i].second;
-        size_t parts = 0;
-        for (uint32_t v = strands.first(s) + 1; v < strands.offsets[s + 1]; ++v) parts += partsOf(v);
-        first[i + 1] = parts;
-    });
-    for (size_t i = 0; i < n; ++i) first[i + 1] += first[i];
+    for (size_t i = 0; i < n; ++i) first[i + 1] = first[i] + partCount[order[i].second];
 
     BulkVector<Segment> segments(first[n]);
     spans->resize(first[n]);
@@ -161,11 +177,14 @@ BulkVector<Segment> prepareSegments(const StrandFrame& strands, const GridTransf
     tbb::parallel_for(size_t(0), n, [&](size_t i) {
         const size_t s = order[i].second;
         size_t out = first[i];
-        for (uint32_t v = strands.first(s) + 1; v < strands.offsets[s + 1]; ++v) {
+        const uint32_t begin = strands.first(s), end = strands.offsets[s + 1];
+        if (end == begin) return;
+        Vec3d a = transform.toIndex(strands.positions[begin].cast<double>());
+        for (uint32_t v = begin + 1; v < end; ++v) {
             const Vec3d p0 = strands.positions[v - 1].cast<double>(), p1 = strands.positions[v].cast<double>();
-            const Vec3d a = transform.toIndex(p0), d = transform.toIndex(p1) - a;
+            const Vec3d next = transform.toIndex(p1), d = next - a;
             const double r0 = strands.radii[v - 1], r1 = strands.radii[v];
-            const size_t parts = partsOf(v);
+            const size_t parts = partsOf(d);
             const double k = kPi * (p1 - p0).norm() / voxelVolume / double(parts);
             for (size_t j = 0; j < parts; ++j, ++out) {
                 const double u0 = double(j) / double(parts), u1 = double(j + 1) / double(parts);
@@ -190,6 +209,7 @@ BulkVector<Segment> prepareSegments(const StrandFrame& strands, const GridTransf
                     (*velocities)[out] = {v0 + dv * float(u0), v0 + dv * float(u1)};
                 }
             }
+            a = next;
         }
     });
     if (absurd) {  // the first such segment, for the message
@@ -430,12 +450,11 @@ double hairVolume(const StrandFrame& strands) {
 }
 
 DensityGrid voxelize(const StrandFrame& strands, const GridTransform& transform, const VoxelizeSettings& settings) {
-    PhaseClock clock(settings.phases);  // the checks count as preparing
+    PhaseClock clock(settings.phases);  // the checks count as preparing (the range check is in prepareSegments)
     strands.validate();
     const double voxelVolume = transform.voxelVolume();
     if (!(voxelVolume > 0) || !std::isfinite(voxelVolume) || !transform.offset.allFinite())
         throw Error("voxelize: the grid transform is degenerate");
-    checkRange(strands, transform);
     return settings.velocity ? voxelizeTiles<4>(strands, transform, settings, clock)
                              : voxelizeTiles<1>(strands, transform, settings, clock);
 }
