@@ -37,7 +37,13 @@ uniform vec3 uForward;  // sorted: the hair's forward albedo a_f (0 for Kajiya-K
 // (to first order in each a_j; the over operator's 1 - A for a_f = 0). The
 // light the fibres turn and spread away from the straight path is taken from
 // skin a few fibre widths away, of about the same radiance.
+// NO_FORWARD_SCATTERING: a_f = 0 (Kajiya-Kay hair), the over operator's 1 - A
+// without the pow (llvmpipe's is exp2(log2 x y), its cost per sample and channel).
+#ifdef NO_FORWARD_SCATTERING
+vec3 skinThrough(float coverage) { return vec3(max(1.0 - coverage, 1e-30)); }
+#else
 vec3 skinThrough(float coverage) { return pow(vec3(max(1.0 - coverage, 1e-30)), vec3(1.0) - uForward); }
+#endif
 
 layout(location = 0) out vec4 oColor;
 layout(location = 1) out vec4 oDepth;

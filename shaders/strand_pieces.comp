@@ -7,7 +7,9 @@
 // the same tessellation coordinates (equal spacing: x = k / n on line l) as
 // one strip of lines * n pieces (the end of line l is the start of line
 // l + 1), shaded per point, and the pieces' index pairs, in patch order so
-// the sorted patches stay back to front. Invocation = patch.
+// the sorted patches stay back to front. Invocation = patch. (An
+// invocation a point, its patch from a CPU-written list, cost more:
+// docs/benchmarks.md.)
 #include "common.glsl"
 #include "strand_curve.glsl"
 #ifdef EMIT
@@ -17,7 +19,8 @@
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Points { vec4 point[]; };  // xyz position, w radius
 layout(std430, binding = 1) readonly buffer Patches { uint patchIndex[]; };  // PATCH_SIZE a patch
-layout(std430, binding = 2) buffer Shape { uint shape[]; };  // per patch: lines << 8 | pieces a line
+// Per patch: segments << 16 | lines << 8 | pieces a line; 0 culled.
+layout(std430, binding = 2) buffer Shape { uint shape[]; };
 #ifdef EMIT
 layout(std430, binding = 3) readonly buffer Firsts { uvec2 first[]; };  // per patch: first vertex, first index
 layout(std430, binding = 4) writeonly buffer Vertices { vec4 vertex[]; };  // two a point: clip position; rgb, alpha
@@ -37,10 +40,11 @@ int patchSegments(uint p) {
 }
 
 void main() {
-    uint p = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
+    uint id = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
+#ifdef COUNT
+    uint p = id;
     if (p >= uPatches) return;
     int segments = patchSegments(p);
-#ifdef COUNT
     // strand.tesc, THIN_PASS, word for word.
     float pixels = 0.0;
     bvec4 outside = bvec4(true);
@@ -62,10 +66,14 @@ void main() {
     float pieces = uTess.y > 0.0 ? clamp(ceil(pixels / uTess.y), 1.0, most) : most;
     float lines = ceil(pieces / 64.0);
     bool cull = any(outside) || behind || segments < 1 || widest > uTess.w;
-    shape[p] = cull ? 0u : (uint(lines) << 8) | uint(ceil(pieces / lines));
+    // The segments too, so the emit pass need not count them again.
+    shape[p] = cull ? 0u : (uint(segments) << 16) | (uint(lines) << 8) | uint(ceil(pieces / lines));
 #else
+    uint p = id;
+    if (p >= uPatches) return;
     uint s_ = shape[p];
-    uint lines = s_ >> 8, n = s_ & 255u;
+    int segments = int(s_ >> 16);
+    uint lines = (s_ >> 8) & 255u, n = s_ & 255u;
     if (lines == 0u) return;
     uint count = lines * n;
     uvec2 f = first[p];

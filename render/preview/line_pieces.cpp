@@ -41,14 +41,17 @@ void LinePieces::compile(bool on, const std::vector<std::string>& defines, const
                       shading);
 }
 
-void LinePieces::build(const StrandBuffers& strands) {
-    indexCount = 0;
+void LinePieces::countPieces(const StrandBuffers& strands) {
+    indexCount = pointCount = 0;
     const size_t patches = strands.patchSize > 0 ? strands.indexCount / size_t(strands.patchSize) : 0;
+    patchCount = patches;
     if (!patches) return;
     ensureBuffer(shape, shapeCapacity, patches * 4);
     ensureBuffer(firsts, firstCapacity, patches * 8);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, strands.vertices.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, strands.indices);
+    strandPoints = strands.vertices.id();
+    strandPatches = strands.indices;
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, strandPoints);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, strandPatches);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, shape);
     count.use();
     glProgramUniform1ui(count.id(), count.uniform("uPatches"), GLuint(patches));
@@ -60,16 +63,21 @@ void LinePieces::build(const StrandBuffers& strands) {
     firstPairs.resize(patches * 2);
     uint32_t vertex = 0, index = 0;
     for (size_t p = 0; p < patches; ++p) {
-        const uint32_t pieces = (shapes[p] >> 8) * (shapes[p] & 255u);
+        const uint32_t pieces = ((shapes[p] >> 8) & 255u) * (shapes[p] & 255u);
         firstPairs[2 * p] = vertex;
         firstPairs[2 * p + 1] = index;
         if (pieces) vertex += pieces + 1, index += 2 * pieces;
     }
+    pointCount = vertex;
     indexCount = index;
     if (!index) return;
     glNamedBufferSubData(firsts, 0, GLsizeiptr(patches * 8), firstPairs.data());
-    ensureBuffer(vertices, vertexCapacity, size_t(vertex) * 32);
-    ensureBuffer(indices, indexCapacity, size_t(index) * 4);
+}
+
+void LinePieces::emitPieces() {
+    if (!indexCount) return;
+    ensureBuffer(vertices, vertexCapacity, pointCount * 32);
+    ensureBuffer(indices, indexCapacity, indexCount * 4);
     if (!vao) {
         glCreateVertexArrays(1, &vao);
         glEnableVertexArrayAttrib(vao, 0);
@@ -83,10 +91,13 @@ void LinePieces::build(const StrandBuffers& strands) {
     glVertexArrayElementBuffer(vao, indices);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, firsts);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, vertices);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, strandPoints);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, strandPatches);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, shape);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, indices);
     emit.use();
-    glProgramUniform1ui(emit.id(), emit.uniform("uPatches"), GLuint(patches));
-    dispatchRows(patches);
+    glProgramUniform1ui(emit.id(), emit.uniform("uPatches"), GLuint(patchCount));
+    dispatchRows(patchCount);
     glMemoryBarrier(GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_ELEMENT_ARRAY_BARRIER_BIT);
 }
 
@@ -101,7 +112,8 @@ void LinePieces::destroy() {
     for (unsigned* b : {&shape, &firsts, &vertices, &indices})
         if (*b) glDeleteBuffers(1, b), *b = 0;
     if (vao) glDeleteVertexArrays(1, &vao), vao = 0;
-    shapeCapacity = firstCapacity = vertexCapacity = indexCapacity = indexCount = 0;
+    shapeCapacity = firstCapacity = vertexCapacity = indexCapacity = 0;
+    indexCount = pointCount = patchCount = 0;
 }
 
 }  // namespace hp

@@ -24,7 +24,8 @@ bool linePiecesInCompute(int setting, const std::string& renderer);
 struct LinePieces {
     unsigned shape = 0, firsts = 0, vertices = 0, indices = 0, vao = 0;
     size_t shapeCapacity = 0, firstCapacity = 0, vertexCapacity = 0, indexCapacity = 0;
-    size_t indexCount = 0;
+    size_t indexCount = 0, pointCount = 0, patchCount = 0;
+    unsigned strandPoints = 0, strandPatches = 0;  ///< the strand buffers counted (not owned)
     std::vector<uint32_t> shapes, firstPairs;  ///< the counts read back, the prefix sums sent
 
     GlProgram count, emit, lines;
@@ -33,10 +34,11 @@ struct LinePieces {
     /// and the shading's) and `shading` (hair.frag's), or drops them (`on` false).
     void compile(bool on, const std::vector<std::string>& defines, const std::vector<std::string>& shading);
     bool compiled() const { return emit.id() != 0; }
-    /// Counts, sums on the CPU and emits the pieces of the patches of
-    /// `strands` (in its current order) with the camera's uniforms and
-    /// textures bound.
-    void build(const StrandBuffers& strands);
+    /// Counts the pieces of the patches of `strands` (in its current order)
+    /// with the camera's uniforms bound and sums them on the CPU.
+    void countPieces(const StrandBuffers& strands);
+    /// Then emits and shades them (the camera's uniforms and textures bound).
+    void emitPieces();
     /// Draws them as GL_LINES (strand_pieces.vert, hair.frag).
     void draw() const;
     void destroy();
